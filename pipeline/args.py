@@ -1,0 +1,94 @@
+"""Parsing of command-line quantities: blocks, accelerations, angles, units.
+
+Every parser raises :class:`ArgumentError` with a one-line message; the command line turns it
+into exit status 2.
+"""
+from __future__ import annotations
+
+import math
+import re
+
+from pulses import G
+
+
+class ArgumentError(ValueError):
+    """A command-line value that cannot be used (reported in one line, exit status 2)."""
+
+
+#: accepted acceleration units and their factor to m/s^2
+ACCELERATION_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01,
+                      "gal": 0.01, "mm/s2": 0.001, "nm/s2": 1e-9}
+
+
+def _finite_positive(value: float, what: str) -> float:
+    if not math.isfinite(value) or value <= 0.0:
+        raise ArgumentError(f"{what} must be a positive finite number, got {value!r}")
+    return value
+
+
+def parse_block(text: str) -> tuple[float, float]:
+    """``"7.5x1.8"`` -> ``(height, width)`` in m."""
+    parts = re.split(r"\s*[xX*]\s*", str(text).strip())
+    if len(parts) != 2:
+        raise ArgumentError(f"--block expects HEIGHTxWIDTH in m, such as 7.5x1.8; got {text!r}")
+    try:
+        height, width = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise ArgumentError(f"--block expects HEIGHTxWIDTH in m, such as 7.5x1.8; got {text!r}") from None
+    return (_finite_positive(height, "block height (m)"), _finite_positive(width, "block width (m)"))
+
+
+def parse_length(text: str, what: str = "length (m)") -> float:
+    try:
+        value = float(str(text).strip().rstrip("m"))
+    except ValueError:
+        raise ArgumentError(f"{what}: expected a number in m, got {text!r}") from None
+    return _finite_positive(value, what)
+
+
+def parse_acceleration(text: str, default_unit: str | None = None, signed: bool = True) -> float:
+    """``"0.71g"``, ``"6.9m/s2"``, ``"690gal"`` -> m/s^2.
+
+    A bare number needs ``default_unit``; units are never guessed.
+    """
+    s = str(text).strip().replace(" ", "")
+    m = re.fullmatch(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)(.*)", s)
+    if not m:
+        raise ArgumentError(f"cannot read acceleration {text!r}; write e.g. 0.71g or 6.96m/s2")
+    value, unit = float(m.group(1)), m.group(2).lower() or default_unit
+    if unit is None:
+        raise ArgumentError(f"acceleration {text!r} has no unit; write e.g. {text}g or {text}m/s2")
+    if unit not in ACCELERATION_UNITS:
+        raise ArgumentError(f"unknown acceleration unit {unit!r} in {text!r}; use one of "
+                            f"g, m/s2, cm/s2, gal")
+    value *= ACCELERATION_UNITS[unit]
+    if not math.isfinite(value) or (not signed and value <= 0.0) or value == 0.0:
+        raise ArgumentError(f"acceleration must be a non-zero finite value, got {text!r}")
+    return value
+
+
+def parse_angle(text: str) -> float:
+    """``"14deg"``, ``"0.24rad"``, ``"tan0.24"`` -> radians.  A bare number is refused."""
+    s = str(text).strip().lower().replace(" ", "")
+    try:
+        if s.endswith("deg"):
+            value = math.radians(float(s[:-3]))
+        elif s.endswith("rad"):
+            value = float(s[:-3])
+        elif s.startswith("tan"):
+            value = math.atan(float(s[3:].lstrip("=")))
+        else:
+            raise ArgumentError(f"angle {text!r} needs a unit: 14deg, 0.244rad or tan0.24")
+    except ValueError:
+        raise ArgumentError(f"cannot read angle {text!r}; write 14deg, 0.244rad or tan0.24") from None
+    if not (math.isfinite(value) and 0.0 < value < math.pi / 2):
+        raise ArgumentError(f"angle must lie strictly between 0 and 90 deg, got {text!r}")
+    return value
+
+
+def parse_positive(text: str, what: str) -> float:
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise ArgumentError(f"{what}: expected a number, got {text!r}") from None
+    return _finite_positive(value, what)

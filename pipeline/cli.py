@@ -1,0 +1,55 @@
+"""The ``pipeline`` command: one sub-command per job, each in its own module.
+
+Every sub-command module defines ``add_parser(subparsers)`` (which registers the sub-command and
+sets ``func`` to the function that runs it with the parsed arguments and returns an exit code).
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from .args import ArgumentError
+
+#: sub-command modules, in the order ``pipeline --help`` lists them
+COMMANDS = ["simulate", "fit", "convert", "design", "spectrum", "chart", "run", "demo"]
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line and exit status 2, as argparse does, without usage noise
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="pipeline", description="Size free-standing rocking columns against "
+                     "near-fault pulses: read records, fit pulses, solve, design and verify.")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"pipeline.cmd_{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"pipeline.cmd_{name}":
+                continue  # sub-command not built in this version
+            raise
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except ArgumentError as exc:
+        print(f"pipeline {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
