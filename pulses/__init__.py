@@ -1,5 +1,8 @@
 """Pulse shapes, accelerogram reading and pulse fitting (no dependency on ``rocking``)."""
+from .errors import RecordError
 from .record import G, Record
+from .io import read_record
+from .sac import write_sac
 from .shapes import (
     BETA,
     SHAPES,
@@ -14,4 +17,5 @@ from .shapes import (
 __all__ = [
     "G", "Record", "BETA", "SHAPES", "Pulse", "Rectangular", "OneSine", "SymmetricRicker",
     "AntisymmetricRicker", "make_pulse",
+    "RecordError", "read_record", "write_sac",
 ]

@@ -1,0 +1,189 @@
+"""PEER NGA ``.AT2`` accelerograms, and the obspy waveform plugin that reads them.
+
+An AT2 file has four header lines and then the samples, in Fortran ``E`` format, usually five a
+line, with a short last line::
+
+    PEER NGA STRONG MOTION DATABASE RECORD
+    Northridge-01, 1/17/1994, Rinaldi Receiving Sta, 228
+    ACCELERATION TIME SERIES IN UNITS OF G
+    NPTS=   1991, DT=   .0100 SEC,   0 POLE @    30.00000 HZ, ...
+      -.2556093E-02  -.2534838E-02  -.2450926E-02  -.2152656E-02  -.1770125E-02
+
+The older NGA/PEER header writes the fourth line as ``1991    0.0100    NPTS, DT``.  Numbers may
+lack a leading zero (``.0100``, ``-.25E-02``) and may touch (no space before a minus sign), so
+samples are read with a regular expression, never by splitting on blanks or by fixed columns.
+The sample count is checked against ``NPTS``: sample ``k`` (0-based) is at ``t = k DT``, so the
+record lasts ``(NPTS - 1) DT``.
+
+Once the package is installed, ``obspy.read("x.AT2")`` works through the entry points
+``pulses.at2:_is_at2`` and ``pulses.at2:_read_at2`` declared in ``pyproject.toml``.
+"""
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from .errors import RecordError
+
+#: one Fortran real: optional sign, digits with optional point (or a point and digits),
+#: optional exponent with E or D
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?")
+#: NGA-West2 style: ``NPTS=   1991, DT=   .0100 SEC``
+_NPTS_DT_NEW = re.compile(r"NPTS\s*=\s*(\d+)\s*,?\s*DT\s*=\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?)",
+                          re.IGNORECASE)
+#: older NGA/PEER style: ``1991    0.0100    NPTS, DT``
+_NPTS_DT_OLD = re.compile(r"^\s*(\d+)\s+([-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?)\s+NPTS\s*,?\s*DT",
+                          re.IGNORECASE)
+#: what the third header line says about the quantity and its units
+_UNITS = re.compile(r"IN\s+UNITS\s+OF\s+([A-Z0-9/\^\*\.]+(?:/[A-Z0-9\^\*]+)*)", re.IGNORECASE)
+
+
+def _float(text: str) -> float:
+    return float(text.replace("D", "E").replace("d", "e"))
+
+
+def parse_npts_dt(line: str) -> tuple[int, float] | None:
+    """``(NPTS, DT)`` from the fourth header line in either style, or ``None``."""
+    m = _NPTS_DT_NEW.search(line) or _NPTS_DT_OLD.search(line)
+    if not m:
+        return None
+    return int(m.group(1)), _float(m.group(2))
+
+
+def _quantity_and_units(line: str) -> tuple[str, str | None]:
+    """``("acceleration", "g")`` from ``ACCELERATION TIME SERIES IN UNITS OF G``."""
+    upper = line.upper()
+    if "VELOCITY" in upper:
+        quantity = "velocity"
+    elif "DISPLACEMENT" in upper:
+        quantity = "displacement"
+    elif "ACCELERATION" in upper:
+        quantity = "acceleration"
+    else:
+        quantity = "unknown"
+    m = _UNITS.search(line)
+    units = m.group(1).rstrip(",.").lower() if m else None
+    if units in ("cm/sec/sec", "cm/sec2", "cm/s/s", "cm/sec^2"):
+        units = "cm/s2"
+    return quantity, units
+
+
+def _title_fields(line: str) -> dict:
+    """Event, date, station and component from the second header line.
+
+    ``Northridge-01, 1/17/1994, Rinaldi Receiving Sta, 228`` -> event ``Northridge-01``, date
+    ``1/17/1994``, station ``Rinaldi Receiving Sta``, component ``228``.  With three fields the
+    date stays inside the event field (``IMPERIAL VALLEY 10/15/79 2316, El Centro Array #4, 140``).
+    """
+    fields = [f.strip() for f in line.strip().split(",")]
+    out = {"event": "", "date": "", "station": "", "component": ""}
+    dated = [i for i, f in enumerate(fields) if re.fullmatch(r"\d{1,2}/\d{1,2}/\d{2,4}(\s+[\d:]+)?", f)]
+    if dated and len(fields) >= dated[0] + 3:  # event(s), date, station(s), component
+        i = dated[0]
+        out.update(event=", ".join(fields[:i]), date=fields[i],
+                   station=", ".join(fields[i + 1:-1]), component=fields[-1])
+    elif len(fields) >= 3:
+        out.update(event=", ".join(fields[:-2]), station=fields[-2], component=fields[-1])
+    elif len(fields) == 2:
+        out.update(event=fields[0], station=fields[1])
+    elif fields:
+        out.update(event=fields[0])
+    return out
+
+
+def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
+    """Read a PEER ``.AT2`` file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    values : ndarray
+        The samples as written in the file (for acceleration files, in g).
+    dt : float
+        Sampling interval, s.
+    header : dict
+        ``title``, ``event``, ``date``, ``station``, ``component``, ``quantity``
+        (``"acceleration"``, ``"velocity"``, ...), ``units`` (as stated, e.g. ``"g"``), ``npts``,
+        ``dt``, ``header_style`` (``"NPTS=, DT="`` or ``"NPTS, DT"``) and the four header
+        ``lines``.
+
+    Raises
+    ------
+    RecordError
+        For a missing, empty, truncated or corrupt file, or one whose sample count disagrees
+        with ``NPTS``.
+    """
+    path = os.fspath(path)
+    try:
+        with open(path, "r", encoding="utf-8-sig", errors="replace") as fh:
+            text = fh.read()
+    except FileNotFoundError:
+        raise RecordError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise RecordError(f"{path}: is a directory, not a record file") from None
+    lines = text.splitlines()
+    if not text.strip():
+        raise RecordError(f"{path}: the file is empty")
+    if len(lines) < 4:
+        raise RecordError(f"{path}: truncated PEER AT2 file: {len(lines)} line(s), the header alone has 4")
+    npts_dt = parse_npts_dt(lines[3])
+    if npts_dt is None:
+        raise RecordError(f"{path}: not a PEER AT2 file: line 4 should give NPTS and DT "
+                          f"(e.g. 'NPTS=  1991, DT= .0100 SEC'), found {lines[3].strip()[:60]!r}")
+    npts, dt = npts_dt
+    style = "NPTS=, DT=" if _NPTS_DT_NEW.search(lines[3]) else "NPTS, DT"
+    values = []
+    for lineno, line in enumerate(lines[4:], start=5):
+        tokens = _NUMBER.findall(line)
+        rest = _NUMBER.sub("", line)
+        if rest.strip():
+            raise RecordError(f"{path}: line {lineno} is not a list of numbers: {line.strip()[:60]!r}")
+        values.extend(tokens)
+    data = np.array([_float(v) for v in values], dtype=float)
+    if data.size != npts:
+        what = "truncated" if data.size < npts else "longer than its header says"
+        raise RecordError(f"{path}: {what}: header NPTS={npts} but the file holds {data.size} samples")
+    if not (np.isfinite(dt) and dt > 0):
+        raise RecordError(f"{path}: header DT={dt!r} is not a positive time step")
+    quantity, units = _quantity_and_units(lines[2])
+    header = {"title": lines[1].strip(), **_title_fields(lines[1]), "quantity": quantity,
+              "units": units, "npts": npts, "dt": dt, "header_style": style,
+              "lines": [ln.rstrip() for ln in lines[:4]]}
+    return data, dt, header
+
+
+# -- obspy waveform plugin -----------------------------------------------------------------
+def _is_at2(filename) -> bool:
+    """obspy plugin hook: True if ``filename`` starts like a PEER AT2 file (never raises)."""
+    try:
+        with open(filename, "r", encoding="utf-8-sig", errors="replace") as fh:
+            head = [fh.readline() for _ in range(5)]
+    except Exception:
+        return False
+    return len(head) >= 4 and parse_npts_dt(head[3]) is not None and bool(_NUMBER.search(head[4]))
+
+
+def _read_at2(filename, headonly=False, **kwargs):
+    """obspy plugin hook: read a PEER AT2 file into an :class:`obspy.Stream` of one trace.
+
+    The trace holds the samples as written in the file (g for acceleration files); the header
+    is kept in ``trace.stats.at2`` (``units``, ``quantity``, ``event``, ``date``, ...).
+    """
+    from obspy import Stream, Trace
+    from obspy.core.util import AttribDict
+
+    data, dt, header = read_at2_file(filename)
+    tr = Trace(data=np.zeros(0) if headonly else data)
+    tr.stats.delta = dt
+    tr.stats.station = header["station"]
+    tr.stats.channel = header["component"]
+    if headonly:
+        tr.stats.npts = header["npts"]
+    tr.stats.at2 = AttribDict({k: v for k, v in header.items() if k != "lines"})
+    return Stream([tr])

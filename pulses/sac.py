@@ -1,0 +1,82 @@
+"""SAC files: what ``idep`` says about units, and writing a record as SAC.
+
+By the SAC standard the dependent-variable code ``idep`` gives the quantity *and* its units:
+``iacc`` means nm/s^2, ``ivel`` nm/s, ``idisp`` nm (SPEC section 7).  Many files in the wild
+hold m/s^2, cm/s^2 or g under ``iacc``; :func:`pulses.read_record` honours the standard unless
+the user passes units, and refuses a peak that would then be implausible.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .errors import RecordError
+from .record import Record
+
+#: SAC ``idep`` enumeration values (as obspy stores them) -> quantity
+IDEP_QUANTITY = {8: "acceleration", 7: "velocity", 6: "displacement", 5: "unknown", 50: "volts"}
+#: the SAC standard's units for each quantity code
+IDEP_STANDARD_UNITS = {8: "nm/s2", 7: "nm/s", 6: "nm"}
+IACC = 8
+#: value SAC uses for an undefined integer header
+SAC_UNDEFINED = -12345
+
+
+def idep_units(idep) -> tuple[str, str | None]:
+    """``(quantity, standard units)`` for a SAC ``idep`` value (``None`` or -12345: undefined)."""
+    if idep is None or idep == SAC_UNDEFINED:
+        return "undefined", None
+    idep = int(idep)
+    return IDEP_QUANTITY.get(idep, f"code {idep}"), IDEP_STANDARD_UNITS.get(idep)
+
+
+def shortest_float32(value: float) -> float:
+    """The shortest decimal that rounds to the same float32 as ``value``.
+
+    SAC stores ``delta`` in 32 bits: 0.005 comes back as 0.004999999888.  Reading it as the
+    shortest decimal with the same float32 gives back 0.005 exactly.
+    """
+    return float(np.format_float_positional(np.float32(value), unique=True, trim="-"))
+
+
+def write_sac(record: Record, path) -> str:
+    """Write ``record`` as a binary SAC file of ground acceleration in nm/s^2 (``idep = iacc``).
+
+    This is the SAC standard, so :func:`pulses.read_record` reads the file back without being
+    told units.  SAC stores 32-bit floats: samples come back to a relative 6e-8 and ``dt``
+    exactly (see :func:`shortest_float32`).  Station, component and event go into ``kstnm``
+    (8 characters), ``kcmpnm`` (8) and ``kevnm`` (16); the record's name into ``kuser0`` (8).
+
+    Parameters
+    ----------
+    record : pulses.Record
+        Acceleration in m/s^2.
+    path : str or path-like
+        Output file (overwritten).
+
+    Returns
+    -------
+    str
+        The path written.
+    """
+    from obspy.io.sac import SACTrace
+
+    meta = record.metadata or {}
+    sac = SACTrace(data=(np.asarray(record.acc, dtype=float) * 1e9).astype(np.float32))
+    sac.delta = record.dt
+    sac.b = record.t_start
+    sac.idep = "iacc"
+    sac.iztype = "ib"
+    for key, field, width in (("station", "kstnm", 8), ("component", "kcmpnm", 8), ("event", "kevnm", 16)):
+        value = str(meta.get(key) or "").strip()
+        if value:
+            setattr(sac, field, value[:width])
+    if record.name:
+        sac.kuser0 = str(record.name)[:8]
+    path = os.fspath(path)
+    try:
+        sac.write(path)
+    except OSError as exc:
+        raise RecordError(f"{path}: cannot write SAC file: {exc.strerror or exc}") from None
+    return path
