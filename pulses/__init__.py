@@ -1,6 +1,7 @@
 """Pulse shapes, accelerogram reading and pulse fitting (no dependency on ``rocking``)."""
 from .errors import RecordError
 from .record import G, Record
+from .scenario import VP_TO_AP, design_pulse, pulse_period
 from .io import read_record
 from .sac import write_sac
 from .shapes import (
@@ -18,4 +19,5 @@ __all__ = [
     "G", "Record", "BETA", "SHAPES", "Pulse", "Rectangular", "OneSine", "SymmetricRicker",
     "AntisymmetricRicker", "make_pulse",
     "RecordError", "read_record", "write_sac",
+    "design_pulse", "pulse_period", "VP_TO_AP",
 ]
