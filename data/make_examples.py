@@ -8,9 +8,9 @@ Every record is a pulse of one of the paper's shapes (SPEC section 3) added to b
 broadband motion (filtered Gaussian noise under a rise-plateau-decay envelope), plus one record
 with broadband motion only (no pulse), as a control.  They are 25 s long at 100 Hz (2500 samples,
 about 10 kB each), written as SAC with ``idep = iacc`` and the samples in nm/s^2, as the SAC
-standard says, so that ``pipeline run data/*.sac --block 7.5x1.8`` reads them with their units
-and no option.  The true pulse of each record is listed in ``examples.csv`` and kept in the SAC
-header too (``kuser0`` shape, ``user0`` ap in m/s^2, ``user1`` Tp in s, ``user2`` t0 in s).
+standard says (through :func:`pulses.write_sac`), so that ``pipeline run data/*.sac --block 7.5x1.8``
+reads them with their units and no option.  The true pulse of each record is listed in
+``examples.csv`` (shape, signed ap in g, Tp and t0 in s, Lp in m).
 """
 from __future__ import annotations
 
@@ -21,7 +21,8 @@ import pathlib
 import numpy as np
 from scipy import signal
 
-from pulses import G, make_pulse
+import pulses
+from pulses import G, Record, make_pulse
 
 HERE = pathlib.Path(__file__).resolve().parent
 
@@ -64,29 +65,12 @@ def example(stem, shape, ap_g, tp, t0, rms_g, seed):
     return acc
 
 
-def write_sac(path: pathlib.Path, acc: np.ndarray, stem: str, shape, ap_g, tp, t0, station="SYN"):
-    """Write ``acc`` (m/s^2) as SAC with idep = iacc and nm/s^2 (the SAC standard)."""
-    from obspy import Trace
-    from obspy.core import AttribDict
-
-    tr = Trace(data=(acc * 1e9).astype(np.float32))
-    tr.stats.delta = DT
-    tr.stats.network = "XX"
-    tr.stats.station = station
-    tr.stats.channel = "HNX"
-    sac = AttribDict()
-    sac.idep = 8  # iacc: acceleration, nm/s^2
-    sac.kevnm = stem[:16]
-    sac.b = 0.0
-    sac.lcalda = 0
-    if shape is not None:
-        sac.kuser0 = shape[:8]
-        sac.user0 = float(ap_g * G)
-        sac.user1 = float(tp)
-        sac.user2 = float(t0)
-    tr.stats.sac = sac
+def write_sac(path: pathlib.Path, acc: np.ndarray, stem: str, station: str) -> None:
+    """Write ``acc`` (m/s^2) with :func:`pulses.write_sac`: idep = iacc, nm/s^2 (the SAC standard)."""
+    record = Record(acc, DT, name=stem, metadata={"station": station, "component": "HNX",
+                                                   "event": "synthetic"})
     tmp = path.with_name(path.name + ".tmp")
-    tr.write(str(tmp), format="SAC")
+    pulses.write_sac(record, tmp)
     tmp.replace(path)
 
 
@@ -97,7 +81,7 @@ def main(out: pathlib.Path = HERE) -> list[pathlib.Path]:
     for i, (stem, shape, ap_g, tp, t0, rms_g, seed) in enumerate(EXAMPLES, start=1):
         acc = example(stem, shape, ap_g, tp, t0, rms_g, seed)
         path = out / f"{stem}.sac"
-        write_sac(path, acc, stem, shape, ap_g, tp, t0, station=f"SYN{i}")
+        write_sac(path, acc, stem, station=f"SYN{i}")
         paths.append(path)
         rows.append({
             "file": path.name, "shape": shape or "", "ap_g": f"{ap_g:g}" if shape else "",
