@@ -1,0 +1,137 @@
+"""``pipeline run``: records in, verified column designs out, for one record or a whole database."""
+from __future__ import annotations
+
+import argparse
+import os
+
+from .args import ArgumentError, parse_block, parse_length, parse_positive
+
+DEFAULT_OUT = "pipeline-output"
+
+
+def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
+    """Options shared by ``run`` and ``demo``."""
+    parser.add_argument("--out", metavar="DIR", default=default_out,
+                        help=f"folder for the reports (default ./{default_out}); re-running into it "
+                             "gives identical files")
+    parser.add_argument("--jobs", "-j", metavar="N", default="1",
+                        help="number of worker processes (default 1; 0 = one per CPU); the output "
+                             "does not depend on it")
+    parser.add_argument("--dask", metavar="SCHEDULER",
+                        help="distribute records over a dask.distributed cluster: a scheduler "
+                             "address (tcp://host:8786) or 'local' for a local cluster of --jobs "
+                             "workers; needs the [dask] extra")
+    parser.add_argument("--plots", action=argparse.BooleanOptionalAction, default=True,
+                        help="write plots/<record>.png and plots/summary.png (default: yes)")
+    parser.add_argument("--quiet", "-q", action="store_true",
+                        help="no progress bar and no messages (the exit status tells)")
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser(
+        "run", help="records in, verified column designs out",
+        description="For every record: read it, fit its pulse (every shape), size each column by "
+                    "Eq. 31, the envelope rule and the exact criterion, and verify the designs with "
+                    "time histories under the full record. Writes <record>.csv, summary.csv, "
+                    "failures.csv, columns.md and plots into --out. Exit status 0 when every record "
+                    "was processed, 1 when some failed (listed in failures.csv), 2 for bad arguments.")
+    p.add_argument("records", nargs="*", metavar="RECORD",
+                   help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
+                        "...) or folders of them")
+    p.add_argument("--block", action="append", default=[], metavar="HxW",
+                   help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
+    p.add_argument("--height", action="append", default=[], metavar="H",
+                   help="only the width a column of this height (m) needs; repeatable")
+    p.add_argument("--shapes", nargs="+", metavar="SHAPE",
+                   help="pulse shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: "
+                        "the fitter's default set)")
+    p.add_argument("--units", help="units of the samples where the files state none, or to override "
+                                   "SAC's iacc = nm/s^2: g, m/s2, cm/s2 (gal), mm/s2, nm/s2")
+    p.add_argument("--dt", help="sampling interval in s, for text files without a time column")
+    p.add_argument("--column", type=str, help="text files: the column holding the acceleration, from 1")
+    p.add_argument("--format", help="file format, when detection from the content is not wanted "
+                                    "(at2, text, sac, mseed, ...)")
+    add_common(p, DEFAULT_OUT)
+    p.set_defaults(func=main)
+
+
+def parse_jobs(text) -> int:
+    try:
+        jobs = int(str(text))
+    except ValueError:
+        raise ArgumentError(f"--jobs expects a whole number of processes, got {text!r}") from None
+    if jobs < 0:
+        raise ArgumentError(f"--jobs must be 0 (one per CPU) or more, got {jobs}")
+    return jobs or (os.cpu_count() or 1)
+
+
+def parse_shapes(items):
+    if not items:
+        return None
+    from pulses import SHAPES
+
+    names = []
+    for item in items:
+        for name in str(item).replace(",", " ").split():
+            if name == "all":
+                names.extend(SHAPES)
+            elif name in SHAPES:
+                names.append(name)
+            else:
+                raise ArgumentError(f"unknown pulse shape {name!r}; choose from {', '.join(SHAPES)} or all")
+    return tuple(dict.fromkeys(names))
+
+
+def parse_units(text):
+    if text is None:
+        return None
+    from pulses import RecordError
+    from pulses.units import canonical_units
+
+    try:
+        return canonical_units(text)
+    except RecordError as exc:
+        raise ArgumentError(f"--units: {exc}") from None
+
+
+def build_columns(blocks, heights):
+    from .batch import Column
+
+    columns = [Column(*parse_block(b)) for b in blocks]
+    columns += [Column(parse_length(h, "--height (m)")) for h in heights]
+    if not columns:
+        raise ArgumentError("give at least one column: --block HxW (e.g. --block 7.5x1.8) or --height H")
+    return tuple(dict.fromkeys(columns))
+
+
+def options_from(args, **overrides):
+    from .batch import Options
+
+    kw = dict(plots=bool(args.plots))
+    kw.update(overrides)
+    return Options(**kw)
+
+
+def main(args) -> int:
+    from .runner import expand_inputs, run
+
+    columns = build_columns(args.block, args.height)
+    jobs = parse_jobs(args.jobs)
+    column = None
+    if args.column is not None:
+        try:
+            column = int(args.column)
+        except ValueError:
+            column = 0
+        if column < 1:
+            raise ArgumentError(f"--column counts from 1, got {args.column!r}")
+    options = options_from(
+        args, shapes=parse_shapes(args.shapes), units=parse_units(args.units),
+        dt=parse_positive(args.dt, "--dt (s)") if args.dt is not None else None,
+        column=column, format=args.format)
+    if not args.records:
+        raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
+    paths = expand_inputs(args.records)
+    summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
+                  quiet=args.quiet)
+    return summary.exit_code
