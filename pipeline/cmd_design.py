@@ -1,0 +1,133 @@
+"""``pipeline design``: minimum slenderness by Eq. 31, Eq. 20, the envelope rule and exactly.
+
+    pipeline design --block 7.5x1.8 --pulse sine --ap 0.71g --tp 0.8 [--json]
+    pipeline design --height 7.5 --pulse sine --magnitude 7.0 [--vp 0.9]
+"""
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+from .args import ArgumentError, parse_acceleration, parse_block, parse_length, parse_positive
+
+SHAPE_NAMES = {"rect": "rectangular", "sine": "one-sine", "ricker-sym": "symmetric Ricker",
+               "ricker-anti": "antisymmetric Ricker"}
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "design", help="minimum slenderness (Eq. 31, Eq. 20, envelope, exact) and required width",
+        description="Minimum slenderness tan(alpha) of a column against a design pulse by Eq. 31, "
+                    "Eq. 20, the envelope rule and exact time-history analysis; whether the block "
+                    "is adequate by each; and the width its height requires (a fixed point, "
+                    "since p depends on the width).")
+    size = p.add_mutually_exclusive_group(required=True)
+    size.add_argument("--block", help="HEIGHTxWIDTH in m, e.g. 7.5x1.8")
+    size.add_argument("--height", help="full height in m: report the required widths only")
+    p.add_argument("--pulse", default="sine", choices=sorted(SHAPE_NAMES),
+                   help="pulse shape (default sine)")
+    p.add_argument("--ap", help="pulse amplitude, e.g. 0.71g or 6.96m/s2")
+    p.add_argument("--tp", help="pulse period, s")
+    p.add_argument("--magnitude", help="design for a near-fault scenario of this Mw (Eq. 6) "
+                                       "instead of --ap/--tp")
+    p.add_argument("--vp", default="0.9", help="scenario velocity amplitude, m/s (default 0.9)")
+    p.add_argument("--lam", default="1.0", help="lambda of Eq. 20 (default 1)")
+    p.add_argument("--criterion", default="overturn", choices=["overturn", "exceed"],
+                   help="exact answer: failure is overturning (default) or |theta| > alpha")
+    p.add_argument("--json", action="store_true", help="print the results as JSON")
+    p.set_defaults(func=run)
+
+
+def _pulse(args):
+    import pulses
+
+    if args.magnitude is not None:
+        if args.ap is not None or args.tp is not None:
+            raise ArgumentError("give either --magnitude or --ap/--tp, not both")
+        try:
+            mw = float(args.magnitude)
+        except ValueError:
+            raise ArgumentError(f"--magnitude: expected a number, got {args.magnitude!r}") from None
+        if not (math.isfinite(mw) and 3.0 <= mw <= 9.5):
+            raise ArgumentError(f"--magnitude must lie between 3 and 9.5, got {args.magnitude!r}")
+        vp = parse_positive(args.vp, "--vp (m/s)")
+        return pulses.design_pulse(mw, args.pulse, vp), f"scenario Mw {mw:g}, vp = {vp:g} m/s"
+    if args.ap is None or args.tp is None:
+        raise ArgumentError("give the pulse as --ap and --tp (or --magnitude)")
+    ap = abs(parse_acceleration(args.ap))
+    tp = parse_positive(args.tp, "--tp (s)")
+    return pulses.make_pulse(args.pulse, ap, tp), "given pulse"
+
+
+def run(args) -> int:
+    import rocking
+    from pulses import G
+
+    pulse, origin = _pulse(args)
+    lam = parse_positive(args.lam, "--lam")
+    if args.block is not None:
+        height, width = parse_block(args.block)
+        block = rocking.Block.from_dimensions(height, width)
+    else:
+        height, width, block = parse_length(args.height, "--height (m)"), None, None
+    ap_g = abs(pulse.ap) / G
+    out = {
+        "pulse": {"shape": pulse.shape, "ap_g": ap_g, "ap_m_s2": abs(pulse.ap), "tp_s": pulse.tp,
+                  "origin": origin},
+        "height_m": height, "criterion": args.criterion,
+    }
+    rules = {}
+    if block is not None:
+        p = block.p
+        exact = rocking.min_slenderness(pulse, p, criterion=args.criterion)
+        values = {
+            "eq31": rocking.eq31(pulse.ap, pulse.tp, p),
+            "eq20": rocking.eq20(pulse.ap, pulse.tp, p, lam),
+            "envelope": rocking.envelope_rule(pulse.ap, pulse.tp, p),
+            "exact": exact.tan_alpha,
+        }
+        out["block"] = {"height_m": height, "width_m": width, "p_rad_s": p,
+                        "tan_alpha": block.tan_alpha, "alpha_deg": math.degrees(block.alpha),
+                        "eta": block.eta, "pTp": p * pulse.tp}
+        out["exact_transitions"] = list(exact.transitions)
+        out["exact_safe_islands"] = [list(s) for s in exact.safe_islands]
+        for name, value in values.items():
+            rules[name] = {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
+    for name in ("eq31", "eq20", "envelope", "exact"):
+        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=args.criterion)
+        rules.setdefault(name, {})
+        rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
+                            "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
+    out["rules"] = rules
+    if args.json:
+        json.dump(out, sys.stdout, indent=2)
+        print()
+        return 0
+    print(f"Pulse: {SHAPE_NAMES[pulse.shape]}, ap = {ap_g:.4g} g ({abs(pulse.ap):.4g} m/s2), "
+          f"Tp = {pulse.tp:.4g} s ({origin})")
+    if block is not None:
+        b = out["block"]
+        print(f"Block: {height:g} x {width:g} m, p = {b['p_rad_s']:.4g} rad/s, tan(alpha) = "
+              f"{b['tan_alpha']:.4g} (alpha = {b['alpha_deg']:.3g} deg), eta = {b['eta']:.3f}, "
+              f"pTp = {b['pTp']:.4g}")
+    labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})", "envelope": "envelope rule",
+              "exact": f"exact ({args.criterion})"}
+    head = f"{'rule':<22}"
+    if block is not None:
+        head += f"{'min tan(alpha)':>15}  {'adequate':>8}"
+    head += f"  {'required width (m)':>19} for H = {height:g} m"
+    print(head)
+    for name in ("eq31", "eq20", "envelope", "exact"):
+        r = rules[name]
+        line = f"{labels[name]:<22}"
+        if block is not None:
+            line += f"{r['min_tan_alpha']:>15.4f}  {'yes' if r['adequate'] else 'NO':>8}"
+        line += f"  {r['required_width_m']:>19.4f}"
+        print(line)
+    if block is not None and out["exact_safe_islands"]:
+        isl = ", ".join(f"{lo:.4f}-{hi:.4f}" for lo, hi in out["exact_safe_islands"])
+        print(f"safe islands below the exact minimum (tan alpha): {isl}")
+    print("Required widths solve B = H tan(alpha_min(p(B))), p depending on B; "
+          "exact: smallest width surviving at it and every larger width.")
+    return 0

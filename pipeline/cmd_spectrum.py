@@ -1,0 +1,82 @@
+"""``pipeline spectrum``: the overturning spectrum of Fig. 5.
+
+    pipeline spectrum --alpha 14deg --pulse sine [--grid 200x200] --csv out.csv --plot out.png
+"""
+from __future__ import annotations
+
+import math
+import re
+import time
+
+from .args import ArgumentError, parse_angle
+
+SHAPES = ["rect", "sine", "ricker-sym", "ricker-anti"]
+
+
+def _range(text, what):
+    m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*[:,]\s*([0-9.eE+-]+)\s*", str(text))
+    try:
+        lo, hi = float(m.group(1)), float(m.group(2))
+    except (AttributeError, ValueError):
+        raise ArgumentError(f"{what}: expected LOW:HIGH, got {text!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+        raise ArgumentError(f"{what}: need 0 < LOW < HIGH, got {text!r}")
+    return lo, hi
+
+
+def _grid(text):
+    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
+    if not m or int(m.group(1)) < 2 or int(m.group(2)) < 2 or int(m.group(1)) * int(m.group(2)) > 4_000_000:
+        raise ArgumentError(f"--grid expects NWxNA with 2..2000 points each, e.g. 200x200; got {text!r}")
+    return int(m.group(1)), int(m.group(2))
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "spectrum", help="overturning spectrum (Fig. 5) of a block slenderness under a pulse shape",
+        description="Survive / overturn over omega_p/p (x) and ap/(g tan alpha) (y) for blocks of "
+                    "slenderness alpha under one pulse shape (the paper's Fig. 5), from the batch "
+                    "solver and the similarity law.")
+    p.add_argument("--alpha", required=True, help="slenderness: 14deg, 0.244rad or tan0.25")
+    p.add_argument("--pulse", default="sine", choices=SHAPES, help="pulse shape (default sine)")
+    p.add_argument("--grid", default="200x200", help="points along omega_p/p x ap/(g tan alpha)")
+    p.add_argument("--wp-range", default="0.5:12", help="omega_p/p range LOW:HIGH (default 0.5:12)")
+    p.add_argument("--ap-range", default="1:6", help="ap/(g tan alpha) range (default 1:6)")
+    p.add_argument("--csv", help="write the grid (long format) to this CSV file")
+    p.add_argument("--plot", help="write the spectrum plot to this PNG file")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    import numpy as np
+
+    import rocking
+
+    alpha = parse_angle(args.alpha)
+    nw, na = _grid(args.grid)
+    w0, w1 = _range(args.wp_range, "--wp-range")
+    a0, a1 = _range(args.ap_range, "--ap-range")
+    start = time.perf_counter()
+    spec = rocking.overturning_spectrum(alpha, args.pulse, np.linspace(w0, w1, nw),
+                                        np.linspace(a0, a1, na))
+    elapsed = time.perf_counter() - start
+    n = spec.overturned.size
+    islands = spec.safe_islands()
+    print(f"Overturning spectrum: {args.pulse} pulse, alpha = {math.degrees(alpha):.4g} deg "
+          f"(tan {math.tan(alpha):.4g}), eta = {spec.eta:.3f}; {nw} x {na} points in "
+          f"{elapsed:.2f} s")
+    print(f"overturn: {int(spec.overturned.sum())} of {n} points; |theta| > alpha without "
+          f"overturning: {int((spec.exceeded_alpha & ~spec.overturned).sum())}; safe-island "
+          f"points (survive above an overturning amplitude): {int(islands.sum())}")
+    mins = spec.minimum_overturning()
+    print(f"{'omega_p/p':>10}  {'min overturning ap/(g tan alpha)':>33}")
+    for i in np.unique(np.linspace(0, nw - 1, min(nw, 8)).astype(int)):
+        v = mins[i]
+        print(f"{spec.wp_over_p[i]:>10.3f}  {('> %.3g' % a1) if np.isnan(v) else ('%.4g' % v):>33}")
+    if args.csv:
+        spec.to_frame().to_csv(args.csv, index=False)
+        print(f"wrote {args.csv}")
+    if args.plot:
+        spec.plot(args.plot)
+        print(f"wrote {args.plot}")
+    return 0

@@ -1,0 +1,202 @@
+"""Overturning spectra (the paper's Fig. 5) and the minimum-slenderness chart (Fig. 8).
+
+Both use the similarity law (SPEC section 4): the response depends only on ``omega_p/p``,
+``tan(alpha)`` and ``ap/g``.  A spectrum is therefore one batch-solver call on a grid of
+blocks (one ``p`` per ``omega_p/p``, with a unit pulse of period 1 s) times amplitude scales.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pulses import G, SHAPES, make_pulse
+
+from .block import Block
+from .design import N_SCAN, RTOL, _batch, eq31, min_slenderness_batch
+
+
+@dataclass
+class OverturningSpectrum:
+    """Survive/overturn grid of Fig. 5 for one block slenderness and pulse shape.
+
+    Arrays are indexed ``[i, j]`` with ``i`` over :attr:`wp_over_p` and ``j`` over
+    :attr:`ap_over_gtan` (the order of the arguments of :func:`overturning_spectrum`).
+    """
+
+    alpha: float
+    shape: str
+    wp_over_p: np.ndarray
+    ap_over_gtan: np.ndarray
+    overturned: np.ndarray
+    exceeded_alpha: np.ndarray
+    max_rotation_ratio: np.ndarray
+    eta: float
+
+    def minimum_overturning(self) -> np.ndarray:
+        """For each ``omega_p/p``: the smallest ``ap/(g tan alpha)`` on the grid that overturns (NaN if none)."""
+        out = np.full(self.wp_over_p.size, np.nan)
+        for i in range(self.wp_over_p.size):
+            hit = np.nonzero(self.overturned[i])[0]
+            if hit.size:
+                out[i] = self.ap_over_gtan[hit[0]]
+        return out
+
+    def safe_islands(self) -> np.ndarray:
+        """Boolean grid: surviving points lying above an overturning point of the same ``omega_p/p``."""
+        seen = np.cumsum(self.overturned, axis=1) > 0
+        return seen & ~self.overturned
+
+    def to_frame(self):
+        """Long-format :class:`pandas.DataFrame`, one row per grid point."""
+        import pandas as pd
+
+        w, a = np.meshgrid(self.wp_over_p, self.ap_over_gtan, indexing="ij")
+        return pd.DataFrame({
+            "wp_over_p": w.ravel(), "ap_over_gtan": a.ravel(),
+            "overturned": self.overturned.ravel(), "exceeded_alpha": self.exceeded_alpha.ravel(),
+            "max_rotation_ratio": self.max_rotation_ratio.ravel(),
+        })
+
+    def plot(self, path=None, ax=None):
+        """Draw the spectrum as in Fig. 5 (x: ``omega_p/p``, y: ``ap/(g tan alpha)``)."""
+        import matplotlib
+
+        if ax is None:
+            matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        from matplotlib.colors import ListedColormap
+
+        fig = None
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(5.5, 4.5))
+        state = np.where(self.overturned, 2, np.where(self.exceeded_alpha, 1, 0)).T
+        cmap = ListedColormap(["#9fd89f", "#f3d37a", "#d9534f"])
+        ax.pcolormesh(self.wp_over_p, self.ap_over_gtan, state, cmap=cmap, vmin=0, vmax=2,
+                      shading="nearest")
+        ax.set_xlabel(r"$\omega_p / p$")
+        ax.set_ylabel(r"$a_p / (g \tan\alpha)$")
+        ax.set_title(f"{self.shape} pulse, alpha = {math.degrees(self.alpha):.3g} deg: "
+                     "survive / |theta|>alpha / overturn", fontsize=9)
+        if fig is not None:
+            fig.tight_layout()
+            if path is not None:
+                fig.savefig(path, dpi=110)
+            plt.close(fig)
+        return ax
+
+
+def overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, *, eta=None, model="fast"):
+    """Fig. 5: which blocks of slenderness ``alpha`` overturn under a ``shape`` pulse.
+
+    Parameters
+    ----------
+    alpha : float
+        Slenderness angle, rad.
+    shape : str
+        ``"rect"``, ``"sine"``, ``"ricker-sym"`` or ``"ricker-anti"``.
+    wp_over_p : array_like
+        Frequency ratios ``omega_p / p`` (x axis of Fig. 5).
+    ap_over_gtan : array_like
+        Amplitude ratios ``ap / (g tan alpha)`` (y axis; 1 is the uplift limit).
+    eta : float, optional
+        Restitution (default Eq. 5 for ``alpha``).
+
+    Returns
+    -------
+    OverturningSpectrum
+        ``.overturned[i, j]`` for ``wp_over_p[i]`` and ``ap_over_gtan[j]``.
+
+    All points are solved in one batch call: by similarity, ``Tp = 1 s`` and ``p = 2 pi /
+    (omega_p/p)``, amplitudes as scales of a unit pulse.
+    """
+    if shape not in SHAPES:
+        raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}")
+    alpha = float(alpha)
+    wp = np.atleast_1d(np.asarray(wp_over_p, dtype=float)).ravel()
+    ratio = np.atleast_1d(np.asarray(ap_over_gtan, dtype=float)).ravel()
+    if np.any(wp <= 0) or not np.all(np.isfinite(wp)):
+        raise ValueError("wp_over_p must be positive and finite")
+    if np.any(ratio < 0) or not np.all(np.isfinite(ratio)):
+        raise ValueError("ap_over_gtan must be non-negative and finite")
+    probe = Block(1.0, alpha, eta)
+    blocks = [Block(2.0 * math.pi / w, alpha, probe.eta) for w in wp]
+    pulse = make_pulse(shape, 1.0, 1.0)
+    res = _batch(blocks, pulse, ratio * G * math.tan(alpha), grid=True, model=model)
+    shp = (wp.size, ratio.size)
+    over = np.asarray(res.overturned, dtype=bool).reshape(shp)
+    exc = np.asarray(res.exceeded_alpha, dtype=bool).reshape(shp) | over
+    mrr = getattr(res, "max_rotation_ratio", None)
+    mrr = (np.asarray(mrr, dtype=float).reshape(shp) if mrr is not None
+           else np.asarray(res.max_rotation, dtype=float).reshape(shp) / alpha)
+    return OverturningSpectrum(alpha=alpha, shape=shape, wp_over_p=wp, ap_over_gtan=ratio,
+                               overturned=over, exceeded_alpha=exc, max_rotation_ratio=mrr,
+                               eta=probe.eta)
+
+
+#: pTp values of the chart (Fig. 8 shows curves for several pTp)
+CHART_PTP = (0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 20.0)
+#: ap/g values of the chart
+CHART_APG = tuple(np.round(np.linspace(0.075, 1.5, 20), 6))
+
+
+def slenderness_chart(shapes=("rect", "sine", "ricker-sym", "ricker-anti"), p_tp=CHART_PTP,
+                      ap_over_g=CHART_APG, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL,
+                      model="fast"):
+    """Fig. 8: exact minimum ``tan(alpha)`` against ``ap/g`` for several ``pTp``, beside Eq. 31.
+
+    Returns a :class:`pandas.DataFrame` with columns ``shape, pTp, ap_over_g, exact, eq31,
+    ratio`` (``exact / eq31``; above 1 where Eq. 31 is unconservative), ``transitions`` (how
+    many verdict changes the scan found) and ``islands`` (how many safe islands lie below the
+    answer).
+    """
+    import pandas as pd
+
+    if isinstance(shapes, str):
+        shapes = tuple(SHAPES) if shapes == "all" else (shapes,)
+    pt, ag = np.meshgrid(np.asarray(p_tp, float), np.asarray(ap_over_g, float), indexing="ij")
+    rows = []
+    for shape in shapes:
+        results = min_slenderness_batch(shape, pt.ravel(), ag.ravel(), criterion=criterion,
+                                        n_scan=n_scan, rtol=rtol, model=model)
+        for x, a, r in zip(pt.ravel(), ag.ravel(), results):
+            e31 = float(eq31(a * G, 1.0, x))
+            rows.append({"shape": shape, "pTp": float(x), "ap_over_g": float(a),
+                         "exact": r.tan_alpha, "eq31": e31, "ratio": r.tan_alpha / e31,
+                         "transitions": len(r.transitions), "islands": len(r.safe_islands)})
+    return pd.DataFrame(rows)
+
+
+def plot_chart(frame, path=None):
+    """Draw Fig. 8 from :func:`slenderness_chart`: one panel per shape, Eq. 31 dashed over it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    shapes = list(dict.fromkeys(frame["shape"]))
+    n = len(shapes)
+    ncol = 2 if n > 1 else 1
+    nrow = int(math.ceil(n / ncol))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
+    ptps = sorted(set(frame["pTp"]))
+    colors = plt.cm.viridis(np.linspace(0, 0.9, len(ptps)))
+    for ax, shape in zip(axes.ravel(), shapes):
+        sub = frame[frame["shape"] == shape]
+        for c, x in zip(colors, ptps):
+            s = sub[sub["pTp"] == x].sort_values("ap_over_g")
+            ax.plot(s["ap_over_g"], s["exact"], "-", color=c, lw=1.5, label=f"pTp={x:g}")
+            ax.plot(s["ap_over_g"], s["eq31"], "--", color=c, lw=0.9)
+        ax.set_title(f"{shape}: exact (solid) vs Eq. 31 (dashed)", fontsize=9)
+        ax.set_xlabel("ap / g")
+        ax.set_ylabel("minimum tan(alpha)")
+        ax.grid(alpha=0.3)
+    axes.ravel()[0].legend(fontsize=7, ncol=2)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return fig
