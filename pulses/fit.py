@@ -1,0 +1,340 @@
+"""Fitting acceleration pulses to a record (SPEC section 3; Vassiliou & Makris 2011).
+
+For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ricker):
+
+1. **Match** the record with the shape over periods and times: the wavelet transform with the
+   pulse as mother wavelet (:mod:`pulses.cwt`), on a log-spaced grid of periods.  The best match
+   maximises the share of the record's energy explained by a pulse of least-squares amplitude.
+2. **Refine** ``ap``, ``Tp`` and ``t0`` by least squares on the record's samples inside a window
+   around the pulse (:func:`scipy.optimize.least_squares`, Levenberg-Marquardt, with the
+   amplitude solved linearly for each ``(Tp, t0)``).  A straight-line baseline is fitted
+   together with the pulse inside the window (``baseline=True``), so slow drift of the record
+   does not bias the pulse; it is not part of the pulse and not counted in its score.
+
+A sampled pulse is the pulse evaluated at the sample times, except the rectangular pulse, whose
+point samples do not locate its edges more finely than ``dt``: it is sampled as its average over
+each sample's cell ``[t_i - dt/2, t_i + dt/2]``.
+
+Quality of a candidate:
+
+- ``score``: share of the record's energy the pulse explains, ``1 - ||x - p||^2 / ||x||^2`` over
+  the whole record (1 for a record that is exactly the pulse);
+- ``correlation``: ``<x, p> / (||x|| ||p||)`` within the pulse window (support of the rectangular
+  and one-sine pulses; ``t0 +- Tp`` for the symmetric and ``t0 +- 1.25 Tp`` for the
+  antisymmetric Ricker, which hold all but 1e-3 of their amplitude).
+
+Candidates are ranked by score; every shape is reported, because shapes that fit almost equally
+well can imply very different designs.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .baseline import pgv as _pgv
+from .baseline import significant_duration
+from .cwt import Matcher
+from .record import G, Record
+from .shapes import BETA, SHAPES, Pulse, make_pulse
+
+#: shapes fitted by default, in the order they are reported on ties
+DEFAULT_SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
+#: ratio between neighbouring periods of the coarse grid (6 %: the matched-filter score of every
+#: shape changes by well under 1 % across one step, so the right basin is never missed)
+GRID_RATIO = 1.06
+#: half-widths of the correlation window around ``t0`` for the Rickers, in Tp
+_WINDOW = {"ricker-sym": (1.0, 1.0), "ricker-anti": (1.25, 1.25)}
+
+
+# -- sampled unit pulses ---------------------------------------------------------------------
+def unit_samples(shape: str, tp: float, t0: float, t, dt: float) -> np.ndarray:
+    """Unit-amplitude pulse at sample times ``t`` (s): point samples, cell averages for ``rect``."""
+    tau = (t - t0) / tp
+    if shape == "sine":
+        return np.where((tau >= 0.0) & (tau <= 1.0), np.sin(2.0 * np.pi * tau), 0.0)
+    if shape == "ricker-sym":
+        x2 = (np.pi * tau) ** 2
+        return (1.0 - 2.0 * x2) * np.exp(-x2)
+    if shape == "ricker-anti":
+        x = (2.0 * np.pi / math.sqrt(3.0)) * tau
+        return (x * x - 3.0) * x * np.exp(-0.5 * x * x) / BETA
+    if shape == "rect":
+        lo = np.maximum(t - 0.5 * dt, t0)
+        hi = np.minimum(t + 0.5 * dt, t0 + tp)
+        return np.clip(hi - lo, 0.0, None) / dt
+    raise ValueError(f"unknown shape {shape!r}; choose one of {', '.join(SHAPES)}")
+
+
+def pulse_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
+    """Interval (s) over which a candidate's ``correlation`` is measured."""
+    if shape in _WINDOW:
+        before, after = _WINDOW[shape]
+        return t0 - before * tp, t0 + after * tp
+    return t0, t0 + tp
+
+
+def _fit_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
+    """Interval (s) of samples used by the least-squares refinement: the pulse plus a margin."""
+    if shape in _WINDOW:
+        return t0 - 3.5 * tp, t0 + 3.5 * tp
+    return t0 - 0.5 * tp, t0 + 1.5 * tp
+
+
+# -- results -----------------------------------------------------------------------------------
+@dataclass
+class Candidate:
+    """One fitted pulse shape.
+
+    Attributes
+    ----------
+    shape : str
+        ``"rect"``, ``"sine"``, ``"ricker-sym"`` or ``"ricker-anti"``.
+    ap : float
+        Amplitude, m/s^2, signed by polarity.
+    tp : float
+        Period, s.
+    t0 : float
+        Arrival (rect, sine) or centre (Rickers), s, on the record's time axis.
+    score : float
+        Share of the record's energy the pulse explains (0-1).
+    correlation : float
+        Correlation of record and pulse within the pulse window (-1 to 1).
+    pulse : pulses.Pulse
+        The pulse object (``make_pulse(shape, ap, tp, t0)``).
+    """
+
+    shape: str
+    ap: float
+    tp: float
+    t0: float
+    score: float
+    correlation: float
+    pulse: Pulse = field(repr=False)
+    rank: int = 0
+
+    @property
+    def ap_g(self) -> float:
+        """Amplitude in g (signed)."""
+        return self.ap / G
+
+    @property
+    def polarity(self) -> int:
+        """+1 or -1: the sign of ``ap``."""
+        return 1 if self.ap >= 0 else -1
+
+    @property
+    def lp(self) -> float:
+        """Length scale ``Lp = |ap| Tp^2``, m."""
+        return abs(self.ap) * self.tp**2
+
+    @property
+    def arrival(self) -> float:
+        """Time the pulse starts, s: ``t0`` for rect and sine, ``t0 - Tp/2`` for the Rickers."""
+        return self.t0 - 0.5 * self.tp if self.shape.startswith("ricker") else self.t0
+
+    def as_dict(self) -> dict:
+        return {"shape": self.shape, "rank": self.rank, "ap_m_s2": self.ap, "ap_g": self.ap_g,
+                "tp_s": self.tp, "t0_s": self.t0, "arrival_s": self.arrival, "polarity": self.polarity,
+                "lp_m": self.lp, "score": self.score, "correlation": self.correlation}
+
+
+@dataclass
+class PulseFit:
+    """Pulse fits of one record, best first.
+
+    Attributes
+    ----------
+    name : str
+        Record name.
+    candidates : list of Candidate
+        One per shape, ranked by ``score`` (best first; ``rank`` 1 is the best).
+    pga : float
+        Peak ground acceleration of the record, m/s^2.
+    pgv : float
+        Peak ground velocity, m/s, after the baseline correction of :mod:`pulses.baseline`.
+    duration : float
+        Length of the record, s.
+    significant_duration : float
+        D5-95 (time between 5 % and 95 % of the Arias intensity), s.
+    """
+
+    name: str
+    candidates: list
+    pga: float
+    pgv: float
+    duration: float
+    significant_duration: float
+
+    @property
+    def best(self) -> Candidate:
+        """The candidate that explains the most of the record's energy."""
+        return self.candidates[0]
+
+    def __getitem__(self, shape: str) -> Candidate:
+        """The candidate of one shape: ``fit["sine"]``."""
+        for c in self.candidates:
+            if c.shape == shape:
+                return c
+        raise KeyError(f"no {shape!r} candidate; fitted shapes: {', '.join(c.shape for c in self.candidates)}")
+
+    def to_frame(self):
+        """One row per candidate (pandas DataFrame), best first, with the record's peaks."""
+        import pandas as pd
+
+        rows = []
+        for c in self.candidates:
+            row = {"record": self.name, **c.as_dict(), "best": c.rank == 1,
+                   "pga_g": self.pga / G, "pgv_m_s": self.pgv, "duration_s": self.duration,
+                   "d5_95_s": self.significant_duration}
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+    def as_dict(self) -> dict:
+        return {"record": self.name, "pga_g": self.pga / G, "pgv_m_s": self.pgv,
+                "duration_s": self.duration, "d5_95_s": self.significant_duration,
+                "best": self.best.shape, "candidates": [c.as_dict() for c in self.candidates]}
+
+
+# -- the fitter ------------------------------------------------------------------------------------
+def default_tp_range(record: Record) -> tuple[float, float]:
+    """Periods searched by default, s: from ``max(0.1 s, 10 dt)`` to ``min(10 s, duration / 2)``."""
+    tp_min = max(0.1, 10.0 * record.dt)
+    tp_max = min(10.0, 0.5 * record.duration)
+    if tp_max <= tp_min:
+        raise ValueError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
+                         f"at least {tp_min:g} s")
+    return tp_min, tp_max
+
+
+def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = True) -> PulseFit:
+    """Fit every candidate pulse shape to a record.
+
+    Parameters
+    ----------
+    record : pulses.Record
+        Ground acceleration, m/s^2.
+    shapes : iterable of str, optional
+        Shapes to fit (default all four: ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``, ``"rect"``).
+    tp_range : (float, float), optional
+        Shortest and longest period searched, s (default :func:`default_tp_range`).
+    baseline : bool, optional
+        Fit a straight-line baseline together with the pulse inside the refinement window
+        (default True).
+
+    Returns
+    -------
+    PulseFit
+        Candidates ranked by score, ``.best``, and the record's PGA, PGV and duration.
+    """
+    shapes = tuple(DEFAULT_SHAPES if shapes is None else shapes)
+    for s in shapes:
+        if s not in SHAPES:
+            raise ValueError(f"unknown pulse shape {s!r}; choose from {', '.join(SHAPES)}")
+    if not shapes:
+        raise ValueError("no pulse shape to fit")
+    tp_min, tp_max = tp_range if tp_range is not None else default_tp_range(record)
+    x = record.acc
+    dt = record.dt
+    t = np.arange(x.size) * dt  # time from the first sample; record.t_start is added at the end
+    matcher = Matcher(x, dt, tp_min, tp_max)
+    n_grid = max(2, int(math.ceil(math.log(tp_max / tp_min) / math.log(GRID_RATIO))) + 1)
+    tps = np.geomspace(tp_min, tp_max, n_grid)
+    energy = float(x @ x)
+    candidates = []
+    for shape in shapes:
+        ap, tp, t0 = _coarse(matcher, shape, tps, t[-1])
+        ap, tp, t0 = _refine(x, t, dt, shape, ap, tp, t0, baseline, energy)
+        p = ap * unit_samples(shape, tp, t0, t, dt)
+        resid = x - p
+        score = 1.0 - float(resid @ resid) / energy if energy > 0 else 0.0
+        lo, hi = pulse_window(shape, tp, t0)
+        inside = (t >= lo) & (t <= hi)
+        xw, pw = x[inside], p[inside]
+        denom = math.sqrt(float(xw @ xw) * float(pw @ pw))
+        corr = float(xw @ pw) / denom if denom > 0 else 0.0
+        t0_abs = t0 + record.t_start
+        candidates.append(Candidate(shape, ap, tp, t0_abs, score, corr, make_pulse(shape, ap, tp, t0_abs)))
+    order = sorted(range(len(candidates)), key=lambda i: -candidates[i].score)
+    ranked = [candidates[i] for i in order]
+    for k, c in enumerate(ranked, start=1):
+        c.rank = k
+    return PulseFit(record.name, ranked, record.pga, _pgv(x, dt), record.duration,
+                    significant_duration(x, dt))
+
+
+def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
+    """Best (ap, Tp, t0) of one shape on the grid of periods and the transform's time grid."""
+    tau, share = matcher.explained(shape, tps)
+    tps_col = np.asarray(tps)[:, None]
+    if shape.startswith("ricker"):  # centre inside the record
+        ok = (tau[None, :] >= 0.0) & (tau[None, :] <= t_end) & np.ones_like(tps_col, dtype=bool)
+    else:  # at least half the pulse inside the record
+        ok = (tau[None, :] >= -0.5 * tps_col) & (tau[None, :] <= t_end - 0.5 * tps_col)
+    masked = np.where(ok, np.abs(share), -1.0)
+    i, j = np.unravel_index(int(np.argmax(masked)), masked.shape)
+    tp, t0 = float(tps[i]), float(tau[j])
+    # least-squares amplitude: share = c|c| / (||w||^2 ||x||^2), so ap = sign * sqrt(|share|) ||x|| / ||w||
+    from .cwt import unit_energy
+    norm_w = math.sqrt(unit_energy(shape) * tp / matcher.dt)
+    ap = math.copysign(math.sqrt(abs(share[i, j]) * matcher.energy) / norm_w, share[i, j])
+    return ap, tp, t0
+
+
+def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
+    """Least-squares ``(ap, Tp, t0)`` near a starting guess; the guess if refinement fails."""
+
+    def solve(tp, t0, idx):
+        tw = t[idx]
+        w = unit_samples(shape, tp, t0, tw, dt)
+        if baseline:
+            tc = tw.mean() if tw.size else 0.0
+            A = np.column_stack([w, np.ones_like(tw), tw - tc])
+        else:
+            A = w[:, None]
+        coef, *_ = np.linalg.lstsq(A, x[idx], rcond=None)
+        return coef, A
+
+    def window(tp, t0):
+        lo, hi = _fit_window(shape, tp, t0)
+        i0 = max(0, int(math.floor(lo / dt)))
+        i1 = min(x.size, int(math.ceil(hi / dt)) + 1)
+        return slice(i0, i1)
+
+    def sse_full(ap, tp, t0):
+        r = x - ap * unit_samples(shape, tp, t0, t, dt)
+        return float(r @ r)
+
+    best = (ap0, tp0, t00)
+    best_sse = sse_full(*best)
+    tp, t0 = tp0, t00
+    for _ in range(3):  # refit when the pulse moved outside the window of the previous pass
+        idx = window(tp, t0)
+        if idx.stop - idx.start < 4:
+            break
+
+        def residual(theta, idx=idx):
+            coef, A = solve(math.exp(theta[0]), theta[1], idx)
+            return x[idx] - A @ coef
+
+        try:
+            sol = least_squares(residual, [math.log(tp), t0], method="lm",
+                                x_scale=[0.05, 0.05 * tp], xtol=1e-12, ftol=1e-12)
+        except (ValueError, np.linalg.LinAlgError):
+            break
+        tp_new, t0_new = math.exp(sol.x[0]), float(sol.x[1])
+        if not (math.isfinite(tp_new) and math.isfinite(t0_new)) or tp_new <= 2 * dt:
+            break
+        coef, _ = solve(tp_new, t0_new, idx)
+        ap_new = float(coef[0])
+        sse = sse_full(ap_new, tp_new, t0_new)
+        if sse < best_sse:
+            best, best_sse = (ap_new, tp_new, t0_new), sse
+        moved = window(tp_new, t0_new)
+        tp, t0 = tp_new, t0_new
+        if moved == idx or (moved.start <= idx.start and moved.stop >= idx.stop and
+                            idx.start == 0 and idx.stop == x.size):
+            break
+    return best
