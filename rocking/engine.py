@@ -1,0 +1,500 @@
+"""Compiled event-driven engine for the rocking block (SPEC section 2), in numba.
+
+One routine, :func:`run`, integrates Eq. 3 over a grid of nodes (record samples, or pulse
+breakpoints and extrema subdivided into equal steps) and handles everything between:
+
+* **rest and uplift**: a block at rest is not integrated; within each interval the forcing is
+  monotonic (records are linear between samples, pulse grids include every extremum), so the
+  first time ``|ug''| = g tan(alpha)`` is found exactly and the block uplifts to
+  ``sgn(theta) = -sgn(ug'')``;
+* **stepping**: classical RK4 on the full nonlinear equation (``linear=False``), or the exact
+  ``cosh``/``sinh`` solution of the linearised equation for forcing linear on each interval
+  (``linear=True``);
+* **impacts**: located on the cubic Hermite interpolant of the step, then refined by Newton
+  iterations that re-integrate from the start of the step, so the impact time is as accurate as
+  the stepper itself; the angular velocity is multiplied by ``eta``;
+* **Zeno sequences**: once the post-impact velocity falls below ``zeno_tol * p * alpha`` while
+  both sides are restoring, the remaining geometric series of hops is summed in closed form and
+  the block is put at rest at the accumulation time (no threshold on the *result*: the hops
+  left out are ``(zeno_tol * alpha)^2`` small);
+* **peaks**: ``max|theta|`` includes the extremum of the Hermite interpolant inside each step;
+* **overturning**: ``|theta|`` reaching ``pi/2``;
+* **end of the excitation**: the energy rule of SPEC section 2 decides overturning exactly and
+  gives the next peak, without further integration (:func:`energy_verdict`).
+
+All angles in rad, times in s, accelerations as ``ug''/g`` (dimensionless).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+HALF_PI = 0.5 * math.pi
+TWO_PI = 2.0 * math.pi
+SQRT3 = math.sqrt(3.0)
+BETA = abs((3.0 - math.sqrt(6.0) - 3.0) * math.sqrt(3.0 - math.sqrt(6.0))
+           * math.exp(-(3.0 - math.sqrt(6.0)) / 2.0))
+
+# forcing kinds (match pulses.*.kind); FREE = no ground motion
+FREE = -1
+NODAL = 0  # piecewise linear between node values (records; sampled pulses for the linear model)
+RECT, SINE, RICKER_SYM, RICKER_ANTI = 1, 2, 3, 4
+
+# status codes returned by run()
+REST, ROCKING, OVERTURNED = 0, 1, 2
+
+_MAX_EVENTS_PER_STEP = 1_000_000
+
+
+# --------------------------------------------------------------------------- forcing
+@njit(cache=True, inline="always")
+def forcing(kind, amp, tp, t0, uval, j, ta, tb, t):
+    """Ground acceleration over g at time ``t`` inside interval ``j`` = ``[ta, tb]``.
+
+    ``amp`` is ``ap/g`` for pulses and a scale factor for nodal values.
+    """
+    if kind == NODAL:
+        return amp * (uval[j] + (uval[j + 1] - uval[j]) * ((t - ta) / (tb - ta)))
+    if kind == FREE:
+        return 0.0
+    if kind == RECT:
+        return amp
+    tau = (t - t0) / tp
+    if kind == SINE:
+        return amp * math.sin(TWO_PI * tau)
+    if kind == RICKER_SYM:
+        x2 = (math.pi * tau) ** 2
+        return amp * (1.0 - 2.0 * x2) * math.exp(-x2)
+    x = TWO_PI * tau / SQRT3
+    return amp * (x * x - 3.0) * x * math.exp(-0.5 * x * x) / BETA
+
+
+# --------------------------------------------------------------------------- steppers
+@njit(cache=True, inline="always")
+def _rhs(theta, s, u, p2, sa, ca, linear):
+    if linear:
+        return p2 * (theta - s * sa - u)  # sa carries alpha itself in the linear model
+    # sin(alpha s - theta) and cos(alpha s - theta) by angle addition
+    sn, cs = math.sin(theta), math.cos(theta)
+    sin_d = s * sa * cs - ca * sn
+    cos_d = ca * cs + s * sa * sn
+    return -p2 * (sin_d + u * cos_d)
+
+
+@njit(cache=True)
+def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear):
+    """Advance ``(theta, omega)`` on side ``s`` from ``t`` by ``h`` (inside interval ``j``)."""
+    p2 = p * p
+    if linear:
+        # forcing is linear on the interval: u(t + x) = u0 + u1 x, exact cosh/sinh solution
+        u0 = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
+        u1 = (forcing(kind, amp, tp, t0, uval, j, ta, tb, t + h) - u0) / h if h > 0 else 0.0
+        y0 = theta - s * sa - u0
+        dy0 = omega - u1
+        ch, sh = math.cosh(p * h), math.sinh(p * h)
+        y = y0 * ch + dy0 / p * sh
+        dy = y0 * p * sh + dy0 * ch
+        return y + s * sa + u0 + u1 * h, dy + u1
+    hh = 0.5 * h
+    u_a = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
+    u_m = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + hh)
+    u_b = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + h)
+    k1t = omega
+    k1w = _rhs(theta, s, u_a, p2, sa, ca, False)
+    k2t = omega + hh * k1w
+    k2w = _rhs(theta + hh * k1t, s, u_m, p2, sa, ca, False)
+    k3t = omega + hh * k2w
+    k3w = _rhs(theta + hh * k2t, s, u_m, p2, sa, ca, False)
+    k4t = omega + h * k3w
+    k4w = _rhs(theta + h * k3t, s, u_b, p2, sa, ca, False)
+    return (theta + h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t),
+            omega + h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w))
+
+
+# --------------------------------------------------------------------------- Hermite helpers
+@njit(cache=True, inline="always")
+def _hermite(th_a, om_a, th_b, om_b, h):
+    c0 = th_a
+    c1 = h * om_a
+    c2 = 3.0 * (th_b - th_a) - h * (2.0 * om_a + om_b)
+    c3 = 2.0 * (th_a - th_b) + h * (om_a + om_b)
+    return c0, c1, c2, c3
+
+
+@njit(cache=True, inline="always")
+def _cubic(c0, c1, c2, c3, x):
+    return c0 + x * (c1 + x * (c2 + x * c3))
+
+
+@njit(cache=True)
+def _stationary(c1, c2, c3):
+    """Roots of the derivative ``c1 + 2 c2 x + 3 c3 x^2`` inside (0, 1), sorted (nan if none)."""
+    r1, r2 = np.nan, np.nan
+    a, b, c = 3.0 * c3, 2.0 * c2, c1
+    if abs(a) < 1e-300 or abs(a) * 1e12 < abs(b):
+        if b != 0.0:
+            r1 = -c / b
+    else:
+        disc = b * b - 4.0 * a * c
+        if disc >= 0.0:
+            sq = math.sqrt(disc)
+            q = -0.5 * (b + math.copysign(sq, b))
+            x1 = q / a
+            x2 = c / q if q != 0.0 else np.nan
+            r1, r2 = min(x1, x2), max(x1, x2)
+    if not (r1 > 0.0 and r1 < 1.0):
+        r1 = np.nan
+    if not (r2 > 0.0 and r2 < 1.0):
+        r2 = np.nan
+    if np.isnan(r1):
+        r1, r2 = r2, np.nan
+    return r1, r2
+
+
+@njit(cache=True)
+def _first_crossing(c0, c1, c2, c3, s, level):
+    """First x in (0, 1] where ``s*H(x) - level`` turns non-positive, given it starts >= 0.
+
+    Returns ``(lo, hi, interior)`` bracketing it (``interior``: found at an extremum of the
+    interpolant inside the step, which the caller must confirm, because the interpolation error
+    can fake a shallow dip), or ``(-1, -1, False)`` if there is none.
+    """
+    e1, e2 = _stationary(c1, c2, c3)
+    lo = 0.0
+    for k in range(3):
+        hi = e1 if k == 0 else (e2 if k == 1 else 1.0)
+        if np.isnan(hi) or hi <= lo:
+            continue
+        value = s * _cubic(c0, c1, c2, c3, hi) - level
+        if k < 2:
+            if value < 0.0:
+                return lo, hi, True
+        elif value < 0.0 or (value == 0.0 and s * c0 - level > 0.0):
+            return lo, hi, False
+        lo = hi
+    return -1.0, -1.0, False
+
+
+@njit(cache=True)
+def _hermite_peak(th_a, om_a, th_b, om_b, h):
+    """Largest ``|theta|`` of the Hermite interpolant inside a step (ends excluded)."""
+    c0, c1, c2, c3 = _hermite(th_a, om_a, th_b, om_b, h)
+    e1, e2 = _stationary(c1, c2, c3)
+    peak = 0.0
+    if not np.isnan(e1):
+        peak = abs(_cubic(c0, c1, c2, c3, e1))
+    if not np.isnan(e2):
+        peak = max(peak, abs(_cubic(c0, c1, c2, c3, e2)))
+    return peak
+
+
+# --------------------------------------------------------------------------- energy rule
+@njit(cache=True)
+def _potential(x, alpha, linear):
+    """Potential energy over m g R at ``|theta| = x`` (zero at rest)."""
+    if linear:
+        return 0.5 * alpha * alpha - 0.5 * (alpha - x) ** 2
+    return math.cos(alpha - x) - math.cos(alpha)
+
+
+@njit(cache=True)
+def _peak_from_energy(e, alpha, linear):
+    """Peak ``|theta|`` of a block with energy ``e`` (over m g R) below the critical one."""
+    if linear:
+        return alpha - math.sqrt(max(alpha * alpha - 2.0 * e, 0.0))
+    return alpha - math.acos(min(math.cos(alpha) + e, 1.0))
+
+
+@njit(cache=True)
+def energy_verdict(theta, omega, p, alpha, eta, linear):
+    """Decide overturning after the excitation ends (SPEC section 2), exactly.
+
+    Returns ``(overturns, next_peak)``; ``next_peak`` is the largest ``|theta|`` of the free
+    motion that follows (``pi/2`` if it overturns).
+    """
+    x = abs(theta)
+    if x == 0.0 and omega == 0.0:
+        return False, 0.0
+    e = 0.5 * omega * omega / (p * p) + _potential(x, alpha, linear)
+    e_crit = _potential(alpha, alpha, linear)
+    r = eta * eta
+    if theta == 0.0:
+        away = True  # just after an impact or uplift, moving into a side
+    elif omega == 0.0:  # at a turning point
+        if x > alpha:
+            return True, HALF_PI  # beyond the top at rest: falls outward
+        if x == alpha:
+            return False, x  # the verge: infinite time to fall either way
+        away = False
+    else:
+        away = theta * omega > 0.0
+    if away:
+        if x >= alpha or e > e_crit:
+            return True, HALF_PI
+        return False, max(x, _peak_from_energy(e, alpha, linear))
+    # moving toward zero
+    if x > alpha and e < e_crit:
+        return True, HALF_PI  # cannot climb back over the top: falls outward
+    if r * e > e_crit:
+        return True, HALF_PI  # passes the impact with enough energy to overturn
+    return False, _peak_from_energy(r * e, alpha, linear)
+
+
+# --------------------------------------------------------------------------- main loop
+@njit(cache=True)
+def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
+    """First time in ``[t, t2]`` where ``|u| > tan(alpha)`` (monotonic u), or nan."""
+    ua = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
+    if abs(ua) > tan_a:
+        return t
+    ub = forcing(kind, amp, tp, t0, uval, j, ta, tb, t2)
+    if abs(ub) <= tan_a:
+        return np.nan
+    level = math.copysign(tan_a, ub)
+    if kind == NODAL:
+        x = t + (t2 - t) * (level - ua) / (ub - ua)
+        return min(max(x, t), t2)
+    lo, hi = t, t2  # bisection to the last representable time
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if abs(forcing(kind, amp, tp, t0, uval, j, ta, tb, mid)) > tan_a:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@njit(cache=True)
+def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
+        p, alpha, eta, theta0, omega0, linear, zeno_tol, stop_at_rest,
+        hist_t, hist_theta, hist_omega, impacts, record):
+    """Integrate the rocking block over ``n_int`` intervals of the grid.
+
+    Parameters
+    ----------
+    kind, amp, tp, t0, uval : forcing (see :func:`forcing`); ``uval`` holds node values of
+        ``ug''/g`` for ``kind == NODAL``.
+    nodes : float array; when empty the grid is uniform, ``t_start + j * h_uniform``.
+    n_int, n_sub : number of intervals, and RK4 (or exact) sub-steps per interval.
+    p, alpha, eta : block (rad/s, rad, -).
+    theta0, omega0 : initial state (rad, rad/s).
+    linear : use the linearised equation (exact stepping) instead of the nonlinear one.
+    zeno_tol : Zeno sequences are summed once ``|omega| < zeno_tol * p * alpha``.
+    stop_at_rest : stop as soon as the block is at rest (free motion only).
+    hist_t, hist_theta, hist_omega : output arrays of length ``n_int + 1`` (when ``record``).
+    impacts : output array of impact times; impacts beyond its length are counted only.
+
+    Returns
+    -------
+    status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted, n_rest
+    """
+    tan_a = math.tan(alpha)
+    if linear:
+        sa, ca = alpha, 1.0
+    else:
+        sa, ca = math.sin(alpha), math.cos(alpha)
+    uniform = nodes.shape[0] == 0
+    theta, omega = theta0, omega0
+    if theta != 0.0:
+        s = 1.0 if theta > 0.0 else -1.0
+    elif omega != 0.0:
+        s = 1.0 if omega > 0.0 else -1.0
+    else:
+        s = 0.0
+    uplifted = s != 0.0
+    max_abs = abs(theta)
+    n_imp = 0
+    n_rest = 0
+    rest_until = -np.inf
+    omega_zeno = zeno_tol * p * alpha
+    status = ROCKING if s != 0.0 else REST
+    t = nodes[0] if not uniform else t_start
+    n_hist = 0
+    if record:
+        hist_t[0], hist_theta[0], hist_omega[0] = t, theta, omega
+        n_hist = 1
+    for j in range(n_int):
+        if uniform:
+            ta = t_start + j * h_uniform
+            tb = t_start + (j + 1) * h_uniform
+        else:
+            ta, tb = nodes[j], nodes[j + 1]
+        hsub = (tb - ta) / n_sub
+        for k in range(n_sub):
+            t2 = tb if k == n_sub - 1 else ta + (k + 1) * hsub
+            events = 0
+            while t < t2:
+                events += 1
+                if s == 0.0:
+                    # ---- at rest: wait for |ug''| > g tan(alpha)
+                    if stop_at_rest:
+                        status = REST
+                        t = max(t, rest_until)
+                        break
+                    if rest_until >= t2:
+                        t = t2
+                        break
+                    if rest_until > t:
+                        t = rest_until
+                    t_up = _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a)
+                    if np.isnan(t_up):
+                        t = t2
+                        break
+                    t = t_up
+                    u_up = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
+                    if abs(u_up) <= tan_a:  # touching the threshold from below at t2
+                        u_up = forcing(kind, amp, tp, t0, uval, j, ta, tb, t2)
+                    s = -1.0 if u_up > 0.0 else 1.0
+                    theta, omega = 0.0, 0.0
+                    uplifted = True
+                    status = ROCKING
+                    if t >= t2:
+                        break
+                h = t2 - t
+                th2, om2 = step(kind, amp, tp, t0, uval, j, ta, tb, t, h,
+                                theta, omega, s, p, sa, ca, linear)
+                c0, c1, c2, c3 = _hermite(theta, omega, th2, om2, h)
+                # ---- impact: theta reaches 0 (first crossing of the step, grazes included)
+                lo, hi, interior = _first_crossing(c0, c1, c2, c3, s, 0.0)
+                if interior:
+                    # a dip of the interpolant inside the step: real only if the solution dips
+                    th_e, _ = step(kind, amp, tp, t0, uval, j, ta, tb, t, hi * h,
+                                   theta, omega, s, p, sa, ca, linear)
+                    if s * th_e > 0.0:
+                        lo = -1.0
+                if lo >= 0.0 and (events < _MAX_EVENTS_PER_STEP):
+                    # bisection on the cubic, then Newton on the re-integrated solution
+                    for _ in range(60):
+                        mid = 0.5 * (lo + hi)
+                        if s * _cubic(c0, c1, c2, c3, mid) > 0.0:
+                            lo = mid
+                        else:
+                            hi = mid
+                        if hi - lo < 1e-6:
+                            break
+                    x = hi
+                    for _ in range(8):
+                        th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
+                                          theta, omega, s, p, sa, ca, linear)
+                        if om_x == 0.0:
+                            break
+                        xn = x - th_x / (om_x * h)
+                        if xn <= 0.0 or xn > 1.0:
+                            break
+                        converged = abs(xn - x) < 4e-16
+                        x = xn
+                        if converged:
+                            break
+                    th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
+                                      theta, omega, s, p, sa, ca, linear)
+                    t_imp = t + x * h
+                    if t_imp <= t:
+                        t_imp = t + 1e-16 * max(abs(t), 1.0)
+                    # peak between t and the impact
+                    pk = _hermite_peak(theta, omega, th_x, om_x, t_imp - t)
+                    if pk > max_abs:
+                        max_abs = pk
+                    if n_imp < impacts.shape[0]:
+                        impacts[n_imp] = t_imp
+                    n_imp += 1
+                    omega = eta * om_x
+                    s = -s
+                    theta = 0.0
+                    t = t_imp
+                    # ---- Zeno: sum the remaining hops in closed form
+                    if abs(omega) <= omega_zeno:
+                        u_now = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
+                        if linear:
+                            a_new = p * p * (alpha + s * u_now)
+                            a_old = p * p * (alpha - s * u_now)
+                        else:
+                            a_new = p * p * (sa + s * u_now * ca)
+                            a_old = p * p * (sa - s * u_now * ca)
+                        if a_new > 0.0 and a_old > 0.0:
+                            t_z = 2.0 * abs(omega) / (1.0 - eta * eta) * (1.0 / a_new + eta / a_old)
+                            rest_until = t + t_z
+                            s = 0.0
+                            omega = 0.0
+                            n_rest += 1
+                            status = REST
+                    continue
+                if lo >= 0.0:  # too many events in one step: settle (never loops forever)
+                    s = 0.0
+                    theta, omega = 0.0, 0.0
+                    status = REST
+                    rest_until = t2
+                    continue
+                # ---- overturning: |theta| reaches pi/2
+                if abs(th2) >= HALF_PI:
+                    lo, hi, _ = _first_crossing(c0, c1, c2, c3, -s, -HALF_PI)
+                    x = 1.0 if lo < 0.0 else hi
+                    for _ in range(60):
+                        if lo < 0.0:
+                            break
+                        mid = 0.5 * (lo + hi)
+                        if s * _cubic(c0, c1, c2, c3, mid) < HALF_PI:
+                            lo = mid
+                        else:
+                            hi = mid
+                        x = hi
+                    t = t + x * h
+                    theta = math.copysign(HALF_PI, th2)
+                    omega = c1 / h + x * (2.0 * c2 + 3.0 * c3 * x) / h
+                    max_abs = HALF_PI
+                    status = OVERTURNED
+                    break
+                pk = _hermite_peak(theta, omega, th2, om2, h)
+                if pk > max_abs:
+                    max_abs = pk
+                if abs(th2) > max_abs:
+                    max_abs = abs(th2)
+                theta, omega, t = th2, om2, t2
+            if status == OVERTURNED or (stop_at_rest and status == REST):
+                break
+        if record:
+            hist_t[n_hist], hist_theta[n_hist], hist_omega[n_hist] = t, theta, omega
+            n_hist += 1
+        if status == OVERTURNED or (stop_at_rest and status == REST):
+            break
+    if status == REST:
+        theta, omega = 0.0, 0.0
+    return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted, n_rest
+
+
+@njit(cache=True, parallel=True)
+def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
+             p, alpha, eta, linear, zeno_tol):
+    """:func:`run` for many blocks/amplitudes at once (arrays ``amp``, ``p``, ``alpha``, ``eta``,
+    ``n_sub`` of equal length); then the energy rule.  No histories are kept.
+
+    Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted``.
+    """
+    n = p.shape[0]
+    overturned = np.zeros(n, dtype=np.bool_)
+    max_abs = np.zeros(n)
+    n_impacts = np.zeros(n, dtype=np.int64)
+    uplifted = np.zeros(n, dtype=np.bool_)
+    empty = np.zeros(0)
+    no_impacts = np.zeros(0)
+    for i in prange(n):
+        st, th, om, te, mx, ni, nh, up, nr = run(
+            kind, amp[i], tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub[i],
+            p[i], alpha[i], eta[i], 0.0, 0.0, linear, zeno_tol, False,
+            empty, empty, empty, no_impacts, False)
+        if st == OVERTURNED:
+            over = True
+        elif st == ROCKING:
+            over, peak = energy_verdict(th, om, p[i], alpha[i], eta[i], linear)
+            if peak > mx:
+                mx = peak
+        else:
+            over = False
+        overturned[i] = over
+        max_abs[i] = HALF_PI if over else mx
+        n_impacts[i] = ni
+        uplifted[i] = up
+    return overturned, max_abs, n_impacts, uplifted
