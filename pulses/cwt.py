@@ -71,15 +71,16 @@ def unit_spectrum(shape: str, nu):
         return (1j * 8.0 * math.pi**3 * math.sqrt(2.0 * math.pi) / (BETA * a**4)) * nu**3 \
             * np.exp(-2.0 * math.pi**2 * nu**2 / a**2)
     omega = 2.0 * math.pi * nu
-    one_minus = 1.0 - np.exp(-1j * omega)
+    one_minus = (1.0 - np.cos(omega)) + 1j * np.sin(omega)  # 1 - exp(-i omega)
     if shape == "rect":
-        safe = np.where(omega == 0.0, 1.0, omega)
-        return np.where(omega == 0.0, 1.0 + 0j, one_minus / (1j * safe))
+        small = np.abs(omega) < 1e-8
+        safe = np.where(small, 1.0, omega)
+        return np.where(small, 1.0 + 0j, one_minus / (1j * safe))
     if shape == "sine":
         denom = 4.0 * math.pi**2 - omega**2
         near = np.abs(np.abs(nu) - 1.0) < 1e-9
         safe = np.where(near, 1.0, denom)
-        return np.where(near, -0.5j * np.sign(nu), one_minus * 2.0 * math.pi / safe)
+        return np.where(near, -0.5j * np.sign(nu), one_minus * (2.0 * math.pi / safe))
     raise ValueError(f"unknown shape {shape!r}; choose one of {', '.join(SHAPES)}")
 
 
@@ -103,6 +104,10 @@ _UNIT_ENERGY = {"rect": 1.0, "sine": 0.5, "ricker-sym": _energy("ricker-sym"), "
 #: are below 1e-3 of their peak (rect and sine keep their slowly decaying sinc tails out of
 #: the coarse search, which is all this transform is for)
 BAND_CYCLES = 3.0
+#: zero padding after the record, in longest periods: the circular correlation must not wrap a
+#: pulse's support round to the other end.  The Ricker wavelets fall below 1e-8 of their peak
+#: 1.5 Tp from the centre, so 1.5 Tp is enough for the matching (it is only the coarse search)
+PAD_PERIODS = 1.5
 
 
 class Matcher:
@@ -124,7 +129,7 @@ class Matcher:
         acc = np.asarray(acc, dtype=float)
         self.dt = float(dt)
         self.n = acc.size
-        pad = int(math.ceil(3.5 * tp_max / dt)) + 1
+        pad = int(math.ceil(PAD_PERIODS * tp_max / dt)) + 1
         self.nfft = sfft.next_fast_len(self.n + pad, real=True)
         spectrum = sfft.rfft(acc, self.nfft)
         f_keep = min(BAND_CYCLES / tp_min, 0.5 / dt)
@@ -138,6 +143,7 @@ class Matcher:
         self.period = self.nfft * dt
         self.dtau = self.period / self.n_out
         self.energy = float(acc @ acc)
+        self.tp_max = float(tp_max)
 
     def transform(self, shape: str, tps) -> tuple[np.ndarray, np.ndarray]:
         """Correlation ``c(tau, Tp)`` for every period in ``tps``.
@@ -155,7 +161,7 @@ class Matcher:
         c = sfft.irfft(self.spectrum[None, :] * np.conj(w_hat), self.n_out, axis=1) * (self.n_out / self.nfft)
         k = np.arange(self.n_out)
         tau = k * self.dtau
-        tau = np.where(tau > self.period - 3.5 * tps.max() - self.dtau, tau - self.period, tau)
+        tau = np.where(tau > self.period - PAD_PERIODS * tps.max() - self.dtau, tau - self.period, tau)
         return tau, c
 
     def explained(self, shape: str, tps) -> tuple[np.ndarray, np.ndarray]:
@@ -166,3 +172,46 @@ class Matcher:
         tau, c = self.transform(shape, tps)
         norm = unit_energy(shape) * np.asarray(tps, dtype=float)[:, None] / self.dt
         return tau, c * np.abs(c) / (norm * max(self.energy, 1e-300))
+
+    def best_match(self, shape: str, tps, t_end: float):
+        """Best ``(signed share, Tp, tau)`` over the periods ``tps`` (s) and all allowed times.
+
+        Periods are taken an octave at a time, each with the band (and so the time grid) its
+        shortest period needs: a long period is matched on a coarse time grid, which keeps the
+        cost proportional to the record length and almost independent of the period range.
+        Allowed times: the centre of a Ricker inside the record, at least half of a rectangular
+        or one-sine pulse inside it.
+        """
+        tps = np.sort(np.asarray(tps, dtype=float))
+        best = (0.0, float(tps[0]), 0.0)
+        start = 0
+        while start < tps.size:
+            stop = int(np.searchsorted(tps, 2.0 * tps[start], side="left"))
+            stop = max(stop, start + 1)
+            group = tps[start:stop]
+            share, tau = self._band_share(shape, group)
+            if shape.startswith("ricker"):
+                ok = (tau[None, :] >= 0.0) & (tau[None, :] <= t_end)
+                ok = np.broadcast_to(ok, share.shape)
+            else:
+                half = 0.5 * group[:, None]
+                ok = (tau[None, :] >= -half) & (tau[None, :] <= t_end - half)
+            masked = np.where(ok, np.abs(share), -1.0)
+            i, j = np.unravel_index(int(np.argmax(masked)), masked.shape)
+            if masked[i, j] > abs(best[0]):
+                best = (float(share[i, j]), float(group[i]), float(tau[j]))
+            start = stop
+        return best
+
+    def _band_share(self, shape, group):
+        m = int(math.ceil(BAND_CYCLES / group[0] * self.nfft * self.dt)) + 1
+        m = max(2, min(m, self.spectrum.size))
+        n_out = min(sfft.next_fast_len(2 * (m - 1), real=True), self.nfft)
+        m = min(m, n_out // 2 + 1)
+        tps = group[:, None]
+        w_hat = tps / self.dt * unit_spectrum(shape, self.freq[None, :m] * tps)
+        c = sfft.irfft(self.spectrum[None, :m] * np.conj(w_hat), n_out, axis=1) * (n_out / self.nfft)
+        tau = np.arange(n_out) * (self.period / n_out)
+        tau = np.where(tau > self.period - PAD_PERIODS * self.tp_max, tau - self.period, tau)
+        norm = unit_energy(shape) * tps / self.dt
+        return c * np.abs(c) / (norm * max(self.energy, 1e-300)), tau

@@ -32,11 +32,11 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, minimize
 
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
-from .cwt import Matcher
+from .cwt import Matcher, unit_energy
 from .record import G, Record
 from .shapes import BETA, SHAPES, Pulse, make_pulse
 
@@ -45,6 +45,10 @@ DEFAULT_SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
 #: ratio between neighbouring periods of the coarse grid (6 %: the matched-filter score of every
 #: shape changes by well under 1 % across one step, so the right basin is never missed)
 GRID_RATIO = 1.06
+#: least margin (s) of record kept on each side of the pulse by the refinement: the straight-line
+#: baseline fitted with the pulse is pinned down by the motion around it, so that it does not
+#: trade off against a short pulse
+FIT_MARGIN = 1.0
 #: half-widths of the correlation window around ``t0`` for the Rickers, in Tp
 _WINDOW = {"ricker-sym": (1.0, 1.0), "ricker-anti": (1.25, 1.25)}
 
@@ -68,6 +72,32 @@ def unit_samples(shape: str, tp: float, t0: float, t, dt: float) -> np.ndarray:
     raise ValueError(f"unknown shape {shape!r}; choose one of {', '.join(SHAPES)}")
 
 
+def unit_samples_and_derivatives(shape: str, tp: float, t0: float, t, dt: float):
+    """Unit pulse at ``t`` and its derivatives with respect to ``tp`` and ``t0`` (for the Jacobian)."""
+    m = unit_samples(shape, tp, t0, t, dt)
+    if shape == "rect":  # cell averages: the edges move through the cells they sit in
+        lo = np.maximum(t - 0.5 * dt, t0)
+        hi = np.minimum(t + 0.5 * dt, t0 + tp)
+        inside = hi > lo
+        end_moves = inside & (t0 + tp < t + 0.5 * dt)
+        start_moves = inside & (t0 > t - 0.5 * dt)
+        d_tp = end_moves / dt
+        d_t0 = (end_moves.astype(float) - start_moves) / dt
+        return m, d_tp, d_t0
+    tau = (t - t0) / tp
+    if shape == "sine":
+        dw = np.where((tau >= 0.0) & (tau <= 1.0), 2.0 * np.pi * np.cos(2.0 * np.pi * tau), 0.0)
+    elif shape == "ricker-sym":
+        x2 = (np.pi * tau) ** 2
+        dw = -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * np.exp(-x2)
+    else:  # ricker-anti
+        k = 2.0 * np.pi / math.sqrt(3.0)
+        x = k * tau
+        x2 = x * x
+        dw = k * (-x2 * x2 + 6.0 * x2 - 3.0) * np.exp(-0.5 * x2) / BETA
+    return m, -dw * tau / tp, -dw / tp
+
+
 def pulse_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
     """Interval (s) over which a candidate's ``correlation`` is measured."""
     if shape in _WINDOW:
@@ -78,9 +108,10 @@ def pulse_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
 
 def _fit_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
     """Interval (s) of samples used by the least-squares refinement: the pulse plus a margin."""
+    margin = max(0.5 * tp, FIT_MARGIN)
     if shape in _WINDOW:
-        return t0 - 3.5 * tp, t0 + 3.5 * tp
-    return t0 - 0.5 * tp, t0 + 1.5 * tp
+        return t0 - 3.0 * tp - margin, t0 + 3.0 * tp + margin
+    return t0 - margin, t0 + tp + margin
 
 
 # -- results -----------------------------------------------------------------------------------
@@ -266,36 +297,20 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
 
 
 def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
-    """Best (ap, Tp, t0) of one shape on the grid of periods and the transform's time grid."""
-    tau, share = matcher.explained(shape, tps)
-    tps_col = np.asarray(tps)[:, None]
-    if shape.startswith("ricker"):  # centre inside the record
-        ok = (tau[None, :] >= 0.0) & (tau[None, :] <= t_end) & np.ones_like(tps_col, dtype=bool)
-    else:  # at least half the pulse inside the record
-        ok = (tau[None, :] >= -0.5 * tps_col) & (tau[None, :] <= t_end - 0.5 * tps_col)
-    masked = np.where(ok, np.abs(share), -1.0)
-    i, j = np.unravel_index(int(np.argmax(masked)), masked.shape)
-    tp, t0 = float(tps[i]), float(tau[j])
-    # least-squares amplitude: share = c|c| / (||w||^2 ||x||^2), so ap = sign * sqrt(|share|) ||x|| / ||w||
-    from .cwt import unit_energy
+    """Best ``(ap, Tp, t0)`` of one shape on the grid of periods and the transform's time grid."""
+    share, tp, t0 = matcher.best_match(shape, tps, t_end)
+    # share = c|c| / (||w||^2 ||x||^2) and ap = c / ||w||^2, so |ap| = sqrt(|share|) ||x|| / ||w||
     norm_w = math.sqrt(unit_energy(shape) * tp / matcher.dt)
-    ap = math.copysign(math.sqrt(abs(share[i, j]) * matcher.energy) / norm_w, share[i, j])
+    ap = math.copysign(math.sqrt(abs(share) * matcher.energy) / norm_w, share)
     return ap, tp, t0
 
 
 def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
-    """Least-squares ``(ap, Tp, t0)`` near a starting guess; the guess if refinement fails."""
+    """Least-squares ``(ap, Tp, t0)`` near a starting guess; the guess if refinement fails.
 
-    def solve(tp, t0, idx):
-        tw = t[idx]
-        w = unit_samples(shape, tp, t0, tw, dt)
-        if baseline:
-            tc = tw.mean() if tw.size else 0.0
-            A = np.column_stack([w, np.ones_like(tw), tw - tc])
-        else:
-            A = w[:, None]
-        coef, *_ = np.linalg.lstsq(A, x[idx], rcond=None)
-        return coef, A
+    Levenberg-Marquardt on the samples inside the fit window, with the analytic Jacobian; the
+    straight-line baseline ``c0 + c1 (t - tc)`` is fitted alongside when ``baseline`` is True.
+    """
 
     def window(tp, t0):
         lo, hi = _fit_window(shape, tp, t0)
@@ -309,32 +324,121 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
 
     best = (ap0, tp0, t00)
     best_sse = sse_full(*best)
-    tp, t0 = tp0, t00
+    if shape == "rect":
+        return _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline)
+    ap, tp, t0 = ap0, tp0, t00
     for _ in range(3):  # refit when the pulse moved outside the window of the previous pass
         idx = window(tp, t0)
-        if idx.stop - idx.start < 4:
+        if idx.stop - idx.start < 6:
             break
+        tw, xw = t[idx], x[idx]
+        tc = float(tw.mean())
+        ones, ramp = np.ones_like(tw), tw - tc
 
-        def residual(theta, idx=idx):
-            coef, A = solve(math.exp(theta[0]), theta[1], idx)
-            return x[idx] - A @ coef
+        def residual(p):
+            m = unit_samples(shape, max(p[1], 1e-9), p[2], tw, dt)
+            r = xw - p[0] * m
+            if baseline:
+                r = r - p[3] - p[4] * ramp
+            return r
 
+        def jacobian(p):
+            m, d_tp, d_t0 = unit_samples_and_derivatives(shape, max(p[1], 1e-9), p[2], tw, dt)
+            cols = [m, p[0] * d_tp, p[0] * d_t0] + ([ones, ramp] if baseline else [])
+            return -np.column_stack(cols)
+
+        p0 = [ap, tp, t0] + ([0.0, 0.0] if baseline else [])
         try:
-            sol = least_squares(residual, [math.log(tp), t0], method="lm",
-                                x_scale=[0.05, 0.05 * tp], xtol=1e-12, ftol=1e-12)
+            sol = least_squares(residual, p0, jac=jacobian, method="lm", xtol=1e-12, ftol=1e-12,
+                                gtol=1e-12, max_nfev=200)
         except (ValueError, np.linalg.LinAlgError):
             break
-        tp_new, t0_new = math.exp(sol.x[0]), float(sol.x[1])
-        if not (math.isfinite(tp_new) and math.isfinite(t0_new)) or tp_new <= 2 * dt:
+        ap_new, tp_new, t0_new = (float(v) for v in sol.x[:3])
+        if not all(map(math.isfinite, (ap_new, tp_new, t0_new))) or tp_new <= 2 * dt:
             break
-        coef, _ = solve(tp_new, t0_new, idx)
-        ap_new = float(coef[0])
         sse = sse_full(ap_new, tp_new, t0_new)
         if sse < best_sse:
             best, best_sse = (ap_new, tp_new, t0_new), sse
-        moved = window(tp_new, t0_new)
-        tp, t0 = tp_new, t0_new
-        if moved == idx or (moved.start <= idx.start and moved.stop >= idx.stop and
-                            idx.start == 0 and idx.stop == x.size):
+        ap, tp, t0 = ap_new, tp_new, t0_new
+        if window(tp, t0) == idx:
+            break
+    return best
+
+
+def _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline):
+    """Least squares for the rectangular pulse: Nelder-Mead on its two edges.
+
+    The cell-averaged rectangle is piecewise linear in its edges, with a kink each time an edge
+    crosses a cell boundary; a gradient method stalls at the kinks, a simplex does not.  The
+    amplitude (and the baseline) are solved linearly for each pair of edges.
+    """
+    ap, tp, t0 = best
+    for _ in range(3):
+        idx = window(tp, t0)
+        if idx.stop - idx.start < 6:
+            break
+        tw, xw = t[idx], x[idx]
+        tc = float(tw.mean())
+        extra = [np.ones_like(tw), tw - tc] if baseline else []
+
+        n = tw.size
+        ramp = tw - tc
+        prefix = {key: np.concatenate([[0.0], np.cumsum(v)]) for key, v in
+                  (("x", xw), ("one", np.ones(n)), ("ramp", ramp))}
+        vec = {"x": xw, "one": np.ones(n), "ramp": ramp}
+        sxx = float(xw @ xw)
+        base = np.array([[n, ramp.sum()], [ramp.sum(), ramp @ ramp]])
+        base_rhs = np.array([xw.sum(), ramp @ xw])
+
+        def sse(edges):
+            # the cell-averaged rectangle is 1 on whole cells and a fraction on the two edge
+            # cells, so its products with x, 1 and (t - tc) come from prefix sums in O(1)
+            start, end = edges
+            if end - start <= dt:
+                return sxx * (1.0 + (dt - (end - start)))
+            k1 = int(math.floor((start - tw[0]) / dt + 0.5))
+            k2 = int(math.floor((end - tw[0]) / dt + 0.5))
+            parts = []  # (index, weight) of the partly covered cells
+            if k1 == k2:
+                parts.append((k1, (end - start) / dt))
+            else:
+                parts.append((k1, (tw[0] + (k1 + 0.5) * dt - start) / dt))
+                parts.append((k2, (end - (tw[0] + (k2 - 0.5) * dt)) / dt))
+            lo, hi = min(max(k1 + 1, 0), n), min(max(k2, 0), n)
+            dots = {key: prefix[key][hi] - prefix[key][lo] for key in prefix}
+            mm = float(hi - lo)
+            for k, w in parts:
+                if 0 <= k < n:
+                    for key in dots:
+                        dots[key] += w * vec[key][k]
+                    mm += w * w
+            if mm <= 0.0:
+                return sxx
+            if baseline:
+                M = np.array([[mm, dots["one"], dots["ramp"]],
+                              [dots["one"], base[0, 0], base[0, 1]],
+                              [dots["ramp"], base[1, 0], base[1, 1]]])
+                rhs = np.array([dots["x"], base_rhs[0], base_rhs[1]])
+                try:
+                    coef = np.linalg.solve(M, rhs)
+                except np.linalg.LinAlgError:
+                    return sxx
+                return sxx - float(coef @ rhs)
+            return sxx - dots["x"] ** 2 / mm
+
+        simplex = np.array([[t0, t0 + tp], [t0 + 0.6 * dt, t0 + tp], [t0, t0 + tp + 0.6 * dt]])
+        sol = minimize(sse, [t0, t0 + tp], method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "xatol": 1e-7 * tp, "fatol": 1e-14 * float(xw @ xw),
+                                "maxiter": 2000})
+        start, end = (float(v) for v in sol.x)
+        tp_new, t0_new = end - start, start
+        A = np.column_stack([unit_samples("rect", tp_new, t0_new, tw, dt)] + extra)
+        coef, *_ = np.linalg.lstsq(A, xw, rcond=None)
+        ap_new = float(coef[0])
+        s_full = sse_full(ap_new, tp_new, t0_new)
+        if s_full < best_sse:
+            best, best_sse = (ap_new, tp_new, t0_new), s_full
+        ap, tp, t0 = ap_new, tp_new, t0_new
+        if window(tp, t0) == idx:
             break
     return best

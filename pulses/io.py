@@ -274,9 +274,10 @@ def _validate(path, acc, raw, units, units_source, meta):
         raise RecordError(f"{path}: every sample is zero")
     if not PLAUSIBLE_MIN_G <= peak_g <= PLAUSIBLE_MAX_G:
         raw_peak = float(np.max(np.abs(raw)))
-        options = [u for u, _ in plausible_units(raw_peak) if u != units]
+        options = [(u, pg) for u, pg in plausible_units(raw_peak) if u != units]
         where = "given" if units_source == "user" else "stated in the file"
-        fix = (f"if the samples are in {' or '.join(options)}, pass units='{options[0]}' (--units {options[0]})"
+        listed = " or ".join(f"{u} (peak {pg:.2g} g)" for u, pg in options)
+        fix = (f"if the samples are in {listed}, pass units='{options[0][0]}' (--units {options[0][0]})"
                if options else "no acceleration units make it plausible")
         raise RecordError(f"{path}: peak {raw_peak:.4g} {units} ({where}) is {peak_g:.3g} g, implausible "
                           f"for an accelerogram (outside {PLAUSIBLE_MIN_G:g} to {PLAUSIBLE_MAX_G:g} g); {fix}")

@@ -5,6 +5,8 @@ the format states them and from the user otherwise; they are never guessed.
 """
 from __future__ import annotations
 
+import math
+
 from .errors import RecordError
 from .record import G
 
@@ -62,11 +64,13 @@ def plausible_units(peak_raw: float) -> list[tuple[str, float]]:
     """Units under which a raw peak value would be a plausible accelerogram peak.
 
     Returns ``(units, peak in g)`` pairs for the canonical units that put the peak between 1e-3 g
-    and 5 g (a range every real strong-motion record falls in).
+    and 5 g (a range every real strong-motion record falls in), the likeliest (peak nearest
+    0.3 g) first.
     """
     out = []
     for name in CANONICAL_UNITS:
         peak_g = peak_raw * ACCELERATION_UNITS[name] / G
         if 1e-3 <= peak_g <= WARN_PEAK_G:
             out.append((name, peak_g))
-    return out
+    # most likely first: the peak nearest 0.3 g (on a log scale), typical of strong motion
+    return sorted(out, key=lambda item: abs(math.log10(item[1] / 0.3)))
