@@ -63,11 +63,13 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
     units : str, optional
         Units of the samples in the file: ``"g"``, ``"m/s2"``, ``"cm/s2"`` (= ``"gal"``),
         ``"mm/s2"`` or ``"nm/s2"``.  Required where the file states none (text, MiniSEED, SAC
-        without ``idep``); for SAC it overrides the standard reading of ``iacc`` (nm/s^2); for
-        AT2 it must agree with the header.
+        without ``idep``); for SAC it overrides the standard reading of ``iacc`` (nm/s^2).  AT2
+        and K-NET files state their units reliably: there it is not applied, and a disagreement
+        is reported in ``metadata["warnings"]``.
     dt : float, optional
-        Sampling interval in s, for text files without a time column (checked against the time
-        column when there is one).
+        Sampling interval in s, for text files without a time column.  Where the file states
+        its time step (header, time column) that one is used, and a disagreement is reported in
+        ``metadata["warnings"]``.
     column : int, optional
         Text files: which column holds the acceleration, counted from 1.
     trace : int or str, optional
@@ -109,10 +111,15 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
         values, file_dt, meta, stated = _read_obspy(path, fmt, units, trace)
 
     # -- units: from the file where it states them, from the user otherwise ----------------
-    if stated is not None and units is not None and fmt == "at2":
+    # AT2 ("UNITS OF G") and K-NET (scale factor) state their units reliably: units passed for a
+    # batch of files are not applied to them, and a disagreement is reported as a warning.
+    # SAC's iacc is overridden by the user's units (files in the wild break the standard).
+    reliable = fmt == "at2" or meta.get("format") == "knet"
+    meta.setdefault("warnings", [])
+    if reliable and units is not None:
         if unit_factor(units) != unit_factor(stated):
-            raise RecordError(f"{path}: the header states units of {stated}, you passed {units!r}; "
-                              f"leave units out for this file")
+            meta["warnings"].append(f"units {units!r} passed but the file states {stated}: used {stated}")
+        units = None
     if units is not None:
         used_units, units_source = canonical_units(units), "user"
     elif stated is not None:
@@ -127,8 +134,10 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
         dt = float(dt)
         if not (np.isfinite(dt) and dt > 0):
             raise RecordError(f"{path}: dt must be a positive time step in s, got {dt!r}")
-        if file_dt is not None and abs(dt - file_dt) > 1e-6 * file_dt:
-            raise RecordError(f"{path}: dt={dt:g} s given but the file says {file_dt:g} s")
+        if file_dt is not None:  # the file's own time step wins
+            if abs(dt - file_dt) > 1e-6 * file_dt:
+                meta["warnings"].append(f"dt={dt:g} s passed but the file says {file_dt:g} s: used {file_dt:g} s")
+            dt = file_dt
     elif file_dt is not None:
         dt = file_dt
     else:

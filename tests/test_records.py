@@ -181,8 +181,8 @@ def test_csv_with_time_column_bom_and_comments(tmp_path):
     rec = read_record(path, units="g")  # dt from the time column
     assert rec.dt == pytest.approx(0.01, rel=1e-12) and rec.npts == 50
     np.testing.assert_allclose(rec.acc, np.round(acc, 6) * G, rtol=1e-12)
-    with pytest.raises(RecordError, match="dt=0.02 s given but the file says 0.01 s"):
-        read_record(path, units="g", dt=0.02)
+    other = read_record(path, units="g", dt=0.02)  # the file's time column wins, with a warning
+    assert other.dt == pytest.approx(0.01) and "file says 0.01 s" in other.metadata["warnings"][0]
     bad = tmp_path / "uneven.csv"
     tt = np.concatenate([np.arange(20) * 0.01, 0.25 + np.arange(20) * 0.01])
     bad.write_text("\n".join(f"{a:.3f},0.1" for a in tt))
