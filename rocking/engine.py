@@ -30,6 +30,13 @@ import math
 
 import numpy as np
 from numba import njit, prange
+from scipy.integrate._ivp import dop853_coefficients as _dop853
+
+#: Butcher tableau of the 8th-order Dormand-Prince formula (the 12 stages of DOP853)
+N_STAGES = _dop853.N_STAGES
+RK8_A = np.ascontiguousarray(_dop853.A[:N_STAGES, :N_STAGES])
+RK8_B = np.ascontiguousarray(_dop853.B[:N_STAGES])
+RK8_C = np.ascontiguousarray(_dop853.C[:N_STAGES])
 
 HALF_PI = 0.5 * math.pi
 TWO_PI = 2.0 * math.pi
@@ -84,19 +91,29 @@ def _rhs(theta, s, u, p2, sa, ca, linear):
 
 
 @njit(cache=True)
-def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear):
-    """Advance ``(theta, omega)`` on side ``s`` from ``t`` by ``h`` (inside interval ``j``)."""
+def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
+         high_order, kt, kw):
+    """Advance ``(theta, omega)`` on side ``s`` from ``t`` by ``h`` (inside interval ``j``).
+
+    Nonlinear: the 8th-order Dormand-Prince formula (fixed step; the 12 stages of DOP853) or,
+    with ``high_order=False``, classical RK4.  Linear: the exact solution.
+    """
     p2 = p * p
     if linear:
         # forcing is linear on the interval: u(t + x) = u0 + u1 x, exact cosh/sinh solution
         u0 = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
         u1 = (forcing(kind, amp, tp, t0, uval, j, ta, tb, t + h) - u0) / h if h > 0 else 0.0
+        # y = theta - s alpha - u obeys y'' = p^2 y; written as increments with
+        # cosh(x) - 1 = 2 sinh(x/2)^2 so that short steps (Zeno hops) lose no digits
         y0 = theta - s * sa - u0
         dy0 = omega - u1
-        ch, sh = math.cosh(p * h), math.sinh(p * h)
-        y = y0 * ch + dy0 / p * sh
-        dy = y0 * p * sh + dy0 * ch
-        return y + s * sa + u0 + u1 * h, dy + u1
+        sh = math.sinh(p * h)
+        chm1 = 2.0 * math.sinh(0.5 * p * h) ** 2
+        return (theta + y0 * chm1 + dy0 / p * sh + u1 * h,
+                omega + y0 * p * sh + dy0 * chm1)
+    if high_order:
+        return _step_rk8(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p2, sa, ca,
+                         kt, kw)
     hh = 0.5 * h
     u_a = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
     u_m = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + hh)
@@ -111,6 +128,27 @@ def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, l
     k4w = _rhs(theta + h * k3t, s, u_b, p2, sa, ca, False)
     return (theta + h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t),
             omega + h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w))
+
+
+@njit(cache=True)
+def _step_rk8(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p2, sa, ca, kt, kw):
+    """One fixed step of the 8th-order Dormand-Prince formula (DOP853's 12 stages).
+
+    ``kt``, ``kw``: scratch arrays of length ``N_STAGES``.
+    """
+    for i in range(N_STAGES):
+        th_i, om_i = theta, omega
+        for m in range(i):
+            th_i += h * RK8_A[i, m] * kt[m]
+            om_i += h * RK8_A[i, m] * kw[m]
+        u_i = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + RK8_C[i] * h)
+        kt[i] = om_i
+        kw[i] = _rhs(th_i, s, u_i, p2, sa, ca, False)
+    th_new, om_new = theta, omega
+    for i in range(N_STAGES):
+        th_new += h * RK8_B[i] * kt[i]
+        om_new += h * RK8_B[i] * kw[i]
+    return th_new, om_new
 
 
 # --------------------------------------------------------------------------- Hermite helpers
@@ -178,15 +216,30 @@ def _first_crossing(c0, c1, c2, c3, s, level):
 
 
 @njit(cache=True)
-def _hermite_peak(th_a, om_a, th_b, om_b, h):
-    """Largest ``|theta|`` of the Hermite interpolant inside a step (ends excluded)."""
+def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
+               s, p, sa, ca, linear, high_order, kt, kw):
+    """Largest ``|theta|`` at a turning point strictly inside a step (0 if none).
+
+    The turning point is located on the cubic Hermite interpolant, the solution is re-integrated
+    to it, and the small residual velocity is removed by one quadratic (Newton) correction, so the
+    peak is as accurate as the stepper rather than the interpolant.
+    """
     c0, c1, c2, c3 = _hermite(th_a, om_a, th_b, om_b, h)
     e1, e2 = _stationary(c1, c2, c3)
     peak = 0.0
-    if not np.isnan(e1):
-        peak = abs(_cubic(c0, c1, c2, c3, e1))
-    if not np.isnan(e2):
-        peak = max(peak, abs(_cubic(c0, c1, c2, c3, e2)))
+    for k in range(2):
+        x = e1 if k == 0 else e2
+        if np.isnan(x):
+            continue
+        th_e, om_e = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h, th_a, om_a, s, p, sa, ca,
+                          linear, high_order, kt, kw)
+        u_e = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + x * h)
+        acc = _rhs(th_e, s, u_e, p * p, sa, ca, linear)
+        value = th_e
+        if acc != 0.0:
+            value = th_e - 0.5 * om_e * om_e / acc
+        if abs(value) > peak:
+            peak = abs(value)
     return peak
 
 
@@ -271,7 +324,7 @@ def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
 @njit(cache=True)
 def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
         p, alpha, eta, theta0, omega0, linear, zeno_tol, stop_at_rest,
-        hist_t, hist_theta, hist_omega, impacts, record):
+        hist_t, hist_theta, hist_omega, impacts, record, high_order=True):
     """Integrate the rocking block over ``n_int`` intervals of the grid.
 
     Parameters
@@ -283,6 +336,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     p, alpha, eta : block (rad/s, rad, -).
     theta0, omega0 : initial state (rad, rad/s).
     linear : use the linearised equation (exact stepping) instead of the nonlinear one.
+    high_order : nonlinear stepping by the 8th-order formula (default) or, if False, RK4.
     zeno_tol : Zeno sequences are summed once ``|omega| < zeno_tol * p * alpha``.
     stop_at_rest : stop as soon as the block is at rest (free motion only).
     hist_t, hist_theta, hist_omega : output arrays of length ``n_int + 1`` (when ``record``).
@@ -293,6 +347,8 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted, n_rest
     """
     tan_a = math.tan(alpha)
+    kt = np.empty(N_STAGES)
+    kw = np.empty(N_STAGES)
     if linear:
         sa, ca = alpha, 1.0
     else:
@@ -356,14 +412,14 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         break
                 h = t2 - t
                 th2, om2 = step(kind, amp, tp, t0, uval, j, ta, tb, t, h,
-                                theta, omega, s, p, sa, ca, linear)
+                                theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
                 c0, c1, c2, c3 = _hermite(theta, omega, th2, om2, h)
                 # ---- impact: theta reaches 0 (first crossing of the step, grazes included)
                 lo, hi, interior = _first_crossing(c0, c1, c2, c3, s, 0.0)
                 if interior:
                     # a dip of the interpolant inside the step: real only if the solution dips
                     th_e, _ = step(kind, amp, tp, t0, uval, j, ta, tb, t, hi * h,
-                                   theta, omega, s, p, sa, ca, linear)
+                                   theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
                     if s * th_e > 0.0:
                         lo = -1.0
                 if lo >= 0.0 and (events < _MAX_EVENTS_PER_STEP):
@@ -379,7 +435,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                     x = hi
                     for _ in range(8):
                         th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
-                                          theta, omega, s, p, sa, ca, linear)
+                                          theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
                         if om_x == 0.0:
                             break
                         xn = x - th_x / (om_x * h)
@@ -390,12 +446,13 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         if converged:
                             break
                     th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
-                                      theta, omega, s, p, sa, ca, linear)
+                                      theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
                     t_imp = t + x * h
                     if t_imp <= t:
                         t_imp = t + 1e-16 * max(abs(t), 1.0)
                     # peak between t and the impact
-                    pk = _hermite_peak(theta, omega, th_x, om_x, t_imp - t)
+                    pk = _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, t_imp - t, theta,
+                                    omega, th_x, om_x, s, p, sa, ca, linear, high_order, kt, kw)
                     if pk > max_abs:
                         max_abs = pk
                     if n_imp < impacts.shape[0]:
@@ -447,7 +504,8 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                     max_abs = HALF_PI
                     status = OVERTURNED
                     break
-                pk = _hermite_peak(theta, omega, th2, om2, h)
+                pk = _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, th2, om2,
+                                s, p, sa, ca, linear, high_order, kt, kw)
                 if pk > max_abs:
                     max_abs = pk
                 if abs(th2) > max_abs:
@@ -467,7 +525,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
 
 @njit(cache=True, parallel=True)
 def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
-             p, alpha, eta, linear, zeno_tol):
+             p, alpha, eta, linear, zeno_tol, high_order=True):
     """:func:`run` for many blocks/amplitudes at once (arrays ``amp``, ``p``, ``alpha``, ``eta``,
     ``n_sub`` of equal length); then the energy rule.  No histories are kept.
 
@@ -484,7 +542,7 @@ def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
         st, th, om, te, mx, ni, nh, up, nr = run(
             kind, amp[i], tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub[i],
             p[i], alpha[i], eta[i], 0.0, 0.0, linear, zeno_tol, False,
-            empty, empty, empty, no_impacts, False)
+            empty, empty, empty, no_impacts, False, high_order)
         if st == OVERTURNED:
             over = True
         elif st == ROCKING:

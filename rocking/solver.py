@@ -25,10 +25,15 @@ from pulses import G, Pulse, Record
 from . import engine
 from .block import Block
 
-#: RK4 accuracy knob: the largest ``p_eff * h`` of a step, with ``p_eff = p sqrt(1 + max|ug''|/g)``
-#: (the fastest rate of the linearised dynamics).  Measured in ``benchmarks``: max|theta| agrees
-#: with the reference to ~1e-9 rad on pulses and records at this setting.
-PH_MAX = 0.05
+#: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
+#: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  With the
+#: 8th-order formula one step per sample of any usual record is far inside it; measured in
+#: ``benchmarks``: max|theta| agrees with the reference to ~1e-9 rad or better on pulses and records.
+PH_MAX = 0.2
+#: the same knob for the RK4 option (``order=4``), which needs far smaller steps: rocking responses
+#: to broadband records amplify local errors, and RK4 at one step per 200 Hz sample can be off by
+#: 1e-4 rad in max|theta| (see benchmarks)
+PH_MAX_RK4 = 0.05
 #: steps per pulse period, at least (resolves the forcing of the pulse itself)
 STEPS_PER_TP = 200
 #: ``model="auto"`` picks the linearised model when ``LINEAR_ERROR_COEFF * alpha**2 <= tol``:
@@ -165,7 +170,8 @@ class _Grid:
     u_peak: float  # max |ug''|/g over the excitation (before scaling)
 
 
-def _grid(excitation, p_max: float, linear: bool, duration: float | None) -> _Grid:
+def _grid(excitation, p_max: float, linear: bool, duration: float | None,
+          ph_max: float = PH_MAX) -> _Grid:
     empty = np.zeros(0)
     if isinstance(excitation, Record):
         n_int = excitation.npts - 1
@@ -180,7 +186,7 @@ def _grid(excitation, p_max: float, linear: bool, duration: float | None) -> _Gr
         if linear:
             h_max = min(excitation.tp / LINEAR_STEPS_PER_TP, 0.05 / p_eff)
         else:
-            h_max = min(excitation.tp / STEPS_PER_TP, PH_MAX / p_eff)
+            h_max = min(excitation.tp / STEPS_PER_TP, ph_max / p_eff)
         t_end = None if duration is None else excitation.support[0] + duration
         nodes = _pulse_grid(excitation, h_max, t_end)
         return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
@@ -205,7 +211,8 @@ def _choose_model(model: str, block: Block, tol: float) -> str:
 # --------------------------------------------------------------------------- simulate
 def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: float = 0.0,
              duration: float | None = None, model: str = "auto", tol: float = 1e-6,
-             history: bool = True, zeno_tol: float = ZENO_TOL) -> RockingResult:
+             history: bool = True, zeno_tol: float = ZENO_TOL, order: int = 8,
+             ph_max: float | None = None) -> RockingResult:
     """Rocking response of ``block`` to ``excitation``.
 
     Parameters
@@ -229,6 +236,11 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         Keep ``t``, ``theta``, ``omega`` (set False to save memory on very long records).
     zeno_tol : float
         Post-impact ``|omega| / (p alpha)`` below which a Zeno sequence is summed in closed form.
+    order : {8, 4}
+        Fast engine only: the 8th-order Dormand-Prince formula (default) or classical RK4.
+    ph_max : float, optional
+        Fast engine only: largest ``p_eff * h`` of a step (default :data:`PH_MAX`, or
+        :data:`PH_MAX_RK4` for ``order=4``); smaller means more sub-steps per sample.
 
     Returns
     -------
@@ -243,6 +255,10 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         raise ValueError(f"theta0 must lie inside (-pi/2, pi/2), got {theta0!r}")
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be positive and finite, got {duration!r}")
+    if order not in (4, 8):
+        raise ValueError(f"order must be 8 or 4, got {order!r}")
+    if ph_max is None:
+        ph_max = PH_MAX if order == 8 else PH_MAX_RK4
     chosen = _choose_model(model, block, tol)
     at_rest = theta0 == 0.0 and omega0 == 0.0
     if excitation is not None and at_rest and model in ("auto", "fast", "linear"):
@@ -255,7 +271,7 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         return simulate_reference(block, excitation, theta0=theta0, omega0=omega0,
                                   duration=duration, zeno_tol=zeno_tol)
     return _simulate_compiled(block, excitation, theta0, omega0, duration, chosen == "linear",
-                              history, zeno_tol)
+                              history, zeno_tol, order == 8, ph_max)
 
 
 def _never_uplifts(block, excitation, duration, history):
@@ -269,37 +285,42 @@ def _never_uplifts(block, excitation, duration, history):
 
 
 def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_tol,
-              stop_at_rest=False, n_sub=None):
-    if n_sub is None:
-        h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
-        n_sub = int(_n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else PH_MAX))
-        if linear:
-            n_sub = 1 if grid.kind in (engine.NODAL, engine.RECT, engine.FREE) else n_sub
+              stop_at_rest=False, high_order=True, ph_max=PH_MAX):
+    h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
+    n_sub = int(_n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else ph_max))
+    if linear and grid.kind in (engine.NODAL, engine.RECT, engine.FREE):
+        n_sub = 1  # exact for forcing linear on each interval
     size = grid.n_int + 1 if history else 0
     hist_t, hist_th, hist_om = np.empty(size), np.empty(size), np.empty(size)
     impacts = np.empty(4096)
     out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes, grid.t_start,
                      grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta, theta0, omega0,
-                     linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om, impacts, history)
+                     linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om, impacts, history,
+                     high_order)
     status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
         out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes,
                          grid.t_start, grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta,
                          theta0, omega0, linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om,
-                         impacts, history)
+                         impacts, history, high_order)
         status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     return (status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts[:n_imp],
             hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist])
 
 
+#: ``p * h`` of the free-rocking grid (no forcing to resolve; RK4 energy drift ~1e-12 per cycle)
+PH_FREE = 0.005
+
+
 def _free_grid(block: Block, t_start: float, length: float, h_hint: float | None) -> _Grid:
-    h = 0.02 / block.p if h_hint is None else min(h_hint, 0.02 / block.p)
+    h = PH_FREE / block.p if h_hint is None else min(h_hint, PH_FREE / block.p)
     n = max(1, math.ceil(length / h - 1e-9))
     return _Grid(engine.FREE, 0.0, 1.0, 0.0, np.zeros(0), np.zeros(0), t_start, length / n, n, 0.0)
 
 
-def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, history, zeno_tol):
+def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, history, zeno_tol,
+                       high_order=True, ph_max=PH_MAX):
     name = "linear" if linear else "fast"
     if excitation is None:
         # free rocking: the energy rule already knows the verdict; integrate for the history
@@ -307,7 +328,7 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
         length = duration if duration is not None else _free_rocking_horizon(block)
         grid = _free_grid(block, 0.0, length, None)
         res = _run_grid(grid, block, theta0, omega0, linear, history, zeno_tol,
-                        stop_at_rest=duration is None)
+                        stop_at_rest=duration is None, high_order=high_order, ph_max=ph_max)
         status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
         if status == engine.OVERTURNED:
             over, verdict_by, t_over = True, "integration", t_end
@@ -319,8 +340,9 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
         return _result(block, over, max_abs, impacts, n_imp, t, th, om, name, verdict_by,
                        uplifted or theta0 != 0 or omega0 != 0, t_over)
 
-    grid = _grid(excitation, block.p, linear, duration)
-    res = _run_grid(grid, block, theta0, omega0, linear, history, zeno_tol)
+    grid = _grid(excitation, block.p, linear, duration, ph_max)
+    res = _run_grid(grid, block, theta0, omega0, linear, history, zeno_tol,
+                    high_order=high_order, ph_max=ph_max)
     status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
     t_over = math.nan
     if status == engine.OVERTURNED:
@@ -336,7 +358,8 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
         # free rocking after the excitation, for the history only (the verdict stands)
         h_hint = excitation.dt if isinstance(excitation, Record) else excitation.tp / 50
         free = _free_grid(block, t_end, start + duration - t_end, h_hint)
-        res2 = _run_grid(free, block, theta, omega, linear, history, zeno_tol)
+        res2 = _run_grid(free, block, theta, omega, linear, history, zeno_tol,
+                         high_order=high_order, ph_max=ph_max)
         status2, _, _, t_end2, max2, n2, _, imp2, t2, th2, om2 = res2
         if status2 == engine.OVERTURNED:
             t_over = t_end2
@@ -370,7 +393,7 @@ def _result(block, over, max_abs, impacts, n_imp, t, th, om, model, verdict_by, 
 
 # --------------------------------------------------------------------------- batch
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
-                  model: str = "fast") -> BatchResult:
+                  model: str = "fast", order: int = 8) -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
 
     Parameters
@@ -383,6 +406,8 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         False: ``blocks`` and ``scales`` broadcast pairwise (1-D result).  True: every block
         against every scale, results of shape ``(n_blocks, n_scales)``.
     model : {"fast", "linear"}
+    order : {8, 4}
+        Stepping formula of the fast engine (see :func:`simulate`).
 
     Returns
     -------
@@ -409,16 +434,17 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         shape = p.shape
     p, alpha, eta, scales = (np.ascontiguousarray(a, dtype=float).ravel()
                              for a in (p, alpha, eta, scales))
-    g = _grid(excitation, float(p.max()), linear, None)
+    ph_max = PH_MAX if order == 8 else PH_MAX_RK4
+    g = _grid(excitation, float(p.max()), linear, None, ph_max)
     amp = g.amp * scales
     h = g.h if g.nodes.size == 0 else float(np.max(np.diff(g.nodes)))
     p_eff = p * np.sqrt(1.0 + g.u_peak * np.abs(scales))
-    n_sub = _n_sub(h, p_eff, 0.05 if linear else PH_MAX)
+    n_sub = _n_sub(h, p_eff, 0.05 if linear else ph_max)
     if linear and g.kind in (engine.NODAL, engine.RECT):
         n_sub[:] = 1
     over, max_abs, n_imp, up = engine.run_many(g.kind, amp, g.tp, g.t0, g.uval, g.nodes,
                                                g.t_start, g.h, g.n_int, n_sub, p, alpha, eta,
-                                               linear, ZENO_TOL)
+                                               linear, ZENO_TOL, order == 8)
     ratio = max_abs / alpha
     return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
                        max_abs.reshape(shape), ratio.reshape(shape), n_imp.reshape(shape),
