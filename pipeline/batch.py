@@ -181,41 +181,48 @@ def _process(task: Task):
         "pulse_ap_g": _g(best.ap),
         "pulse_tp_s": best.tp,
         "pulse_t0_s": best.t0,
+        "pulse_arrival_s": getattr(best, "arrival", None),
         "pulse_lp_m": abs(best.ap) * best.tp ** 2,
         "pulse_score": best.score,
         "pulse_correlation": getattr(best, "correlation", None),
         "shapes_fitting": ";".join(c.shape for c in fitting),
     }
 
+    blocks = {col: rocking.Block.from_dimensions(col.height, col.width)
+              for col in task.columns if col.width is not None}
+    exact = _stage("design", _exact_by_shape, fitting, list(blocks.values()))
+
     rows = []
     histories = []
     verified_cache = {}
-    eq31_width_cache = {}
+    eq31_cache = {}
     for col in task.columns:
         row = dict(base)
         row.update({"column": col.label, "column_kind": col.kind, "height_m": col.height})
         H = col.height
         curves = []
 
-        # -- Eq. 31 width for this height, for every fitting shape: the widest governs --
-        def eq31_widths():
-            widths = []
-            for c in fitting:
-                w = rocking.required_width(H, c.pulse, rule="eq31").width
-                widths.append((float(w), c))
-            # widest first, ties to the better fit (fitting is ranked best first)
-            return max(widths, key=lambda wc: wc[0])
-
-        if H not in eq31_width_cache:
-            eq31_width_cache[H] = _stage("design", eq31_widths)
-        w31, gov = eq31_width_cache[H]
+        # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
+        if H not in eq31_cache:
+            eq31_cache[H] = _stage("design", lambda: [
+                (float(rocking.required_width(H, c.pulse, rule="eq31").width), c) for c in fitting])
+        widths = eq31_cache[H]
+        w31, gov = max(widths, key=lambda wc: wc[0])  # ties: the better fit (ranked first)
         row.update({"governing_shape": gov.shape, "governing_ap_g": _g(gov.ap),
                     "governing_tp_s": gov.tp, "eq31_width_m": w31, "eq31_width_tan_alpha": w31 / H})
+        for shape in SHAPE_NAMES:
+            c = by_shape.get(shape)
+            if c is None:
+                continue
+            k = _shape_key(shape)
+            row.update({f"{k}_fits": any(c is f for f in fitting), f"{k}_ap_g": _g(c.ap),
+                        f"{k}_tp_s": c.tp, f"{k}_score": c.score})
+        for w, c in widths:
+            row[f"{_shape_key(c.shape)}_eq31_width_m"] = w
 
-        # -- the column as it stands ---------------------------------------------------------------
-        block = None
+        # -- the column as it stands -----------------------------------------------------------------
         if col.width is not None:
-            block = rocking.Block.from_dimensions(H, col.width)
+            block = blocks[col]
             p = block.p
 
             def design_as_stands():
@@ -224,23 +231,14 @@ def _process(task: Task):
                     "alpha_deg": math.degrees(block.alpha), "p_rad_s": p, "p_tp": p * best.tp,
                     "eq31_tan_alpha": float(rocking.eq31(best.ap, best.tp, p)),
                     "envelope_tan_alpha": float(rocking.envelope_rule(best.ap, best.tp, p, shape=best.shape)),
-                    "exact_tan_alpha": float(rocking.min_slenderness(best.pulse, p).tan_alpha),
+                    "exact_tan_alpha": exact[(best.shape, block)],
                     "governing_eq31_tan_alpha": float(rocking.eq31(gov.ap, gov.tp, p)),
                 }
-                for shape in SHAPE_NAMES:
-                    k = _shape_key(shape)
-                    c = by_shape.get(shape)
-                    if c is None:
-                        continue
-                    fits = any(c is f for f in fitting)
-                    d[f"{k}_fits"] = fits
-                    d[f"{k}_ap_g"] = _g(c.ap)
-                    d[f"{k}_tp_s"] = c.tp
-                    d[f"{k}_score"] = c.score
+                for c in by_shape.values():
+                    k = _shape_key(c.shape)
                     d[f"{k}_eq31_tan_alpha"] = float(rocking.eq31(c.ap, c.tp, p))
-                    if fits:
-                        d[f"{k}_exact_tan_alpha"] = (d["exact_tan_alpha"] if c is best else
-                                                     float(rocking.min_slenderness(c.pulse, p).tan_alpha))
+                    if (c.shape, block) in exact:
+                        d[f"{k}_exact_tan_alpha"] = exact[(c.shape, block)]
                 d["eq31_adequate"] = block.tan_alpha >= d["governing_eq31_tan_alpha"]
                 return d
 
@@ -251,13 +249,6 @@ def _process(task: Task):
                         "n_impacts": int(res.n_impacts), "model": str(res.model)})
             if opts.plots:
                 curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
-        else:
-            for shape in SHAPE_NAMES:
-                c = by_shape.get(shape)
-                if c is not None:
-                    k = _shape_key(shape)
-                    row.update({f"{k}_fits": any(c is f for f in fitting), f"{k}_ap_g": _g(c.ap),
-                                f"{k}_tp_s": c.tp, f"{k}_score": c.score})
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
         block31 = rocking.Block.from_dimensions(H, w31)
@@ -279,6 +270,26 @@ def _process(task: Task):
         rows.append(row)
 
     return rows, (record, fit, fitting, histories)
+
+
+def _exact_by_shape(fitting, blocks) -> dict:
+    """Exact minimum tan(alpha) of every fitting pulse for every block: ``{(shape, block): tan}``.
+
+    One ``rocking.min_slenderness_batch`` call per shape covers all the blocks (the similarity law:
+    only pTp and ap/g matter), which gives the same numbers as ``rocking.min_slenderness``.
+    """
+    import rocking
+    from pulses import G
+
+    out = {}
+    if not blocks:
+        return out
+    for c in fitting:
+        p_tp = [b.p * c.tp for b in blocks]
+        res = rocking.min_slenderness_batch(c.shape, p_tp, [abs(c.ap) / G] * len(blocks))
+        for b, r in zip(blocks, res):
+            out[(c.shape, b)] = float(r.tan_alpha)
+    return out
 
 
 def _fit(record, shapes):

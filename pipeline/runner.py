@@ -73,10 +73,28 @@ def _serial(tasks):
         yield process_record(task)
 
 
+def init_worker() -> None:
+    """Set up a worker process: one compiled-solver thread (the processes share the CPUs)."""
+    try:
+        import numba
+
+        numba.set_num_threads(1)
+    except Exception:  # pragma: no cover - numba missing or threading layer not started
+        pass
+
+
 def _pool(tasks, jobs):
+    import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    # Not plain fork: the parent may already run OpenMP threads (numba's parallel solver), and
+    # forking such a process is unsafe.  The fork server starts clean, imports the package once
+    # and forks the workers from there (cheap, and compilation caches are loaded only once).
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    if ctx.get_start_method() == "forkserver":
+        ctx.set_forkserver_preload(["pipeline.batch", "pulses", "rocking"])
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
         futures = {pool.submit(process_record, t): t for t in tasks}
         try:
             for fut in as_completed(futures):
@@ -112,6 +130,7 @@ def _dask(tasks, address, jobs):
 
     client, cluster = dask_client(address, jobs)
     try:
+        client.run(init_worker)
         futures = client.map(process_record, tasks, pure=False)
         index = {f.key: t for f, t in zip(futures, tasks)}
         for fut in as_completed(futures):

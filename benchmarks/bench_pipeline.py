@@ -1,0 +1,105 @@
+"""Throughput of ``pipeline run`` end to end: records per second against --jobs and record length.
+
+``python benchmarks/bench_pipeline.py`` prints a dict; :func:`run` returns it.
+
+- 40 synthetic near-fault records of 20-40 s at 100 Hz (a pulse of each shape plus broadband
+  motion, written as SAC), two columns each (``--block 7.5x1.8 --block 6x1.2``), ``--no-plots``,
+  with ``--jobs 1`` and ``--jobs 2``: records/s, warm (in-process, compilation caches loaded) and
+  cold (a fresh ``pipeline`` process, as a user runs it).
+- The same with plots, ``--jobs 2``.
+- Record length: 8 records each of 10, 20, 40, 80 s, ``--jobs 1``: seconds per record.
+"""
+from __future__ import annotations
+
+import os
+import pathlib
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+COLUMNS = ["--block", "7.5x1.8", "--block", "6x1.2"]
+SHAPES = ["sine", "ricker-sym", "ricker-anti"]
+
+
+def make_records(folder, n, durations, dt=0.01, seed=0):
+    """``n`` SAC records with durations cycling through ``durations`` (s)."""
+    import pulses
+    from pulses import G
+
+    from scipy import signal
+
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    sos = signal.butter(4, (0.4, 12.0), btype="bandpass", fs=1.0 / dt, output="sos")
+    paths = []
+    for k in range(n):
+        duration = durations[k % len(durations)]
+        npts = int(round(duration / dt)) + 1
+        t = dt * np.arange(npts)
+        noise = signal.sosfiltfilt(sos, rng.standard_normal(npts))
+        noise *= 0.06 * G / np.std(noise) * np.exp(-((t - 0.3 * duration) / (0.3 * duration)) ** 2)
+        ap = rng.uniform(0.25, 0.8) * G * rng.choice([-1.0, 1.0])
+        tp = rng.uniform(0.4, 2.5)
+        t0 = rng.uniform(0.2, 0.5) * duration
+        acc = noise + pulses.make_pulse(SHAPES[k % 3], ap, tp, t0)(t)
+        path = folder / f"rec{k:03d}_{duration:g}s.sac"
+        pulses.write_sac(pulses.Record(acc, dt, name=path.stem), path)
+        paths.append(str(path))
+    return paths
+
+
+def _timed_main(argv):
+    from pipeline.cli import main
+
+    t0 = time.perf_counter()
+    code = main(argv)
+    return time.perf_counter() - t0, code
+
+
+def _timed_cold(argv):
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "pipeline", *argv], capture_output=True, text=True)
+    return time.perf_counter() - t0, proc.returncode
+
+
+def run(repeats: int = 2) -> dict:
+    results = {"machine": f"{platform.machine()} {os.cpu_count()} CPUs, Python {platform.python_version()}"}
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        recs = make_records(tmp / "recs", 40, durations=[20.0, 25.0, 30.0, 35.0, 40.0])
+        results["records"] = "40 SAC records, 20-40 s at 100 Hz, two columns each"
+        # warm-up: loads the compilation caches in this process (workers fork from it)
+        _timed_main(["run", *recs[:2], *COLUMNS, "--out", str(tmp / "warm"), "--no-plots", "-q"])
+        for jobs in (1, 2):
+            best = min(_timed_main(["run", *recs, *COLUMNS, "--out", str(tmp / f"o{jobs}"), "--no-plots",
+                                    "-q", "--jobs", str(jobs)])[0] for _ in range(repeats))
+            results[f"warm_jobs{jobs}_records_per_s"] = round(len(recs) / best, 2)
+            cold, code = _timed_cold(["run", *recs, *COLUMNS, "--out", str(tmp / f"c{jobs}"), "--no-plots",
+                                      "-q", "--jobs", str(jobs)])
+            results[f"cold_jobs{jobs}_records_per_s"] = round(len(recs) / cold, 2)
+            results[f"exit_code_jobs{jobs}"] = code
+        results["speedup_jobs2_over_jobs1_warm"] = round(
+            results["warm_jobs2_records_per_s"] / results["warm_jobs1_records_per_s"], 2)
+        secs, _ = _timed_main(["run", *recs, *COLUMNS, "--out", str(tmp / "plots"), "-q", "--jobs", "2"])
+        results["warm_jobs2_with_plots_records_per_s"] = round(len(recs) / secs, 2)
+        same = all((tmp / "o1" / f).read_bytes() == (tmp / "o2" / f).read_bytes()
+                   for f in ("summary.csv", "failures.csv"))
+        results["jobs1_jobs2_identical"] = same
+        per_length = {}
+        for duration in (10.0, 20.0, 40.0, 80.0):
+            lrecs = make_records(tmp / f"len{duration:g}", 8, durations=[duration], seed=1)
+            secs = min(_timed_main(["run", *lrecs, *COLUMNS, "--out", str(tmp / f"l{duration:g}"),
+                                    "--no-plots", "-q"])[0] for _ in range(repeats))
+            per_length[f"{duration:g}s"] = round(secs / len(lrecs), 4)
+        results["jobs1_seconds_per_record_by_length"] = per_length
+    print(results)
+    return results
+
+
+if __name__ == "__main__":
+    run()

@@ -1,0 +1,313 @@
+"""``pipeline run`` and ``pipeline demo``: reports, robustness, determinism, jobs, CLI end to end."""
+from __future__ import annotations
+
+import csv
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import pulses
+import rocking
+from pipeline import report
+from pipeline.batch import Column, record_ids
+from pipeline.cli import main
+from pulses import G
+
+from .conftest import shared_record
+
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+
+
+# -- helpers -------------------------------------------------------------------------------------
+def synthetic(seed, shape="sine", ap_g=0.5, tp=1.0, t0=2.0, dt=0.02, duration=6.0, noise_g=0.03):
+    """A small record: a pulse plus smooth noise (m/s^2)."""
+    rng = np.random.default_rng(seed)
+    n = int(round(duration / dt)) + 1
+    t = dt * np.arange(n)
+    noise = np.convolve(rng.standard_normal(n), np.hanning(9) / np.hanning(9).sum(), mode="same")
+    noise *= noise_g * G / np.std(noise) * np.sin(np.pi * t / t[-1])
+    return t, noise + pulses.make_pulse(shape, ap_g * G, tp, t0)(t)
+
+
+def write_good(folder, k, **kw) -> pathlib.Path:
+    shapes = ["sine", "ricker-sym", "ricker-anti"]
+    t, acc = synthetic(100 + k, shape=shapes[k % 3], ap_g=0.3 + 0.04 * (k % 7), tp=0.6 + 0.1 * (k % 5), **kw)
+    path = pathlib.Path(folder) / f"good{k:02d}.sac"
+    pulses.write_sac(pulses.Record(acc, t[1] - t[0], name=path.stem, metadata={"station": f"S{k}"}), path)
+    return path
+
+
+def write_bad(folder) -> list[pathlib.Path]:
+    """The five bad records: missing, empty, truncated, NaN, velocity."""
+    from obspy.io.sac import SACTrace
+
+    folder = pathlib.Path(folder)
+    missing = folder / "missing.sac"
+    empty = folder / "empty.sac"
+    empty.write_bytes(b"")
+    good = write_good(folder, 99)
+    truncated = folder / "truncated.sac"
+    truncated.write_bytes(good.read_bytes()[: 632 + 4 * 100])  # header + 100 of 301 samples
+    good.unlink()
+    t, acc = synthetic(7)
+    data = (acc * 1e9).astype(np.float32)
+    data[50:60] = np.nan
+    nan = folder / "nan.sac"
+    SACTrace(data=data, delta=0.02, idep="iacc").write(str(nan))
+    velocity = folder / "velocity.sac"
+    vel = np.cumsum(acc) * 0.02 * 1e9
+    SACTrace(data=vel.astype(np.float32), delta=0.02, idep="ivel").write(str(velocity))
+    return [missing, empty, truncated, nan, velocity]
+
+
+def read_csv(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def tree(folder):
+    folder = pathlib.Path(folder)
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def batch20(tmp_path_factory):
+    """15 good small records and 5 bad ones, interleaved."""
+    folder = tmp_path_factory.mktemp("batch20")
+    good = [write_good(folder, k) for k in range(15)]
+    bad = write_bad(folder)
+    paths = []
+    for i, g in enumerate(good):
+        paths.append(g)
+        if i % 3 == 1 and bad:
+            paths.append(bad.pop(0))
+    return [str(p) for p in paths]
+
+
+@pytest.fixture(scope="module")
+def batch_run(batch20, tmp_path_factory):
+    out = tmp_path_factory.mktemp("run1")
+    code = main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "--quiet"])
+    return code, out
+
+
+# -- robustness ------------------------------------------------------------------------------------
+def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20):
+    code, out = batch_run
+    assert code == 1
+    failures = read_csv(out / "failures.csv")
+    assert sorted(f["record"] for f in failures) == ["empty", "missing", "nan", "truncated", "velocity"]
+    reasons = {f["record"]: f["reason"].lower() for f in failures}
+    assert all(f["stage"] == "read" for f in failures)
+    assert "no such file" in reasons["missing"] or "not found" in reasons["missing"]
+    assert "nan" in reasons["nan"]
+    assert "velocity" in reasons["velocity"]
+    assert all(len(r) > 10 for r in reasons.values())
+    summary = read_csv(out / "summary.csv")
+    assert [r["record"] for r in summary] == [f"good{k:02d}" for k in range(15)]  # input order
+    for k in range(15):
+        rows = read_csv(out / f"good{k:02d}.csv")
+        assert len(rows) == 1 and rows[0]["column"] == "7.5x1.8"
+        assert rows[0]["verified_width_m"] and rows[0]["eq31_width_m"] and rows[0]["exact_tan_alpha"]
+    assert not list(out.glob("missing*.csv")) and not list(out.glob(".*"))  # no stray temp files
+    # every column of the reports is explained in columns.md, with a unit
+    md = (out / "columns.md").read_text()
+    for name in list(summary[0]) + list(report.FAILURE_FIELDS):
+        assert f"| `{name}` |" in md
+
+
+def test_rerun_into_same_folder_is_identical_and_jobs_do_not_matter(batch_run, batch20, tmp_path):
+    code, out = batch_run
+    before = tree(out)
+    assert main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"]) == 1
+    assert tree(out) == before
+    out2 = tmp_path / "jobs2"
+    assert main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out2), "--no-plots", "-q",
+                 "--jobs", "2"]) == 1
+    assert tree(out2) == before
+
+
+def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
+    rec = write_good(tmp_path, 1)
+    out = tmp_path / "out"
+    assert main(["run", str(rec), "--height", "6", "--out", str(out), "--no-plots", "-q"]) == 0
+    assert read_csv(out / "failures.csv") == []
+    row = read_csv(out / "summary.csv")[0]
+    assert row["column_kind"] == "height" and row["width_m"] == "" and float(row["verified_width_m"]) > 0
+    capsys.readouterr()
+    for bad in (["--block", "7.5x0"], ["--block", "abc"], [], ["--block", "7.5x1.8", "--jobs", "-1"],
+                ["--block", "7.5x1.8", "--units", "cm/s"], ["--block", "7.5x1.8", "--shapes", "square"]):
+        assert main(["run", str(rec), *bad, "--out", str(out), "-q"]) == 2, bad
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("pipeline run: error:") and "\n" not in err
+    assert main(["run", "--block", "7.5x1.8", "--out", str(out)]) == 2
+
+
+def test_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
+    target = tmp_path / "summary.csv"
+    report.write_atomic(target, "old\n")
+
+    def boom(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "replace", boom)
+    with pytest.raises(KeyboardInterrupt):
+        report.write_atomic(target, "new content\n")
+    assert target.read_text() == "old\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["summary.csv"]
+
+
+def test_record_ids_are_unique_and_safe():
+    ids = record_ids(["a/x.sac", "b/x.sac", "c/x.AT2", "summary.sac", "we ird#name.txt"])
+    assert ids == ["x", "x-2", "x-3", "summary-record", "we_ird_name"]
+
+
+# -- end to end on converted SAC files, numbers against the library called directly ---------------
+def test_cli_end_to_end_numbers_match_library(tmp_path):
+    src = DATA / "synth_sine_055g_0.9s.sac"
+    conv = tmp_path / "conv"
+    conv.mkdir()
+    # convert through the library (the SAC writer), as `pipeline convert` does
+    rec0 = pulses.read_record(src)
+    sac = conv / "example.sac"
+    pulses.write_sac(rec0, sac)
+    out = tmp_path / "out"
+    code = main(["run", str(sac), "--block", "7.5x1.8", "--block", "6x1", "--height", "9",
+                 "--out", str(out), "--no-plots", "-q"])
+    assert code == 0
+    rows = read_csv(out / "example.csv")
+    assert [r["column"] for r in rows] == ["7.5x1.8", "6x1", "9"]
+
+    record = pulses.read_record(sac)
+    fit = pulses.fit_pulse(record)
+    best = fit.best
+    close = lambda text, value: math.isclose(float(text), value, rel_tol=2e-5, abs_tol=1e-9)
+    r = rows[0]
+    assert r["pulse_shape"] == best.shape
+    assert close(r["pga_g"], record.pga / G) and int(r["npts"]) == record.npts
+    assert close(r["pulse_ap_g"], best.ap / G) and close(r["pulse_tp_s"], best.tp)
+    assert close(r["pulse_t0_s"], best.t0) and close(r["pulse_score"], best.score)
+    # the column as it stands
+    block = rocking.Block.from_dimensions(7.5, 1.8)
+    assert close(r["p_rad_s"], block.p) and close(r["tan_alpha"], 0.24)
+    assert close(r["eq31_tan_alpha"], rocking.eq31(best.ap, best.tp, block.p))
+    assert close(r["envelope_tan_alpha"], rocking.envelope_rule(best.ap, best.tp, block.p, shape=best.shape))
+    assert close(r["exact_tan_alpha"], rocking.min_slenderness(best.pulse, block.p).tan_alpha)
+    sim = rocking.simulate(block, record)
+    assert r["overturns"] == str(bool(sim.overturned))
+    assert close(r["max_theta_ratio"], sim.max_rotation_ratio)
+    assert r["model"] == str(sim.model)
+    # the Eq. 31 design for its height (governing pulse) and its verification
+    gov = next(c for c in fit.candidates if c.shape == r["governing_shape"])
+    w31 = rocking.required_width(7.5, gov.pulse, rule="eq31").width
+    assert close(r["eq31_width_m"], w31)
+    sim31 = rocking.simulate(rocking.Block.from_dimensions(7.5, w31), record)
+    assert r["eq31_width_overturns"] == str(bool(sim31.overturned))
+    assert close(r["eq31_width_max_theta_ratio"], sim31.max_rotation_ratio)
+    # the verified width under the full record
+    ver = rocking.required_width(7.5, record, rule="exact")
+    assert close(r["verified_width_m"], ver.width)
+    assert r["verified_adequate"] == str(1.8 >= ver.width)
+    assert close(rows[2]["verified_width_m"], rocking.required_width(9.0, record, rule="exact").width)
+    # every fitting shape has its design; the governing one is the widest Eq. 31 design
+    fitting = r["shapes_fitting"].split(";")
+    assert fitting[0] == best.shape
+    for shape in fitting:
+        k = shape.replace("-", "_")
+        assert r[f"{k}_fits"] == "True" and r[f"{k}_exact_tan_alpha"] != ""
+    widths = {c.shape: rocking.required_width(7.5, c.pulse, rule="eq31").width
+              for c in fit.candidates if c.shape in fitting}
+    assert max(widths.values()) == pytest.approx(w31)
+    # summary.csv is the per-record report's rows
+    assert read_csv(out / "summary.csv") == rows
+
+
+def test_console_script_runs_bundled_examples_with_plots(tmp_path):
+    """The installed command on two bundled records, with plots (a subprocess, like a user)."""
+    out = tmp_path / "out"
+    recs = [str(DATA / "synth_sine_055g_0.9s.sac"), str(DATA / "synth_broadband_only.sac")]
+    proc = subprocess.run([sys.executable, "-m", "pipeline", "run", *recs, "--block", "7.5x1.8",
+                           "--out", str(out)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "2 of 2 records processed" in proc.stdout
+    assert proc.stderr == ""  # no progress bar when not on a terminal
+    for name in ("synth_sine_055g_0.9s.png", "synth_broadband_only.png", "summary.png"):
+        png = (out / "plots" / name).read_bytes()
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
+
+
+# -- the paper's records -----------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def paper_run(tmp_path_factory):
+    rinaldi = shared_record("Rinaldi228.AT2")
+    pacoima = shared_record("RSN77_SFERN_PUL164.AT2")
+    out = tmp_path_factory.mktemp("paper")
+    code = main(["run", str(rinaldi), str(pacoima), "--block", "7.5x1.8", "--out", str(out),
+                 "--no-plots", "-q"])
+    return code, out
+
+
+def test_rinaldi_eq31_and_survival_of_the_temple_column(paper_run):
+    code, out = paper_run
+    assert code == 0
+    r = read_csv(out / "Rinaldi228.csv")[0]
+    # paper, Section 6: one-sine pulse 0.71 g, 0.8 s -> Eq. 31 = 0.373 for p = 1.381 rad/s
+    assert "sine" in r["shapes_fitting"].split(";") or r["pulse_shape"] == "sine"
+    assert float(r["p_rad_s"]) == pytest.approx(1.381, abs=1e-3)
+    assert 0.64 <= abs(float(r["sine_ap_g"])) <= 0.76
+    assert 0.76 <= float(r["sine_tp_s"]) <= 0.84
+    assert float(r["sine_eq31_tan_alpha"]) == pytest.approx(0.37, abs=0.03)
+    # Fig. 11: the column (tan alpha 0.24) survives the full record
+    assert r["overturns"] == "False"
+    assert float(r["max_theta_ratio"]) < 1.0
+    assert r["verified_adequate"] == "True"
+    assert float(r["governing_eq31_tan_alpha"]) >= float(r["sine_eq31_tan_alpha"])
+
+
+def test_pacoima_processed_with_its_pulse_shapes(paper_run):
+    code, out = paper_run
+    r = read_csv(out / "RSN77_SFERN_PUL164.csv")[0]
+    assert r["pulse_shape"] in pulses.SHAPES
+    for shape in r["shapes_fitting"].split(";"):
+        k = shape.replace("-", "_")
+        assert float(r[f"{k}_eq31_tan_alpha"]) > 0 and float(r[f"{k}_exact_tan_alpha"]) >= 0
+    assert float(r["verified_width_m"]) > 0 and r["overturns"] in ("True", "False")
+
+
+def test_erzincan_ns_plain_text_processed(tmp_path):
+    erz = shared_record("base_isolation_benchmark/erzikan.txt")
+    out = tmp_path / "out"
+    code = main(["run", str(erz), "--units", "cm/s2", "--dt", "0.005", "--column", "1",
+                 "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"])
+    assert code == 0, read_csv(out / "failures.csv")
+    r = read_csv(out / "erzikan.csv")[0]
+    assert float(r["pga_g"]) == pytest.approx(0.515, abs=0.01)  # MANIFEST: N-S peak
+    assert float(r["dt_s"]) == 0.005
+    assert r["pulse_shape"] in pulses.SHAPES and r["shapes_fitting"]
+    assert float(r["verified_width_m"]) > 0
+
+
+# -- dask -----------------------------------------------------------------------------------------
+def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
+    pytest.importorskip("dask.distributed")
+    code, out = batch_run
+    out2 = tmp_path / "dask"
+    assert main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out2), "--no-plots", "-q",
+                 "--dask", "local", "--jobs", "2"]) == 1
+    assert tree(out2) == tree(out)
+
+
+# -- demo -------------------------------------------------------------------------------------------
+def test_demo_from_another_directory(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "pipeline", "demo", "--no-plots", "--jobs", "2"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "demo-output"
+    rows = read_csv(out / "summary.csv")
+    assert len(rows) == 5 and {r["column"] for r in rows} == {"7.5x1.8"}
+    assert read_csv(out / "failures.csv") == []
