@@ -109,9 +109,16 @@ def pulse_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
 def _fit_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
     """Interval (s) of samples used by the least-squares refinement: the pulse plus a margin."""
     margin = max(0.5 * tp, FIT_MARGIN)
-    if shape in _WINDOW:
-        return t0 - 3.0 * tp - margin, t0 + 3.0 * tp + margin
+    if shape in _WINDOW:  # both Rickers are below 1e-8 of their peak beyond 2 Tp from the centre
+        return t0 - 2.0 * tp - margin, t0 + 2.0 * tp + margin
     return t0 - margin, t0 + tp + margin
+
+
+def _covers(idx: slice, shape: str, tp: float, t0: float, dt: float, n: int) -> bool:
+    """True if the samples ``idx`` hold the pulse with at least half the fit margin around it."""
+    lo, hi = _fit_window(shape, tp, t0)
+    half = 0.5 * max(0.5 * tp, FIT_MARGIN)
+    return (idx.start == 0 or idx.start * dt <= lo + half) and (idx.stop >= n or (idx.stop - 1) * dt >= hi - half)
 
 
 # -- results -----------------------------------------------------------------------------------
@@ -231,8 +238,12 @@ class PulseFit:
 
 # -- the fitter ------------------------------------------------------------------------------------
 def default_tp_range(record: Record) -> tuple[float, float]:
-    """Periods searched by default, s: from ``max(0.1 s, 10 dt)`` to ``min(10 s, duration / 2)``."""
-    tp_min = max(0.1, 10.0 * record.dt)
+    """Periods searched by default, s: from ``max(0.2 s, 10 dt)`` to ``min(10 s, duration / 2)``.
+
+    0.2 s is below any pulse period that matters for rocking columns (Eq. 6 gives 0.67 s for
+    Mw 5); the least-squares refinement may still end slightly outside the searched range.
+    """
+    tp_min = max(0.2, 10.0 * record.dt)
     tp_max = min(10.0, 0.5 * record.duration)
     if tp_max <= tp_min:
         raise ValueError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
@@ -335,6 +346,10 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
         tc = float(tw.mean())
         ones, ramp = np.ones_like(tw), tw - tc
 
+        jac = np.empty((tw.size, 5 if baseline else 3))
+        if baseline:
+            jac[:, 3], jac[:, 4] = -ones, -ramp
+
         def residual(p):
             m = unit_samples(shape, max(p[1], 1e-9), p[2], tw, dt)
             r = xw - p[0] * m
@@ -344,13 +359,15 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
 
         def jacobian(p):
             m, d_tp, d_t0 = unit_samples_and_derivatives(shape, max(p[1], 1e-9), p[2], tw, dt)
-            cols = [m, p[0] * d_tp, p[0] * d_t0] + ([ones, ramp] if baseline else [])
-            return -np.column_stack(cols)
+            jac[:, 0] = -m
+            jac[:, 1] = -p[0] * d_tp
+            jac[:, 2] = -p[0] * d_t0
+            return jac.copy()
 
         p0 = [ap, tp, t0] + ([0.0, 0.0] if baseline else [])
         try:
-            sol = least_squares(residual, p0, jac=jacobian, method="lm", xtol=1e-12, ftol=1e-12,
-                                gtol=1e-12, max_nfev=200)
+            sol = least_squares(residual, p0, jac=jacobian, method="lm", xtol=1e-9, ftol=1e-12,
+                                gtol=1e-12, max_nfev=100)
         except (ValueError, np.linalg.LinAlgError):
             break
         ap_new, tp_new, t0_new = (float(v) for v in sol.x[:3])
@@ -360,7 +377,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
         if sse < best_sse:
             best, best_sse = (ap_new, tp_new, t0_new), sse
         ap, tp, t0 = ap_new, tp_new, t0_new
-        if window(tp, t0) == idx:
+        if _covers(idx, shape, tp, t0, dt, x.size):
             break
     return best
 
@@ -382,53 +399,48 @@ def _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline):
         extra = [np.ones_like(tw), tw - tc] if baseline else []
 
         n = tw.size
-        ramp = tw - tc
-        prefix = {key: np.concatenate([[0.0], np.cumsum(v)]) for key, v in
-                  (("x", xw), ("one", np.ones(n)), ("ramp", ramp))}
-        vec = {"x": xw, "one": np.ones(n), "ramp": ramp}
-        sxx = float(xw @ xw)
-        base = np.array([[n, ramp.sum()], [ramp.sum(), ramp @ ramp]])
-        base_rhs = np.array([xw.sum(), ramp @ xw])
+        ramp = tw - tc if baseline else np.zeros(n)
+        # with the baseline (columns 1 and t - tc, orthogonal since tc is the mean time) projected
+        # out, the amplitude and the remaining sum of squares follow from a few dot products
+        n_ramp = float(ramp @ ramp) or 1.0
+        x_perp = xw - (xw.mean() + ramp * (ramp @ xw) / n_ramp if baseline else 0.0)
+        sxx = float(x_perp @ x_perp)
+        prefix_x = np.concatenate([[0.0], np.cumsum(x_perp)])
+        prefix_r = np.concatenate([[0.0], np.cumsum(ramp)])
 
         def sse(edges):
             # the cell-averaged rectangle is 1 on whole cells and a fraction on the two edge
-            # cells, so its products with x, 1 and (t - tc) come from prefix sums in O(1)
+            # cells, so its dot products with x, 1 and (t - tc) come from prefix sums in O(1)
             start, end = edges
             if end - start <= dt:
                 return sxx * (1.0 + (dt - (end - start)))
             k1 = int(math.floor((start - tw[0]) / dt + 0.5))
             k2 = int(math.floor((end - tw[0]) / dt + 0.5))
-            parts = []  # (index, weight) of the partly covered cells
             if k1 == k2:
-                parts.append((k1, (end - start) / dt))
+                parts = ((k1, (end - start) / dt),)
             else:
-                parts.append((k1, (tw[0] + (k1 + 0.5) * dt - start) / dt))
-                parts.append((k2, (end - (tw[0] + (k2 - 0.5) * dt)) / dt))
+                parts = ((k1, (tw[0] + (k1 + 0.5) * dt - start) / dt),
+                         (k2, (end - (tw[0] + (k2 - 0.5) * dt)) / dt))
             lo, hi = min(max(k1 + 1, 0), n), min(max(k2, 0), n)
-            dots = {key: prefix[key][hi] - prefix[key][lo] for key in prefix}
-            mm = float(hi - lo)
+            mx = prefix_x[hi] - prefix_x[lo]
+            m1 = float(hi - lo)
+            mr = prefix_r[hi] - prefix_r[lo]
+            mm = m1
             for k, w in parts:
                 if 0 <= k < n:
-                    for key in dots:
-                        dots[key] += w * vec[key][k]
+                    mx += w * x_perp[k]
+                    m1 += w
+                    mr += w * ramp[k]
                     mm += w * w
-            if mm <= 0.0:
+            if baseline:  # squared norm of the pulse column after projecting out the baseline
+                mm -= m1 * m1 / n + mr * mr / n_ramp
+            if mm <= 1e-12:
                 return sxx
-            if baseline:
-                M = np.array([[mm, dots["one"], dots["ramp"]],
-                              [dots["one"], base[0, 0], base[0, 1]],
-                              [dots["ramp"], base[1, 0], base[1, 1]]])
-                rhs = np.array([dots["x"], base_rhs[0], base_rhs[1]])
-                try:
-                    coef = np.linalg.solve(M, rhs)
-                except np.linalg.LinAlgError:
-                    return sxx
-                return sxx - float(coef @ rhs)
-            return sxx - dots["x"] ** 2 / mm
+            return sxx - mx * mx / mm
 
         simplex = np.array([[t0, t0 + tp], [t0 + 0.6 * dt, t0 + tp], [t0, t0 + tp + 0.6 * dt]])
         sol = minimize(sse, [t0, t0 + tp], method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "xatol": 1e-7 * tp, "fatol": 1e-14 * float(xw @ xw),
+                       options={"initial_simplex": simplex, "xatol": 1e-6 * tp, "fatol": 1e-13 * sxx,
                                 "maxiter": 2000})
         start, end = (float(v) for v in sol.x)
         tp_new, t0_new = end - start, start
@@ -439,6 +451,6 @@ def _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline):
         if s_full < best_sse:
             best, best_sse = (ap_new, tp_new, t0_new), s_full
         ap, tp, t0 = ap_new, tp_new, t0_new
-        if window(tp, t0) == idx:
+        if _covers(idx, "rect", tp, t0, dt, x.size):
             break
     return best

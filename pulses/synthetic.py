@@ -86,3 +86,55 @@ def synthetic_record(shape: str, ap: float, tp: float, t0: float, duration: floa
     truth = {"shape": shape, "ap": ap, "tp": tp, "t0": t0}
     return Record(acc, dt, name=f"synthetic-{shape}", metadata={"truth": truth, "units": "m/s2",
                                                                   "warnings": []})
+
+
+def noise_autocovariance(n: int, dt: float, rms: float, band=NOISE_BAND) -> np.ndarray:
+    """Autocovariance (lags 0..n-1, (m/s^2)^2) of :func:`band_noise` with the given RMS.
+
+    The zero-phase filter applies the Butterworth response twice, so the noise power spectrum is
+    ``|H(f)|^4`` times that of the white input.
+    """
+    nyq = 0.5 / dt
+    lo, hi = band[0] / nyq, min(band[1] / nyq, 0.99)
+    sos = signal.butter(4, [lo, hi], btype="bandpass", output="sos")
+    nfft = 1 << int(np.ceil(np.log2(4 * n)))
+    _, h = signal.sosfreqz(sos, worN=nfft // 2 + 1, whole=False)
+    acov = np.fft.irfft(np.abs(h) ** 4, nfft)[:n]
+    return acov * (rms**2 / acov[0])
+
+
+def least_squares_limit(shape: str, ap: float, tp: float, t0: float, duration: float, dt: float,
+                        noise: float, band=NOISE_BAND, baseline: bool = True) -> dict:
+    """Standard deviations of ``ap``, ``Tp`` and ``t0`` that an exact least-squares fit of the
+    true shape has under band-limited background motion (the noise limit of the method).
+
+    Linearised about the true pulse, the least-squares estimate has covariance
+    ``(J'J)^-1 J' S J (J'J)^-1`` with ``J`` the derivatives of the sampled pulse (and of the
+    straight-line baseline fitted with it) over the fit window and ``S`` the covariance of the
+    background motion: the scatter of any least-squares pulse fit, however good its search.
+
+    Returns
+    -------
+    dict
+        ``ap``, ``tp`` (relative standard deviations) and ``t0`` (standard deviation in Tp).
+    """
+    from .fit import _fit_window, unit_samples_and_derivatives
+
+    n = int(round(duration / dt)) + 1
+    t = np.arange(n) * dt
+    lo, hi = _fit_window(shape, tp, t0)
+    idx = slice(max(0, int(np.floor(lo / dt))), min(n, int(np.ceil(hi / dt)) + 1))
+    tw = t[idx]
+    m, d_tp, d_t0 = unit_samples_and_derivatives(shape, tp, t0, tw, dt)
+    cols = [m, ap * d_tp, ap * d_t0]
+    if baseline:
+        cols += [np.ones_like(tw), tw - tw.mean()]
+    J = np.column_stack(cols)
+    acov = noise_autocovariance(tw.size, dt, noise * abs(ap), band)
+    # S J by convolution with the symmetric autocovariance (Toeplitz product through the FFT)
+    kernel = np.concatenate([acov[::-1], acov[1:]])
+    SJ = np.column_stack([signal.fftconvolve(J[:, k], kernel, mode="same") for k in range(J.shape[1])])
+    JtJ_inv = np.linalg.inv(J.T @ J)
+    cov = JtJ_inv @ (J.T @ SJ) @ JtJ_inv
+    sd = np.sqrt(np.diag(cov))
+    return {"ap": sd[0] / abs(ap), "tp": sd[1] / tp, "t0": sd[2] / tp}
