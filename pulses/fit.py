@@ -142,6 +142,11 @@ class Candidate:
         Correlation of record and pulse within the pulse window (-1 to 1).
     pulse : pulses.Pulse
         The pulse object (``make_pulse(shape, ap, tp, t0)``).
+    rank : int
+        1 for the best candidate of the record, 2 for the runner-up, ...
+    fit_window : (float, float) or None
+        First and last sample times (s) used by the least-squares refinement (``None`` if the
+        refinement did not improve on the coarse match).
     """
 
     shape: str
@@ -152,6 +157,7 @@ class Candidate:
     correlation: float
     pulse: Pulse = field(repr=False)
     rank: int = 0
+    fit_window: tuple | None = field(default=None, repr=False)
 
     @property
     def ap_g(self) -> float:
@@ -288,7 +294,7 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     candidates = []
     for shape in shapes:
         ap, tp, t0 = _coarse(matcher, shape, tps, t[-1])
-        ap, tp, t0 = _refine(x, t, dt, shape, ap, tp, t0, baseline, energy)
+        ap, tp, t0, idx = _refine(x, t, dt, shape, ap, tp, t0, baseline)
         p = ap * unit_samples(shape, tp, t0, t, dt)
         resid = x - p
         score = 1.0 - float(resid @ resid) / energy if energy > 0 else 0.0
@@ -298,7 +304,9 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         denom = math.sqrt(float(xw @ xw) * float(pw @ pw))
         corr = float(xw @ pw) / denom if denom > 0 else 0.0
         t0_abs = t0 + record.t_start
-        candidates.append(Candidate(shape, ap, tp, t0_abs, score, corr, make_pulse(shape, ap, tp, t0_abs)))
+        window = None if idx is None else (record.t_start + idx.start * dt, record.t_start + (idx.stop - 1) * dt)
+        candidates.append(Candidate(shape, ap, tp, t0_abs, score, corr, make_pulse(shape, ap, tp, t0_abs),
+                                    fit_window=window))
     order = sorted(range(len(candidates)), key=lambda i: -candidates[i].score)
     ranked = [candidates[i] for i in order]
     for k, c in enumerate(ranked, start=1):
@@ -316,8 +324,8 @@ def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
     return ap, tp, t0
 
 
-def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
-    """Least-squares ``(ap, Tp, t0)`` near a starting guess; the guess if refinement fails.
+def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
+    """Least-squares ``(ap, Tp, t0, window)`` near a starting guess; the guess if refinement fails.
 
     Levenberg-Marquardt on the samples inside the fit window, with the analytic Jacobian; the
     straight-line baseline ``c0 + c1 (t - tc)`` is fitted alongside when ``baseline`` is True.
@@ -329,14 +337,9 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
         i1 = min(x.size, int(math.ceil(hi / dt)) + 1)
         return slice(i0, i1)
 
-    def sse_full(ap, tp, t0):
-        r = x - ap * unit_samples(shape, tp, t0, t, dt)
-        return float(r @ r)
-
-    best = (ap0, tp0, t00)
-    best_sse = sse_full(*best)
+    best = (ap0, tp0, t00, None)
     if shape == "rect":
-        return _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline)
+        return _refine_rect(x, t, dt, best, window, baseline)
     ap, tp, t0 = ap0, tp0, t00
     for _ in range(3):  # refit when the pulse moved outside the window of the previous pass
         idx = window(tp, t0)
@@ -373,23 +376,26 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline, energy):
         ap_new, tp_new, t0_new = (float(v) for v in sol.x[:3])
         if not all(map(math.isfinite, (ap_new, tp_new, t0_new))) or tp_new <= 2 * dt:
             break
-        sse = sse_full(ap_new, tp_new, t0_new)
-        if sse < best_sse:
-            best, best_sse = (ap_new, tp_new, t0_new), sse
+        # accept when it beats the starting (Tp, t0) on this window's own objective
+        start = np.column_stack([unit_samples(shape, tp, t0, tw, dt)] + ([ones, ramp] if baseline else []))
+        coef, *_ = np.linalg.lstsq(start, xw, rcond=None)
+        if 2.0 * sol.cost > float(np.sum((xw - start @ coef) ** 2)) * (1 + 1e-12):
+            break
+        best = (ap_new, tp_new, t0_new, idx)
         ap, tp, t0 = ap_new, tp_new, t0_new
         if _covers(idx, shape, tp, t0, dt, x.size):
             break
     return best
 
 
-def _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline):
+def _refine_rect(x, t, dt, best, window, baseline):
     """Least squares for the rectangular pulse: Nelder-Mead on its two edges.
 
     The cell-averaged rectangle is piecewise linear in its edges, with a kink each time an edge
     crosses a cell boundary; a gradient method stalls at the kinks, a simplex does not.  The
     amplitude (and the baseline) are solved linearly for each pair of edges.
     """
-    ap, tp, t0 = best
+    ap, tp, t0, _ = best
     for _ in range(3):
         idx = window(tp, t0)
         if idx.stop - idx.start < 6:
@@ -438,18 +444,20 @@ def _refine_rect(x, t, dt, best, best_sse, window, sse_full, baseline):
                 return sxx
             return sxx - mx * mx / mm
 
-        simplex = np.array([[t0, t0 + tp], [t0 + 0.6 * dt, t0 + tp], [t0, t0 + tp + 0.6 * dt]])
-        sol = minimize(sse, [t0, t0 + tp], method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "xatol": 1e-6 * tp, "fatol": 1e-13 * sxx,
-                                "maxiter": 2000})
-        start, end = (float(v) for v in sol.x)
+        start, end = t0, t0 + tp
+        for step in (max(0.6 * dt, 0.05 * tp), 0.6 * dt):  # a wide simplex, then a restart
+            simplex = np.array([[start, end], [start + step, end], [start, end + step]])
+            sol = minimize(sse, [start, end], method="Nelder-Mead",
+                           options={"initial_simplex": simplex, "xatol": 1e-6 * tp, "fatol": 1e-13 * sxx,
+                                    "maxiter": 2000})
+            start, end = (float(v) for v in sol.x)
         tp_new, t0_new = end - start, start
+        if not (math.isfinite(tp_new) and tp_new > dt) or sse([start, end]) > sse([t0, t0 + tp]):
+            break
         A = np.column_stack([unit_samples("rect", tp_new, t0_new, tw, dt)] + extra)
         coef, *_ = np.linalg.lstsq(A, xw, rcond=None)
         ap_new = float(coef[0])
-        s_full = sse_full(ap_new, tp_new, t0_new)
-        if s_full < best_sse:
-            best, best_sse = (ap_new, tp_new, t0_new), s_full
+        best = (ap_new, tp_new, t0_new, idx)
         ap, tp, t0 = ap_new, tp_new, t0_new
         if _covers(idx, "rect", tp, t0, dt, x.size):
             break

@@ -1,0 +1,284 @@
+"""The pulse fitter: scale-to-Tp conversion, the FFT wavelet transform, and accuracy.
+
+Accuracy is measured on synthetic records (:mod:`pulses.synthetic`) against the noise limit of
+any least-squares pulse fit (:func:`pulses.synthetic.least_squares_limit`): with band-limited
+background motion (0.5-10 Hz) a short pulse sits inside the noise band, and no fit recovers it
+better than that limit.  The issue's percentage floors are asserted where the limit allows them;
+everywhere the scatter must stay at the limit and every miss must be a pulse that explains the
+record at least as well as the true one (the search did not fail; the data are ambiguous).
+
+Monte-Carlo counts are small (fixed seeds, a few seconds in all); README "Pulse fitting" has
+the full tables, from ``python benchmarks/fit_accuracy.py``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pulses
+from pulses import G, PulseFit, Record, fit_pulse, make_pulse
+from pulses.cwt import (
+    GAUS3_TP_PER_SCALE,
+    MEXH_TP_PER_SCALE,
+    Matcher,
+    scale_from_tp,
+    tp_from_scale,
+    unit_energy,
+    unit_spectrum,
+)
+from pulses.synthetic import least_squares_limit, sampled_pulse, synthetic_record
+
+from .conftest import shared_record
+
+SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
+TPS = (0.2, 0.5, 1.0, 2.0, 5.0)
+DT = 0.005
+
+
+# -- scale to Tp (SPEC section 3) -----------------------------------------------------------------
+def _fourier_peak_period(shape, tp=1.0):
+    """Period (s) at which the Fourier amplitude of the densely sampled pulse peaks."""
+    dt = tp / 2000.0
+    t = np.arange(-40 * tp, 40 * tp, dt)  # 80 Tp long: frequency step 1/(80 Tp)
+    amp = np.abs(np.fft.rfft(make_pulse(shape, 1.0, tp, 0.0)(t)))
+    f = np.fft.rfftfreq(t.size, dt)
+    k = int(np.argmax(amp))
+    # parabolic interpolation of the peak between bins
+    a, b, c = amp[k - 1], amp[k], amp[k + 1]
+    f_peak = f[k] + 0.5 * (a - c) / (a - 2 * b + c) * (f[1] - f[0])
+    return 1.0 / f_peak
+
+
+@pytest.mark.parametrize("shape", ["ricker-sym", "ricker-anti"])
+def test_ricker_fourier_amplitude_peaks_at_tp(shape):
+    # SPEC section 3 defines Tp of the Rickers as the period of the Fourier-amplitude peak;
+    # the FFT of the pulse (80 Tp window, parabolic peak) finds it to better than 1e-4
+    assert _fourier_peak_period(shape, 1.3) == pytest.approx(1.3, rel=1e-4)
+
+
+@pytest.mark.parametrize("shape,name,per_scale", [("ricker-sym", "mexh", MEXH_TP_PER_SCALE),
+                                                    ("ricker-anti", "gaus3", GAUS3_TP_PER_SCALE)])
+def test_pywt_wavelet_at_scale_is_the_pulse_of_period_tp(shape, name, per_scale):
+    import pywt
+
+    psi, x = pywt.ContinuousWavelet(name).wavefun(level=14)
+    scale = 0.37  # any scale: psi(t / scale) must be the pulse with Tp = per_scale * scale
+    tp = tp_from_scale(shape, scale)
+    assert tp == pytest.approx(per_scale * scale, rel=1e-15)
+    assert scale_from_tp(shape, tp) == pytest.approx(scale, rel=1e-15)
+    pulse = make_pulse(shape, 1.0, tp, 0.0)(x * scale)
+    k = np.argmax(np.abs(pulse))
+    ratio = psi[k] / pulse[k]  # pywt normalises to unit energy and may flip the sign
+    np.testing.assert_allclose(psi, ratio * pulse, atol=1e-9 * np.abs(psi).max())
+    # pywt's rounded centre frequencies (0.25, 0.4) would give Tp 10 % and 2.5 % too low
+    tp_pywt = scale / pywt.central_frequency(name)
+    expected_low = {"mexh": 0.10, "gaus3": 0.025}[name]
+    assert 1.0 - tp_pywt / tp == pytest.approx(expected_low, abs=0.003)
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_closed_form_spectra_match_the_fft_of_the_pulse(shape):
+    # the transform uses closed-form Fourier transforms; compare with a fine FFT of the shape
+    dt, tp = 1e-3, 1.0
+    t = np.arange(-20.0, 20.0, dt)
+    w = sampled_pulse(shape, 1.0, tp, 0.0, t, dt)
+    f = np.fft.rfftfreq(t.size, dt)[:200]
+    numeric = np.fft.rfft(w)[:200] * dt * np.exp(-2j * np.pi * f * t[0])
+    closed = tp * unit_spectrum(shape, f * tp)
+    # differences are aliasing of the spectral tails of the sampled pulse: 1/f for the rectangle
+    # (1e-3), 1/f^2 for the one-sine with its kinks (1e-6), nothing visible for the Rickers
+    atol = {"rect": 2e-3, "sine": 1e-5}.get(shape, 1e-9)
+    np.testing.assert_allclose(numeric, closed, atol=atol)
+    e = np.sum(w * w) * dt
+    assert e == pytest.approx(unit_energy(shape) * tp, rel=2e-3 if shape == "rect" else 1e-6)
+
+
+def test_transform_matches_pywavelets_cwt():
+    import pywt
+
+    rec = synthetic_record("ricker-sym", 3.0, 0.8, 6.0, 16.0, 0.01, noise=0.3, seed=4)
+    tp = 0.8
+    m = Matcher(rec.acc, rec.dt, tp_min=6 * rec.dt, tp_max=2.0)  # full band: output at every sample
+    tau, c = m.transform("ricker-sym", [tp])
+    ours = np.interp(rec.time, tau[tau >= 0], c[0][tau >= 0])
+    ref, _ = pywt.cwt(rec.acc, [scale_from_tp("ricker-sym", tp, rec.dt)], "mexh", method="fft")
+    # pywt samples its integrated wavelet on a grid, so agreement is to a correlation of 0.999
+    rho = np.corrcoef(ours[100:-100], ref[0][100:-100])[0, 1]
+    assert abs(rho) > 0.999
+
+
+# -- accuracy without noise ------------------------------------------------------------------------
+@pytest.mark.parametrize("shape", SHAPES)
+def test_noise_free_recovery(shape):
+    rng = np.random.default_rng(11)
+    for tp in TPS:
+        duration = max(20.0, 8 * tp)
+        t0 = rng.uniform(2.0 * tp, duration - 3.0 * tp)  # any arrival, not on the sample grid
+        ap = rng.choice([-1.0, 1.0]) * rng.uniform(1.0, 8.0)
+        fit = fit_pulse(synthetic_record(shape, ap, tp, t0, duration, DT))
+        c = fit[shape]
+        # the search and the scale-to-Tp conversion are exact: 1e-4 is the issue's bar
+        assert fit.best.shape == shape
+        assert c.ap == pytest.approx(ap, rel=1e-4)
+        assert c.tp == pytest.approx(tp, rel=1e-4)
+        assert c.t0 == pytest.approx(t0, abs=1e-4 * tp)
+        assert c.score == pytest.approx(1.0, abs=1e-6) and c.correlation == pytest.approx(1.0, abs=1e-6)
+        assert c.polarity == (1 if ap > 0 else -1)
+
+
+def test_second_weaker_pulse_and_baseline_drift():
+    # a sine of 5 m/s^2, 1 s at 4.3 s; a symmetric Ricker of 40 % its amplitude at 13 s;
+    # a baseline drift of 30 % of ap across the record.  The line fitted with the pulse absorbs
+    # the drift and the second pulse lies outside the fit window: recovery to 1e-4 again
+    rec = synthetic_record("sine", 5.0, 1.0, 4.3, 20.0, DT, second=("ricker-sym", 2.0, 0.6, 13.0),
+                           drift=0.3)
+    c = fit_pulse(rec).best
+    assert c.shape == "sine"
+    assert (c.ap, c.tp, c.t0) == pytest.approx((5.0, 1.0, 4.3), rel=1e-4)
+    # the same with background motion at 15 %: still the stronger pulse, within the noise limit
+    rec = synthetic_record("ricker-anti", -4.0, 1.5, 6.0, 25.0, DT, noise=0.15, seed=3,
+                           second=("sine", 1.6, 0.8, 16.0), drift=0.3)
+    c = fit_pulse(rec).best
+    lim = least_squares_limit("ricker-anti", -4.0, 1.5, 6.0, 25.0, DT, 0.15)
+    assert c.shape == "ricker-anti"
+    assert abs(c.ap / -4.0 - 1) < 4 * lim["ap"] and abs(c.tp / 1.5 - 1) < 4 * lim["tp"]
+
+
+# -- accuracy with background motion ----------------------------------------------------------------
+def _cases(noise, tps, per_cell, seed):
+    """Fit ``per_cell`` random records for every shape and Tp; yield one dict per case."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for tp in tps:
+        duration = max(20.0, 8 * tp)
+        for shape in SHAPES:
+            for _ in range(per_cell):
+                t0 = rng.uniform(2.0 * tp, duration - 3.0 * tp)
+                ap = rng.choice([-1.0, 1.0]) * rng.uniform(2.0, 8.0)
+                rec = synthetic_record(shape, ap, tp, t0, duration, DT, noise=noise, seed=rng)
+                fit = fit_pulse(rec)
+                c = fit[shape]
+                t = np.arange(rec.npts) * DT
+                truth = sampled_pulse(shape, ap, tp, t0, t, DT)
+                r = rec.acc - truth
+                true_score = 1.0 - (r @ r) / (rec.acc @ rec.acc)
+                # the fitter's own objective on the fitted candidate's window: pulse plus best line
+                window = slice(*(int(round(v / DT)) for v in c.fit_window))
+                fitted = sampled_pulse(shape, c.ap, c.tp, c.t0, t, DT)
+                objective = (_window_sse(rec.acc, fitted, t, window), _window_sse(rec.acc, truth, t, window))
+                lim = least_squares_limit(shape, ap, tp, t0, duration, DT, noise)
+                out.append(dict(shape=shape, tp=tp, fit=fit, cand=c, true_score=true_score, lim=lim,
+                                objective=objective,
+                                e_ap=c.ap / ap - 1, e_tp=c.tp / tp - 1, e_t0=(c.t0 - t0) / tp))
+    return out
+
+
+def _window_sse(x, p, t, window):
+    """Sum of squares left in ``window`` after the pulse ``p`` and the best straight line."""
+    lo, hi = max(window.start, 0), min(window.stop + 1, x.size)
+    r = (x - p)[lo:hi]
+    A = np.column_stack([np.ones(hi - lo), t[lo:hi]])
+    coef, *_ = np.linalg.lstsq(A, r, rcond=None)
+    r = r - A @ coef
+    return float(r @ r)
+
+
+def _share(cases, pred):
+    return float(np.mean([bool(pred(c)) for c in cases]))
+
+
+def _check_at_noise_limit(cases):
+    for c in cases:
+        # no search failure: on the fitter's own objective (pulse plus a straight line in the fit
+        # window) the fitted pulse does at least as well as the true one, which least squares can
+        # only beat; and the best candidate explains at least as much of the record's energy as
+        # the true pulse, up to 0.1 % that the fitted line may hold instead of the pulse
+        fitted, true = c["objective"]
+        assert fitted <= true * (1 + 1e-9), c
+        assert c["fit"].best.score >= c["true_score"] - 1e-3, c
+    for key, lim_key in (("e_ap", "ap"), ("e_tp", "tp"), ("e_t0", "t0")):
+        z = np.array([c[key] / c["lim"][lim_key] for c in cases if c["shape"] != "rect"])
+        # scatter at the least-squares noise limit: RMS of error / limit is 1 for an exact
+        # least-squares fit; with ~50-80 cases its sampling error is ~10 %, so 1.35 is a 3.5-sigma bar
+        assert math.sqrt(np.mean(z**2)) < 1.35, (key, math.sqrt(np.mean(z**2)))
+
+
+def test_noise_5_percent():
+    # 3 records per shape and Tp (60 fits); the floors of the issue (ap and Tp within 3 % in 90 %
+    # of cases) hold where the noise limit allows them: for Tp >= 2 s the limit is <= 1.3 %
+    cases = _cases(0.05, TPS, 3, seed=5)
+    long = [c for c in cases if c["tp"] >= 2.0]
+    assert _share(long, lambda c: abs(c["e_ap"]) < 0.03 and abs(c["e_tp"]) < 0.03) >= 0.9
+    assert _share(cases, lambda c: c["fit"].best.shape == c["shape"]) >= 0.95
+    assert _share(cases, lambda c: abs(c["e_t0"]) < 0.05) >= 0.95
+    _check_at_noise_limit(cases)
+
+
+def test_noise_15_percent():
+    cases = _cases(0.15, TPS, 3, seed=15)
+    long = [c for c in cases if c["tp"] >= 2.0]
+    # Tp >= 2 s: limit <= 4 %, so within 5 % in 75 % and within 15 % in 90 % of cases
+    assert _share(long, lambda c: abs(c["e_ap"]) < 0.05 and abs(c["e_tp"]) < 0.05) >= 0.75
+    assert _share(long, lambda c: abs(c["e_ap"]) < 0.15 and abs(c["e_tp"]) < 0.15) >= 0.9
+    assert _share([c for c in cases if c["tp"] >= 1.0], lambda c: c["fit"].best.shape == c["shape"]) >= 0.9
+    assert _share(cases, lambda c: abs(c["e_t0"]) < 0.05) >= 0.95
+    _check_at_noise_limit(cases)
+
+
+def test_noise_30_percent_shape():
+    cases = _cases(0.30, (0.5, 1.0, 2.0, 5.0), 3, seed=30)
+    # right shape in 90 % for Tp >= 1 s; at 0.5 s the shapes are ambiguous in this noise (README)
+    assert _share([c for c in cases if c["tp"] >= 1.0], lambda c: c["fit"].best.shape == c["shape"]) >= 0.9
+    for c in cases:  # every miss is a pulse that explains the record at least as well as the truth
+        assert c["fit"].best.score >= c["true_score"] - 1e-3
+        assert c["objective"][0] <= c["objective"][1] * (1 + 1e-9)
+
+
+# -- the record's own numbers, and the real records ------------------------------------------------
+def test_pga_pgv_duration_of_a_one_sine_with_offset():
+    ap, tp = 4.0, 1.2
+    rec = synthetic_record("sine", ap, tp, 5.0, 20.0, 0.002)
+    offset = Record(rec.acc + 0.05, rec.dt)  # a constant baseline error of 0.05 m/s^2
+    fit = fit_pulse(offset)
+    # one-sine velocity: ap Tp / (2 pi) (1 - cos), peak ap Tp / pi; the zero-final-velocity
+    # correction removes the offset exactly; the trapezoidal rule errs by O((dt/Tp)^2) = 3e-6
+    assert fit.pgv == pytest.approx(ap * tp / math.pi, rel=1e-4)
+    assert fit.pga == pytest.approx(ap + 0.05, rel=1e-9)
+    assert fit.duration == pytest.approx(20.0)
+
+
+def test_rinaldi_one_sine_matches_the_paper():
+    rec = pulses.read_record(shared_record("Rinaldi228.AT2"))
+    fit = fit_pulse(rec)
+    sine = fit["sine"]
+    # paper: one-sine 0.71 g, 0.8 s; the issue allows 7 % on ap and 5 % on Tp
+    assert abs(sine.ap_g) == pytest.approx(0.71, rel=0.07)
+    assert sine.tp == pytest.approx(0.8, rel=0.05)
+    # the symmetric Ricker fits too (about 0.9 g, 1.0 s): every candidate is reported
+    sym = fit["ricker-sym"]
+    assert abs(sym.ap_g) == pytest.approx(0.9, rel=0.07) and sym.tp == pytest.approx(1.0, rel=0.05)
+    assert len(fit.candidates) == 4 and [c.rank for c in fit.candidates] == [1, 2, 3, 4]
+    assert fit.candidates == sorted(fit.candidates, key=lambda c: -c.score)
+    old = fit_pulse(pulses.read_record(shared_record("NGA_no_1063_RRS228.AT2")))["sine"]
+    assert abs(old.ap_g) == pytest.approx(0.71, rel=0.07) and old.tp == pytest.approx(0.8, rel=0.05)
+
+
+def test_result_objects():
+    rec = synthetic_record("ricker-sym", -3.0, 0.9, 8.0, 20.0, DT)
+    fit = fit_pulse(rec, shapes=["ricker-sym", "sine"])
+    assert isinstance(fit, PulseFit) and len(fit.candidates) == 2
+    best = fit.best
+    assert best.shape == "ricker-sym" and best.polarity == -1 and best.ap_g == pytest.approx(-3.0 / G)
+    assert best.lp == pytest.approx(3.0 * 0.9**2)
+    assert best.arrival == pytest.approx(8.0 - 0.45)
+    assert isinstance(best.pulse, pulses.SymmetricRicker)
+    assert best.pulse(np.array([8.0]))[0] == pytest.approx(-3.0)
+    frame = fit.to_frame()
+    assert list(frame["shape"]) == ["ricker-sym", "sine"] and frame["best"].tolist() == [True, False]
+    for col in ("ap_m_s2", "ap_g", "tp_s", "t0_s", "polarity", "lp_m", "score", "correlation",
+                "pga_g", "pgv_m_s", "duration_s"):
+        assert col in frame.columns
+    with pytest.raises(ValueError, match="unknown pulse shape"):
+        fit_pulse(rec, shapes=["triangle"])
