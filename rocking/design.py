@@ -99,7 +99,28 @@ def _batch(blocks, excitation, scales=None, *, grid=False, model="fast"):
     """Call :func:`rocking.simulate_many` (looked up at call time: the solver is a sibling module)."""
     import rocking
 
-    return rocking.simulate_many(blocks, excitation, scales, grid=grid, model=model)
+    if model in ("fast", "linear"):
+        return rocking.simulate_many(blocks, excitation, scales, grid=grid, model=model)
+    # any other model (the slow "reference" yardstick): one simulate() per run
+    blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
+    scales = np.atleast_1d(np.asarray(1.0 if scales is None else scales, dtype=float))
+    if grid:
+        shape = (len(blocks), scales.size)
+        pairs = [(b, s) for b in blocks for s in scales]
+    else:
+        idx_b, idx_s = np.broadcast_arrays(np.arange(len(blocks)), np.arange(scales.size))
+        shape = idx_b.shape
+        pairs = [(blocks[i], scales[j]) for i, j in zip(idx_b.ravel(), idx_s.ravel())]
+    runs = [rocking.simulate(b, excitation.scaled(float(s)), model=model, history=False)
+            for b, s in pairs]
+
+    class _Result:
+        pass
+
+    res = _Result()
+    for name in ("overturned", "exceeded_alpha", "max_rotation", "max_rotation_ratio"):
+        res.__dict__[name] = np.array([getattr(r, name) for r in runs]).reshape(shape)
+    return res
 
 
 def _failed(result, criterion):
@@ -124,48 +145,135 @@ def _peak(excitation) -> float:
 class _Scan:
     """Outcome of a scan-and-refine over many independent 1-D problems."""
 
-    x: np.ndarray          # (n_problems, n_points) scan abscissae, increasing
-    fail: np.ndarray       # (n_problems, n_points) verdicts at the scan points
     brackets: list         # per problem: list of (lo, hi, fail_lo, fail_hi), refined, ascending
     runs: int              # number of solver runs
+    calls: int             # number of batch-solver calls
 
 
-def _scan_refine(evaluate, x, known=None, rtol=RTOL, max_iter=200):
-    """Scan every problem on its abscissae ``x`` and bisect every verdict change.
+#: top zone of the scan: above the highest failing point found, ``ZONE_POINTS`` more points over
+#: ``ZONE_FRACTION`` of its value, repeated while failures keep turning up in the zone's upper
+#: half (at most ``ZONE_ROUNDS`` times).  Failure slivers just above the main boundary (long
+#: pulses) are thinner than the coarse step; see ``benchmarks/bench_design.py`` for the check
+#: against a 20x finer brute-force scan.
+ZONE_FRACTION = 0.25
+ZONE_POINTS = 320
+ZONE_ROUNDS = 4
+#: points per bracket per refinement step (k-section: fewer batch calls than bisection)
+KSECTION = 8
+
+
+def _scan_refine(evaluate, x, known=None, rtol=RTOL, zone=True, refine="all", n_zone=None,
+                 max_iter=100):
+    """Scan every problem on its abscissae ``x`` and refine every verdict change.
 
     ``evaluate(idx, xs)`` returns the failure verdicts of problems ``idx`` at abscissae ``xs``
     (1-D arrays of equal length) in one batch.  ``known`` is an optional boolean mask of scan
     points whose verdict is known to be "survive" without running (e.g. above the uplift limit).
+    With ``zone`` the region just above each problem's highest failing point is scanned densely
+    (``n_zone`` points, default :data:`ZONE_POINTS`, see :data:`ZONE_FRACTION`).  Brackets are
+    then cut in :data:`KSECTION` parts per step, all together, until narrower than ``rtol``
+    relative; where a step reveals more than one change inside a bracket the highest is followed
+    (so the top fail-to-survive transition is always the highest one found).  ``refine="top"``
+    refines only each problem's top fail-to-survive bracket (records, whose verdicts can change
+    hundreds of times); the other changes are then reported at scan resolution.
     """
+    n_zone = ZONE_POINTS if n_zone is None else int(n_zone)
     x = np.asarray(x, dtype=float)
     n_prob, n_pts = x.shape
     fail = np.zeros(x.shape, dtype=bool)
     run = np.ones(x.shape, dtype=bool) if known is None else ~np.asarray(known, dtype=bool)
     idx, col = np.nonzero(run)
-    runs = int(idx.size)
+    runs, calls = int(idx.size), 0
     if idx.size:
         fail[idx, col] = evaluate(idx, x[idx, col])
+        calls += 1
+    xs = [x[i] for i in range(n_prob)]
+    fs = [fail[i] for i in range(n_prob)]
+    if zone:
+        top = x[:, -1]
+        todo = [i for i in range(n_prob) if fs[i].any()]
+        prev = {i: -np.inf for i in todo}
+        for _ in range(ZONE_ROUNDS):
+            pi, px = [], []
+            for i in todo:
+                xf = xs[i][np.nonzero(fs[i])[0][-1]]
+                hi = min(top[i], xf * (1.0 + ZONE_FRACTION))
+                z = xf + (hi - xf) * np.arange(1, n_zone + 1) / n_zone
+                z = z[z < top[i]]
+                prev[i] = (xf, hi)
+                pi.append(np.full(z.size, i))
+                px.append(z)
+            if not pi:
+                break
+            pi, px = np.concatenate(pi), np.concatenate(px)
+            if not px.size:
+                break
+            pf = np.asarray(evaluate(pi, px), dtype=bool)
+            runs += int(px.size)
+            calls += 1
+            nxt = []
+            for i in todo:
+                sel = pi == i
+                xx = np.concatenate([xs[i], px[sel]])
+                ff = np.concatenate([fs[i], pf[sel]])
+                order = np.argsort(xx, kind="stable")
+                xs[i], fs[i] = xx[order], ff[order]
+                xf0, hi = prev[i]
+                new_top = xs[i][np.nonzero(fs[i])[0][-1]]
+                if new_top > xf0 + 0.5 * (hi - xf0) and hi < top[i]:
+                    nxt.append(i)
+            todo = nxt
     # brackets: every change of verdict between neighbouring scan points
-    change_i, change_j = np.nonzero(fail[:, 1:] != fail[:, :-1])
-    lo = x[change_i, change_j].copy()
-    hi = x[change_i, change_j + 1].copy()
-    flo = fail[change_i, change_j].copy()
-    fhi = fail[change_i, change_j + 1].copy()
+    prob, lo, hi, flo, fhi = [], [], [], [], []
+    for i in range(n_prob):
+        ch = np.nonzero(fs[i][1:] != fs[i][:-1])[0]
+        prob.extend([i] * ch.size)
+        lo.extend(xs[i][ch]), hi.extend(xs[i][ch + 1])
+        flo.extend(fs[i][ch]), fhi.extend(fs[i][ch + 1])
+    prob, lo, hi = np.array(prob, dtype=int), np.array(lo, dtype=float), np.array(hi, dtype=float)
+    flo, fhi = np.array(flo, dtype=bool), np.array(fhi, dtype=bool)
+    if refine == "top":
+        # only the last fail->survive change of each problem; the rest stay at scan resolution
+        top_mask = np.zeros(prob.size, dtype=bool)
+        for i in np.unique(prob):
+            cand = np.nonzero((prob == i) & flo & ~fhi)[0]
+            if cand.size:
+                top_mask[cand[-1]] = True
+        rough = ~top_mask
+        done_p, done_lo, done_hi = [prob[rough]], [lo[rough]], [hi[rough]]
+        done_flo, done_fhi = [flo[rough]], [fhi[rough]]
+        prob, lo, hi, flo, fhi = prob[top_mask], lo[top_mask], hi[top_mask], flo[top_mask], fhi[top_mask]
+    else:
+        done_p, done_lo, done_hi, done_flo, done_fhi = [], [], [], [], []
+    k = KSECTION
+    frac = np.arange(1, k) / k
     for _ in range(max_iter):
-        active = (hi - lo) > rtol * np.abs(hi)
-        if not active.any():
+        narrow = (hi - lo) <= rtol * np.abs(hi)
+        done_p.append(prob[narrow]), done_lo.append(lo[narrow]), done_hi.append(hi[narrow])
+        done_flo.append(flo[narrow]), done_fhi.append(fhi[narrow])
+        keep = ~narrow
+        prob, lo, hi, flo, fhi = prob[keep], lo[keep], hi[keep], flo[keep], fhi[keep]
+        if not prob.size:
             break
-        k = np.nonzero(active)[0]
-        mid = 0.5 * (lo[k] + hi[k])
-        fm = np.asarray(evaluate(change_i[k], mid), dtype=bool)
-        runs += int(k.size)
-        same_as_lo = fm == flo[k]
-        lo[k[same_as_lo]] = mid[same_as_lo]
-        hi[k[~same_as_lo]] = mid[~same_as_lo]
+        mids = lo[:, None] + (hi - lo)[:, None] * frac[None, :]          # (n, k-1)
+        vm = np.asarray(evaluate(np.repeat(prob, k - 1), mids.ravel()), dtype=bool)
+        runs += int(vm.size)
+        calls += 1
+        pts = np.concatenate([lo[:, None], mids, hi[:, None]], axis=1)   # (n, k+1)
+        ver = np.concatenate([flo[:, None], vm.reshape(-1, k - 1), fhi[:, None]], axis=1)
+        change = ver[:, 1:] != ver[:, :-1]                              # (n, k)
+        bi = np.arange(prob.size)
+        bj = (k - 1) - np.argmax(change[:, ::-1], axis=1)               # highest change
+        lo, hi = pts[bi, bj], pts[bi, bj + 1]
+        flo, fhi = ver[bi, bj], ver[bi, bj + 1]
+    cat = lambda parts, dt: np.concatenate(parts).astype(dt) if parts else np.zeros(0, dt)
+    prob, lo, hi = cat(done_p + [prob], int), cat(done_lo + [lo], float), cat(done_hi + [hi], float)
+    flo, fhi = cat(done_flo + [flo], bool), cat(done_fhi + [fhi], bool)
+    order = np.lexsort((lo, prob))
     brackets = [[] for _ in range(n_prob)]
-    for m in range(lo.size):
-        brackets[change_i[m]].append((float(lo[m]), float(hi[m]), bool(flo[m]), bool(fhi[m])))
-    return _Scan(x=x, fail=fail, brackets=brackets, runs=runs)
+    for m in order:
+        brackets[prob[m]].append((float(lo[m]), float(hi[m]), bool(flo[m]), bool(fhi[m])))
+    return _Scan(brackets=brackets, runs=runs, calls=calls)
 
 
 def _scan_points(top, n_scan, n_tail=N_TAIL):
@@ -322,7 +430,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL,
         blocks = [Block(p, math.atan(t)) for t in tans]
         return _failed(_batch(blocks, pulse, None, model=model), criterion)
 
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol)
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="top")
     br = scan.brackets[0]
     tan_alpha = 0.0
     for lo, hi, flo, fhi in br:
@@ -360,7 +468,7 @@ class CriticalAmplitudes(list):
         return [(self[i][1], self[i + 1][0]) for i in range(len(self) - 1)]
 
 
-def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n_scan=200,
+def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n_scan=400,
                         rtol=RTOL, model="fast"):
     """All the amplitude intervals (m/s^2) up to ``up_to`` in which ``block`` overturns.
 
@@ -396,7 +504,7 @@ def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n
     def evaluate(idx, amps):
         return _failed(_batch(block, pulse, np.asarray(amps), model=model), criterion)
 
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol)
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, zone=False)
     edges = []
     for lo, hi, flo, fhi in scan.brackets[0]:
         edges.append((0.5 * (lo + hi), fhi))      # value, failing above it?
@@ -461,7 +569,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 
 
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
-                   shape=None, lam=1.0, n_scan=N_SCAN, rtol=RTOL, model="fast"):
+                   shape=None, lam=1.0, n_scan=N_SCAN, n_zone=None, rtol=RTOL, model="fast"):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -483,6 +591,11 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         Shape whose envelope factor to use with ``rule="envelope"`` (default: every shape).
     lam : float
         The lambda of Eq. 20 for ``rule="eq20"``.
+    n_scan, n_zone, rtol : int, int, float
+        ``rule="exact"``: uniform scan points up to the no-uplift width ``H peak/g``, points of
+        the dense zone just above the widest failing width (default :data:`ZONE_POINTS`), and
+        the relative width of the final bracket.  For a record only the top transition is
+        refined (its verdicts may change hundreds of times with the width).
 
     Returns
     -------
@@ -496,7 +609,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
     if rule == "exact":
         return _exact_width(height, excitation, criterion=criterion, eta=eta, n_scan=n_scan,
-                            rtol=rtol, model=model)
+                            rtol=rtol, model=model, n_zone=n_zone)
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
         raise ValueError(f"rule={rule!r} needs a pulse (ap, Tp); for a whole record fit its pulse "
                          "first or use rule='exact'")
@@ -527,7 +640,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
                                 f"{it} iterations", eta=eta)
 
 
-def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model):
+def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None):
     _check_criterion(criterion)
     top = height * _peak(excitation) / G       # wider than this the column never uplifts
     if top <= 0:
@@ -540,18 +653,19 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model):
         blocks = [Block.from_dimensions(height, float(b), eta) for b in widths]
         return _failed(_batch(blocks, excitation, None, model=model), criterion)
 
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol)
+    is_pulse = getattr(excitation, "shape", "record") in ("rect", "sine", "ricker-sym", "ricker-anti")
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="all" if is_pulse else "top",
+                        n_zone=n_zone)
     br = scan.brackets[0]
-    width, n_iter = 0.0, 0
+    width, n_iter = 0.0, scan.calls
     for lo, hi, flo, fhi in br:
         if flo and not fhi:
             width = hi
-    if br:
-        n_iter = int(math.ceil(math.log2(max(top / n_scan / (rtol * max(width, 1e-300)), 2.0))))
     return RequiredWidth(
         width=float(width), height=height, rule="exact", iterations=n_iter,
         method=(f"verified width: scan of {x.shape[1]} widths up to the no-uplift width "
-                f"{top:.4g} m, then bisection of {len(br)} verdict change(s) "
-                f"({scan.runs} solver runs)"),
+                f"{top:.4g} m (denser just above the widest failure), then bracketed "
+                f"refinement of {len(br)} verdict change(s) ({scan.runs} solver runs in "
+                f"{scan.calls} batches)"),
         criterion=criterion, transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br),
         runs=scan.runs, eta=eta)

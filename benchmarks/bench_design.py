@@ -1,0 +1,79 @@
+"""Speed (and accuracy) of the design layer: issue 4's targets on this 2-core machine.
+
+    python benchmarks/bench_design.py
+
+Targets: one exact minimum slenderness < 20 ms; a 200 x 200 overturning spectrum < 5 s; the
+whole Fig. 8 chart (4 shapes x 8 pTp x 20 ap/g) < 60 s.  Also measured: the verified width of
+a column under a record, and the agreement of the exact minimum slenderness found entirely with
+the reference solver (scipy DOP853) against the fast one.
+"""
+from __future__ import annotations
+
+import math
+import statistics
+import time
+
+import numpy as np
+
+
+def _best(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times), statistics.median(times)
+
+
+def run() -> dict:
+    import rocking
+    from pulses import G, make_pulse
+    from rocking.spectrum import CHART_APG, CHART_PTP
+
+    out = {}
+    rinaldi = make_pulse("sine", 0.71 * G, 0.8)
+    rocking.min_slenderness(rinaldi, 1.381)                       # compile / warm up
+    for shape in ("rect", "sine", "ricker-sym", "ricker-anti"):
+        pulse = make_pulse(shape, 0.71 * G, 0.8)
+        best, med = _best(lambda: rocking.min_slenderness(pulse, 1.381), 10)
+        out[f"min_slenderness_{shape}_ms"] = round(med * 1e3, 2)
+
+    alpha = math.radians(14.0)
+    wp, ratio = np.linspace(0.5, 12, 200), np.linspace(1, 6, 200)
+    rocking.overturning_spectrum(alpha, "sine", wp[:2], ratio[:2])
+    for shape in ("sine", "ricker-sym", "ricker-anti"):
+        best, _ = _best(lambda: rocking.overturning_spectrum(alpha, shape, wp, ratio), 1)
+        out[f"spectrum_200x200_{shape}_s"] = round(best, 2)
+
+    t = time.perf_counter()
+    frame = rocking.slenderness_chart("all", CHART_PTP, CHART_APG)
+    out["chart_4x8x20_s"] = round(time.perf_counter() - t, 2)
+    real = frame[frame["shape"] != "rect"]
+    out["chart_max_exact_over_eq31_realisable"] = round(float(real["ratio"].max()), 4)
+    out["chart_max_exact_over_eq31_rect"] = round(float(frame[frame["shape"] == "rect"]["ratio"].max()), 4)
+
+    record = make_pulse("ricker-sym", 0.6 * G, 0.6, t0=5.0).sample(0.005)
+    record = type(record)(np.concatenate([record.acc, np.zeros(2000)]), record.dt)  # 15 s record
+    rocking.required_width(7.5, record, rule="exact")
+    best, _ = _best(lambda: rocking.required_width(7.5, record, rule="exact"), 3)
+    out["verified_width_15s_record_s"] = round(best, 3)
+
+    # the exact minimum slenderness found entirely with the reference model (slow)
+    worst = 0.0
+    t = time.perf_counter()
+    for shape, ptp, apg in [("sine", 1.105, 0.71), ("ricker-anti", 3.0, 0.5)]:
+        pulse = make_pulse(shape, apg * G, 1.0)
+        ref = rocking.min_slenderness(pulse, ptp, model="reference", n_scan=12, rtol=1e-8)
+        fast = rocking.min_slenderness(pulse, ptp)
+        worst = max(worst, abs(fast.tan_alpha / ref.tan_alpha - 1.0))
+    out["reference_vs_fast_min_slenderness_max_rel"] = float(f"{worst:.3g}")
+    out["reference_min_slenderness_s_each"] = round((time.perf_counter() - t) / 2, 2)
+
+    width = max(len(k) for k in out)
+    for key, value in out.items():
+        print(f"{key:<{width}}  {value}")
+    return out
+
+
+if __name__ == "__main__":
+    run()
