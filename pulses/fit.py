@@ -74,8 +74,8 @@ def unit_samples(shape: str, tp: float, t0: float, t, dt: float) -> np.ndarray:
 
 def unit_samples_and_derivatives(shape: str, tp: float, t0: float, t, dt: float):
     """Unit pulse at ``t`` and its derivatives with respect to ``tp`` and ``t0`` (for the Jacobian)."""
-    m = unit_samples(shape, tp, t0, t, dt)
     if shape == "rect":  # cell averages: the edges move through the cells they sit in
+        m = unit_samples(shape, tp, t0, t, dt)
         lo = np.maximum(t - 0.5 * dt, t0)
         hi = np.minimum(t + 0.5 * dt, t0 + tp)
         inside = hi > lo
@@ -86,15 +86,22 @@ def unit_samples_and_derivatives(shape: str, tp: float, t0: float, t, dt: float)
         return m, d_tp, d_t0
     tau = (t - t0) / tp
     if shape == "sine":
-        dw = np.where((tau >= 0.0) & (tau <= 1.0), 2.0 * np.pi * np.cos(2.0 * np.pi * tau), 0.0)
+        inside = (tau >= 0.0) & (tau <= 1.0)
+        phase = 2.0 * np.pi * tau
+        m = np.where(inside, np.sin(phase), 0.0)
+        dw = np.where(inside, 2.0 * np.pi * np.cos(phase), 0.0)
     elif shape == "ricker-sym":
         x2 = (np.pi * tau) ** 2
-        dw = -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * np.exp(-x2)
+        e = np.exp(-x2)
+        m = (1.0 - 2.0 * x2) * e
+        dw = -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * e
     else:  # ricker-anti
         k = 2.0 * np.pi / math.sqrt(3.0)
         x = k * tau
         x2 = x * x
-        dw = k * (-x2 * x2 + 6.0 * x2 - 3.0) * np.exp(-0.5 * x2) / BETA
+        e = np.exp(-0.5 * x2) / BETA
+        m = (x2 - 3.0) * x * e
+        dw = k * (-x2 * x2 + 6.0 * x2 - 3.0) * e
     return m, -dw * tau / tp, -dw / tp
 
 

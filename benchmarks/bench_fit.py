@@ -1,0 +1,58 @@
+"""Speed of the pulse fitter: all four shapes on one record.
+
+``python benchmarks/bench_fit.py`` prints a dict; :func:`run` returns it.
+
+- The issue's case: a 20 s record at 200 Hz (4001 samples; a one-sine pulse plus band-limited
+  background motion at 15 % of ap), all four shapes (``fit_pulse(record)``): median and best of
+  repeated fits, in ms (target: under 15 ms).
+- Per shape on the same record.
+- Record length 10, 20, 40, 80, 160 s at 200 Hz: median ms per fit and ms per 1000 samples (the
+  cost must grow no faster than the length).
+- Reading: ``read_record`` of Rinaldi228.AT2 when ``../shared`` is present.
+"""
+from __future__ import annotations
+
+import pathlib
+import platform
+import time
+
+import numpy as np
+
+
+def _time(fn, repeat):
+    fn()  # warm-up (imports, FFT plans)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times)) * 1e3, float(np.min(times)) * 1e3
+
+
+def run(repeat: int = 30) -> dict:
+    """Measure the fitter; returns ``{name: value}`` (times in ms)."""
+    from pulses import fit_pulse, read_record
+    from pulses.synthetic import synthetic_record
+
+    out = {"python": platform.python_version(), "machine": platform.machine()}
+    rec = synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, 0.005, noise=0.15, seed=1)
+    med, best = _time(lambda: fit_pulse(rec), repeat)
+    out["fit_all_shapes_20s_200Hz_ms_median"] = med
+    out["fit_all_shapes_20s_200Hz_ms_min"] = best
+    out["fit_target_ms"] = 15.0
+    for shape in ("sine", "ricker-sym", "ricker-anti", "rect"):
+        out[f"fit_{shape}_20s_200Hz_ms_median"] = _time(lambda: fit_pulse(rec, shapes=[shape]), repeat)[0]
+    for duration in (10, 20, 40, 80, 160):
+        r = synthetic_record("ricker-sym", 5.0, 1.5, 0.4 * duration, float(duration), 0.005, noise=0.15, seed=2)
+        med, _ = _time(lambda: fit_pulse(r), max(5, repeat // 3))
+        out[f"fit_all_shapes_{duration}s_ms_median"] = med
+        out[f"fit_all_shapes_{duration}s_ms_per_1000_samples"] = med / (r.npts / 1000.0)
+    shared = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "records" / "raw" / "Rinaldi228.AT2"
+    if shared.is_file():
+        out["read_rinaldi228_at2_ms_median"] = _time(lambda: read_record(shared), repeat)[0]
+    return out
+
+
+if __name__ == "__main__":
+    for key, value in run().items():
+        print(f"{key}: {value:.3f}" if isinstance(value, float) else f"{key}: {value}")
