@@ -282,3 +282,33 @@ def test_result_objects():
         assert col in frame.columns
     with pytest.raises(ValueError, match="unknown pulse shape"):
         fit_pulse(rec, shapes=["triangle"])
+
+
+# -- pipeline fit ----------------------------------------------------------------------------------------
+def test_pipeline_fit_table_csv_json_plot(tmp_path, capsys):
+    import json
+
+    import pandas as pd
+
+    from pipeline.cli import main
+
+    rec = synthetic_record("ricker-anti", -0.4 * G, 1.1, 6.0, 20.0, 0.01, noise=0.05, seed=8)
+    rec.name, rec.metadata = "demo", {"station": "SYN"}
+    sac = pulses.write_sac(rec, tmp_path / "demo.sac")
+    csv = tmp_path / "fit.csv"
+    assert main(["fit", sac, "--csv", str(csv), "--plot", str(tmp_path / "plots")]) == 0
+    text = capsys.readouterr().out
+    assert "ricker-anti" in text and "1*" in text
+    frame = pd.read_csv(csv)
+    assert len(frame) == 4 and frame.loc[frame["best"], "shape"].item() == "ricker-anti"
+    best = frame[frame["best"]].iloc[0]
+    # 5 % noise at Tp 1.1 s: the noise limit is ~2 % on ap and ~1 % on Tp; 8 % is 4 sigma
+    assert best["ap_g"] == pytest.approx(-0.4, rel=0.08) and best["tp_s"] == pytest.approx(1.1, rel=0.05)
+    assert (tmp_path / "plots" / "demo.sac.png").is_file()
+    assert main(["fit", sac, "--json", "--shapes", "sine", "ricker-anti"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [c["shape"] for c in data[0]["candidates"]][0] == "ricker-anti" and len(data[0]["candidates"]) == 2
+    assert main(["fit", sac, "--shapes", "triangle"]) == 2
+    assert main(["fit", str(tmp_path / "missing.AT2"), sac]) == 1  # one bad file: reported, others fitted
+    captured = capsys.readouterr()
+    assert "no such file" in captured.err and "ricker-anti" in captured.out

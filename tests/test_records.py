@@ -256,3 +256,29 @@ def test_public_names():
     for name in ("read_record", "RecordError", "write_sac", "fit_pulse", "PulseFit"):
         assert hasattr(pulses, name), name
     assert issubclass(RecordError, ValueError)
+
+
+# -- pipeline convert ------------------------------------------------------------------------------
+def test_pipeline_convert_to_sac_and_mseed(tmp_path, capsys):
+    from pipeline.cli import main
+
+    at2 = shared_record("Rinaldi228.AT2")
+    txt = shared_record("base_isolation_benchmark/rinaldi.txt")
+    out = tmp_path / "out"
+    assert main(["convert", str(at2), "--to", "sac", "--out", str(out)]) == 0
+    back = read_record(out / "Rinaldi228.sac")  # idep = iacc, nm/s^2: no units needed
+    orig = read_record(at2)
+    assert back.npts == orig.npts and back.dt == orig.dt
+    np.testing.assert_allclose(back.acc, orig.acc, rtol=0, atol=1.2e-7 * orig.pga)  # float32
+    assert main(["convert", str(txt), "--to", "sac", "--out", str(out), "--units", "cm/s2",
+                 "--dt", "0.005", "--column", "2"]) == 0
+    col2 = read_record(out / "rinaldi.col2.sac")
+    assert col2.npts == 6000 and col2.pga == pytest.approx(read_record(txt, units="cm/s2", dt=0.005, column=2).pga,
+                                                           rel=1e-7)
+    assert main(["convert", str(at2), "--to", "mseed", "--out", str(out)]) == 0
+    assert "read back with --units m/s2" in capsys.readouterr().out
+    np.testing.assert_allclose(read_record(out / "Rinaldi228.mseed", units="m/s2").acc, orig.acc, rtol=1e-15)
+    # a file that cannot be read: one line on stderr, exit status 1; bad units: exit status 2
+    assert main(["convert", str(txt), "--to", "sac", "--out", str(out)]) == 1
+    assert "column" in capsys.readouterr().err
+    assert main(["convert", str(at2), "--to", "sac", "--out", str(out), "--units", "furlongs"]) == 2
