@@ -1,0 +1,6 @@
+"""``python -m benchmarks [--quick]``: regenerate benchmarks/RESULTS.md and its plots."""
+import sys
+
+from benchmarks.run import main
+
+sys.exit(main())
