@@ -130,7 +130,9 @@ def _column_columns():
                                   "`rocking.required_width`, rule exact). Independent of the pulse fit."),
         ("verified_tan_alpha", "-", "tan(alpha) of the verified width, verified_width_m / height_m."),
         ("verified_adequate", "-", "The column as it stands is at least as wide as the verified width "
-                                   "(blank for `--height`)."),
+                                   "(blank for `--height`). A column that survives (`overturns` False) "
+                                   "but is not verified-adequate stands on a safe island: some slightly "
+                                   "wider column of the same height overturns under the same record."),
     ]
     return cols
 

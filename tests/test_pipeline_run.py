@@ -21,6 +21,8 @@ from pulses import G
 from .conftest import shared_record
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+#: the robustness batch: one column, one shape, no plots (kept cheap; the shapes are tested below)
+BATCH_ARGS = ["--block", "7.5x1.8", "--shapes", "sine", "--no-plots", "--quiet"]
 
 
 # -- helpers -------------------------------------------------------------------------------------
@@ -92,7 +94,7 @@ def batch20(tmp_path_factory):
 @pytest.fixture(scope="module")
 def batch_run(batch20, tmp_path_factory):
     out = tmp_path_factory.mktemp("run1")
-    code = main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "--quiet"])
+    code = main(["run", *batch20, *BATCH_ARGS, "--out", str(out)])
     return code, out
 
 
@@ -121,15 +123,12 @@ def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20)
         assert f"| `{name}` |" in md
 
 
-def test_rerun_into_same_folder_is_identical_and_jobs_do_not_matter(batch_run, batch20, tmp_path):
+def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
+    """Re-running into the same folder, now with 2 processes, leaves every file as it was."""
     code, out = batch_run
     before = tree(out)
-    assert main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"]) == 1
+    assert main(["run", *batch20, *BATCH_ARGS, "--out", str(out), "--jobs", "2"]) == 1
     assert tree(out) == before
-    out2 = tmp_path / "jobs2"
-    assert main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out2), "--no-plots", "-q",
-                 "--jobs", "2"]) == 1
-    assert tree(out2) == before
 
 
 def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
@@ -227,87 +226,105 @@ def test_cli_end_to_end_numbers_match_library(tmp_path):
     assert read_csv(out / "summary.csv") == rows
 
 
-def test_console_script_runs_bundled_examples_with_plots(tmp_path):
-    """The installed command on two bundled records, with plots (a subprocess, like a user)."""
-    out = tmp_path / "out"
-    recs = [str(DATA / "synth_sine_055g_0.9s.sac"), str(DATA / "synth_broadband_only.sac")]
-    proc = subprocess.run([sys.executable, "-m", "pipeline", "run", *recs, "--block", "7.5x1.8",
-                           "--out", str(out)], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr
-    assert "2 of 2 records processed" in proc.stdout
-    assert proc.stderr == ""  # no progress bar when not on a terminal
-    for name in ("synth_sine_055g_0.9s.png", "synth_broadband_only.png", "summary.png"):
-        png = (out / "plots" / name).read_bytes()
-        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
-
-
 # -- the paper's records -----------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def paper_run(tmp_path_factory):
-    rinaldi = shared_record("Rinaldi228.AT2")
-    pacoima = shared_record("RSN77_SFERN_PUL164.AT2")
+    """Rinaldi 228 and Pacoima Dam 164 (AT2) and Erzincan N-S (plain text, cm/s2, dt 0.005 s) in one
+    run: --units/--dt/--column serve the text file; the AT2 headers state theirs, which win (with a
+    warning in the report)."""
+    records = [shared_record("Rinaldi228.AT2"), shared_record("RSN77_SFERN_PUL164.AT2"),
+               shared_record("base_isolation_benchmark/erzikan.txt")]
     out = tmp_path_factory.mktemp("paper")
-    code = main(["run", str(rinaldi), str(pacoima), "--block", "7.5x1.8", "--out", str(out),
-                 "--no-plots", "-q"])
+    code = main(["run", *map(str, records), "--block", "7.5x1.8", "--units", "cm/s2", "--dt", "0.005",
+                 "--column", "1", "--out", str(out), "--no-plots", "-q", "--jobs", "2"])
     return code, out
 
 
 def test_rinaldi_eq31_and_survival_of_the_temple_column(paper_run):
     code, out = paper_run
-    assert code == 0
+    assert code == 0, read_csv(out / "failures.csv")
     r = read_csv(out / "Rinaldi228.csv")[0]
+    assert float(r["pga_g"]) == pytest.approx(0.874, abs=0.001)
     # paper, Section 6: one-sine pulse 0.71 g, 0.8 s -> Eq. 31 = 0.373 for p = 1.381 rad/s
-    assert "sine" in r["shapes_fitting"].split(";") or r["pulse_shape"] == "sine"
+    assert "sine" in r["shapes_fitting"].split(";")
     assert float(r["p_rad_s"]) == pytest.approx(1.381, abs=1e-3)
     assert 0.64 <= abs(float(r["sine_ap_g"])) <= 0.76
     assert 0.76 <= float(r["sine_tp_s"]) <= 0.84
     assert float(r["sine_eq31_tan_alpha"]) == pytest.approx(0.37, abs=0.03)
-    # Fig. 11: the column (tan alpha 0.24) survives the full record
+    # a symmetric Ricker fits about as well and asks for much more (issue: about 0.5); the
+    # governing value is the most demanding fitting shape
+    assert float(r["governing_eq31_tan_alpha"]) >= float(r["sine_eq31_tan_alpha"])
+    # Fig. 11: the column (tan alpha 0.24) survives the full record ...
     assert r["overturns"] == "False"
     assert float(r["max_theta_ratio"]) < 1.0
-    assert r["verified_adequate"] == "True"
-    assert float(r["governing_eq31_tan_alpha"]) >= float(r["sine_eq31_tan_alpha"])
+    # ... though only just: the verified width (survives at that and every larger width) is a few
+    # cm wider, 1.8 m stands on a safe island of the full record
+    assert 1.7 <= float(r["verified_width_m"]) <= 2.0
+    assert r["verified_adequate"] == str(1.8 >= float(r["verified_width_m"]))
+    # the Eq. 31 design for the Temple column's height survives the full record
+    assert r["eq31_width_overturns"] == "False"
 
 
 def test_pacoima_processed_with_its_pulse_shapes(paper_run):
     code, out = paper_run
     r = read_csv(out / "RSN77_SFERN_PUL164.csv")[0]
+    assert float(r["pga_g"]) == pytest.approx(1.219, abs=0.002)
+    assert "passed but the file states g" in r["warnings"]
     assert r["pulse_shape"] in pulses.SHAPES
     for shape in r["shapes_fitting"].split(";"):
         k = shape.replace("-", "_")
         assert float(r[f"{k}_eq31_tan_alpha"]) > 0 and float(r[f"{k}_exact_tan_alpha"]) >= 0
+        assert float(r[f"{k}_eq31_width_m"]) > 0
     assert float(r["verified_width_m"]) > 0 and r["overturns"] in ("True", "False")
 
 
-def test_erzincan_ns_plain_text_processed(tmp_path):
-    erz = shared_record("base_isolation_benchmark/erzikan.txt")
-    out = tmp_path / "out"
-    code = main(["run", str(erz), "--units", "cm/s2", "--dt", "0.005", "--column", "1",
-                 "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"])
-    assert code == 0, read_csv(out / "failures.csv")
+def test_erzincan_ns_plain_text_processed(paper_run):
+    code, out = paper_run
     r = read_csv(out / "erzikan.csv")[0]
-    assert float(r["pga_g"]) == pytest.approx(0.515, abs=0.01)  # MANIFEST: N-S peak
-    assert float(r["dt_s"]) == 0.005
+    assert float(r["pga_g"]) == pytest.approx(0.5154, abs=0.001)  # MANIFEST: N-S peak
+    assert float(r["dt_s"]) == 0.005 and int(r["npts"]) == 4260
     assert r["pulse_shape"] in pulses.SHAPES and r["shapes_fitting"]
     assert float(r["verified_width_m"]) > 0
 
 
 # -- dask -----------------------------------------------------------------------------------------
 def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
+    """A local dask cluster on part of the batch: the same per-record reports and failure rows."""
     pytest.importorskip("dask.distributed")
     code, out = batch_run
+    subset = batch20[:6]  # 5 good records and the missing file
     out2 = tmp_path / "dask"
-    assert main(["run", *batch20, "--block", "7.5x1.8", "--out", str(out2), "--no-plots", "-q",
-                 "--dask", "local", "--jobs", "2"]) == 1
-    assert tree(out2) == tree(out)
+    assert main(["run", *subset, *BATCH_ARGS, "--out", str(out2), "--dask", "local", "--jobs", "2"]) == 1
+    produced = tree(out2)
+    for name in produced:
+        if name.endswith(".csv") and name not in ("summary.csv", "failures.csv"):
+            assert produced[name] == (out / name).read_bytes(), name
+    assert sum(n.endswith(".csv") for n in produced) == 5 + 2
+    fail = read_csv(out2 / "failures.csv")
+    assert fail == [f for f in read_csv(out / "failures.csv") if f["record"] == "missing"]
 
 
 # -- demo -------------------------------------------------------------------------------------------
 def test_demo_from_another_directory(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "pipeline", "demo", "--no-plots", "--jobs", "2"],
-                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    """`pipeline demo` from an unrelated folder: bundled records, ./demo-output, plots, no noise."""
+    proc = subprocess.run([sys.executable, "-m", "pipeline", "demo", "--jobs", "2"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
+    assert "5 of 5 records processed" in proc.stdout
+    assert proc.stderr == ""  # no progress bar when stderr is not a terminal
     out = tmp_path / "demo-output"
     rows = read_csv(out / "summary.csv")
     assert len(rows) == 5 and {r["column"] for r in rows} == {"7.5x1.8"}
     assert read_csv(out / "failures.csv") == []
+    for name in [f"{r['record']}.png" for r in rows] + ["summary.png"]:
+        png = (out / "plots" / name).read_bytes()
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
+    # the known pulses of the examples are found (data/examples.csv)
+    truth = {r["file"].rsplit(".", 1)[0]: r for r in read_csv(DATA / "examples.csv")}
+    for r in rows:
+        t = truth[r["record"]]
+        if t["shape"]:
+            assert t["shape"] in r["shapes_fitting"].split(";")
+            k = t["shape"].replace("-", "_")
+            assert float(r[f"{k}_ap_g"]) == pytest.approx(float(t["ap_g"]), rel=0.12)
+            assert float(r[f"{k}_tp_s"]) == pytest.approx(float(t["tp_s"]), rel=0.12)
