@@ -6,8 +6,9 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    pulse as mother wavelet (:mod:`pulses.cwt`), on a log-spaced grid of periods.  The best match
    maximises the share of the record's energy explained by a pulse of least-squares amplitude.
 2. **Refine** ``ap``, ``Tp`` and ``t0`` by least squares on the record's samples inside a window
-   around the pulse (:func:`scipy.optimize.least_squares`, Levenberg-Marquardt, with the
-   amplitude solved linearly for each ``(Tp, t0)``).  A straight-line baseline is fitted
+   around the pulse (:func:`scipy.optimize.least_squares`, Levenberg-Marquardt with the
+   analytic Jacobian; for the rectangle a grid search over its two edges, see
+   :func:`_refine_rect`).  A straight-line baseline is fitted
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
 
@@ -32,7 +33,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares, minimize
+from scipy.optimize import least_squares
 
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
@@ -396,11 +397,13 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
 
 
 def _refine_rect(x, t, dt, best, window, baseline):
-    """Least squares for the rectangular pulse: Nelder-Mead on its two edges.
+    """Least squares for the rectangular pulse: a search over its two edges.
 
     The cell-averaged rectangle is piecewise linear in its edges, with a kink each time an edge
-    crosses a cell boundary; a gradient method stalls at the kinks, a simplex does not.  The
-    amplitude (and the baseline) are solved linearly for each pair of edges.
+    crosses a cell boundary, and with background motion the sum of squares has a shallow local
+    minimum in almost every cell: a gradient method stalls.  The edges are scanned one at a time
+    over +-0.15 Tp, then both together on grids that shrink to 1e-7 Tp.  The amplitude (and
+    the baseline) are solved linearly for each pair of edges, in O(1) from prefix sums.
     """
     ap, tp, t0, _ = best
     for _ in range(3):
@@ -451,15 +454,36 @@ def _refine_rect(x, t, dt, best, window, baseline):
                 return sxx
             return sxx - mx * mx / mm
 
-        start, end = t0, t0 + tp
-        for step in (max(0.6 * dt, 0.05 * tp), 0.6 * dt):  # a wide simplex, then a restart
-            simplex = np.array([[start, end], [start + step, end], [start, end + step]])
-            sol = minimize(sse, [start, end], method="Nelder-Mead",
-                           options={"initial_simplex": simplex, "xatol": 1e-6 * tp, "fatol": 1e-13 * sxx,
-                                    "maxiter": 2000})
-            start, end = (float(v) for v in sol.x)
+        def sse_many(starts, ends):
+            """:func:`sse` for arrays of edge pairs (the scan's many trials at once)."""
+            k1 = np.floor((starts - tw[0]) / dt + 0.5).astype(int)
+            k2 = np.floor((ends - tw[0]) / dt + 0.5).astype(int)
+            same = k1 == k2
+            w1 = np.where(same, (ends - starts) / dt, (tw[0] + (k1 + 0.5) * dt - starts) / dt)
+            w2 = np.where(same, 0.0, (ends - (tw[0] + (k2 - 0.5) * dt)) / dt)
+            lo = np.clip(k1 + 1, 0, n)
+            hi = np.maximum(np.clip(k2, 0, n), lo)
+            mx = prefix_x[hi] - prefix_x[lo]
+            m1 = (hi - lo).astype(float)
+            mr = prefix_r[hi] - prefix_r[lo]
+            mm = m1.copy()
+            for k, w in ((k1, w1), (k2, w2)):
+                ok = (k >= 0) & (k < n)
+                kc = np.clip(k, 0, n - 1)
+                w = np.where(ok, w, 0.0)
+                mx += w * x_perp[kc]
+                m1 += w
+                mr += w * ramp[kc]
+                mm += w * w
+            if baseline:
+                mm = mm - m1 * m1 / n - mr * mr / n_ramp
+            out = sxx - np.where(mm > 1e-12, mx * mx / np.where(mm > 1e-12, mm, 1.0), 0.0)
+            return np.where(ends - starts > dt, out, np.inf)
+
+        start, end = _scan_edges(sse_many, t0, t0 + tp, tp, dt)
+        start, end = _zoom_edges(sse_many, start, end, step=max(0.3 * tp / 120, 0.5 * dt) * 2, tol=1e-7 * tp)
         tp_new, t0_new = end - start, start
-        if not (math.isfinite(tp_new) and tp_new > dt) or sse([start, end]) > sse([t0, t0 + tp]):
+        if not (math.isfinite(tp_new) and tp_new > dt) or sse((start, end)) > sse((t0, t0 + tp)):
             break
         A = np.column_stack([unit_samples("rect", tp_new, t0_new, tw, dt)] + extra)
         coef, *_ = np.linalg.lstsq(A, xw, rcond=None)
@@ -469,3 +493,53 @@ def _refine_rect(x, t, dt, best, window, baseline):
         if _covers(idx, "rect", tp, t0, dt, x.size):
             break
     return best
+
+
+def _scan_edges(sse_many, start: float, end: float, tp: float, dt: float, sweeps: int = 2):
+    """Move each edge of the rectangle to the best of a grid of positions around it.
+
+    With background motion the sum of squares has a local minimum in almost every cell an edge
+    crosses; a scan over +-0.15 Tp (at most 121 positions, half a cell apart when that fits) puts
+    each edge in the right basin before the grids of :func:`_zoom_edges` close in.
+    """
+    half = max(0.15 * tp, 10 * dt)
+    n = int(min(60, math.ceil(half / (0.5 * dt))))
+    offsets = np.linspace(-half, half, 2 * n + 1)
+    best = float(sse_many(np.array([start]), np.array([end]))[0])
+    for _ in range(sweeps):
+        moved = False
+        for which in (0, 1):
+            starts = start + offsets if which == 0 else np.full(offsets.size, start)
+            ends = end + offsets if which == 1 else np.full(offsets.size, end)
+            values = sse_many(starts, ends)
+            k = int(np.argmin(values))
+            if values[k] < best:
+                best, start, end, moved = float(values[k]), float(starts[k]), float(ends[k]), True
+        if not moved:
+            break
+    return start, end
+
+
+def _zoom_edges(sse_many, start: float, end: float, step: float, tol: float):
+    """Minimise over both edges on 21 x 21 grids that shrink fivefold around the best point.
+
+    The grid spans +-10 steps; when the best point lies on the border the grid moves there at
+    the same size, otherwise it shrinks, until the step is below ``tol`` (s).
+    """
+    offsets = np.arange(-10, 11)
+    best = float(sse_many(np.array([start]), np.array([end]))[0])
+    for _ in range(200):  # guard; a handful of levels are needed
+        s_grid, e_grid = np.meshgrid(start + step * offsets, end + step * offsets, indexing="ij")
+        values = sse_many(s_grid.ravel(), e_grid.ravel())
+        k = int(np.argmin(values))
+        i, j = divmod(k, offsets.size)
+        improved = values[k] < best
+        if improved:
+            best, start, end = float(values[k]), float(s_grid.flat[k]), float(e_grid.flat[k])
+        on_border = not (0 < i < offsets.size - 1 and 0 < j < offsets.size - 1)
+        if improved and on_border:
+            continue  # the minimum lies beyond this grid: move, same size
+        if step < tol:
+            break
+        step /= 5.0
+    return start, end
