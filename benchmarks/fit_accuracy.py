@@ -56,7 +56,7 @@ def cases(noise, tp, n, seed):
             if c.fit_window is not None:
                 lo, hi = (int(round(v / DT)) for v in c.fit_window)
                 fitted = sampled_pulse(shape, c.ap, c.tp, c.t0, t, DT)
-                floor = 1e-12 * float(rec.acc @ rec.acc)  # round-off, for noise-free records
+                floor = 1e-9 * float(rec.acc @ rec.acc)  # convergence tolerance (1e-7 Tp), for noise-free records
                 fail = _window_sse(rec.acc, fitted, t, lo, hi + 1) > _window_sse(rec.acc, truth, t, lo, hi + 1) * (1 + 1e-9) + floor
             lim = least_squares_limit(shape, ap, tp, t0, duration, DT, noise) if noise > 0 else None
             rows.append(dict(shape=shape, ok_shape=fit.best.shape == shape, e_ap=abs(c.ap / ap - 1),

@@ -377,7 +377,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
 
         p0 = [ap, tp, t0] + ([0.0, 0.0] if baseline else [])
         try:
-            sol = least_squares(residual, p0, jac=jacobian, method="lm", xtol=1e-9, ftol=1e-12,
+            sol = least_squares(residual, p0, jac=jacobian, method="lm", xtol=1e-8, ftol=1e-10,
                                 gtol=1e-12, max_nfev=100)
         except (ValueError, np.linalg.LinAlgError):
             break
