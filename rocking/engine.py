@@ -413,6 +413,13 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                 h = t2 - t
                 th2, om2 = step(kind, amp, tp, t0, uval, j, ta, tb, t, h,
                                 theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
+                if omega * om2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI:
+                    # fast path: no turning point, so theta is monotonic over the step and can
+                    # neither reach 0 nor peak inside it (the common case)
+                    if abs(th2) > max_abs:
+                        max_abs = abs(th2)
+                    theta, omega, t = th2, om2, t2
+                    continue
                 c0, c1, c2, c3 = _hermite(theta, omega, th2, om2, h)
                 # ---- impact: theta reaches 0 (first crossing of the step, grazes included)
                 lo, hi, interior = _first_crossing(c0, c1, c2, c3, s, 0.0)
