@@ -25,7 +25,7 @@ from .block import Block
 #: failure criteria: which verdict of the solver counts as failure
 CRITERIA = ("overturn", "exceed")
 #: default number of uniformly spaced scan points (plus a geometric tail towards zero)
-N_SCAN = 96
+N_SCAN = 64
 #: geometric tail below the uniform scan: the smallest uniform point divided by 2, 4, ... 2**N_TAIL
 N_TAIL = 10
 #: default relative width of the refined brackets
@@ -155,8 +155,8 @@ class _Scan:
 #: half (at most ``ZONE_ROUNDS`` times).  Failure slivers just above the main boundary (long
 #: pulses) are thinner than the coarse step; see ``benchmarks/bench_design.py`` for the check
 #: against a 20x finer brute-force scan.
-ZONE_FRACTION = 0.25
-ZONE_POINTS = 320
+ZONE_FRACTION = 0.15
+ZONE_POINTS = 160
 ZONE_ROUNDS = 4
 #: points per bracket per refinement step (k-section: fewer batch calls than bisection)
 KSECTION = 8
