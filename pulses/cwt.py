@@ -174,16 +174,21 @@ class Matcher:
         return tau, c * np.abs(c) / (norm * max(self.energy, 1e-300))
 
     def best_match(self, shape: str, tps, t_end: float):
-        """Best ``(signed share, Tp, tau)`` over the periods ``tps`` (s) and all allowed times.
+        """Best ``(signed share, Tp, tau)`` of each polarity over the periods ``tps`` (s) and times.
 
         Periods are taken an octave at a time, each with the band (and so the time grid) its
         shortest period needs: a long period is matched on a coarse time grid, which keeps the
         cost proportional to the record length and almost independent of the period range.
         Allowed times: the centre of a Ricker inside the record, at least half of a rectangular
         or one-sine pulse inside it.
+
+        Returns
+        -------
+        list of (float, float, float)
+            The best positive and the best negative match, the better first.
         """
         tps = np.sort(np.asarray(tps, dtype=float))
-        best = (0.0, float(tps[0]), 0.0)
+        best = {1: (0.0, float(tps[0]), 0.0), -1: (-0.0, float(tps[0]), 0.0)}
         start = 0
         while start < tps.size:
             stop = int(np.searchsorted(tps, 2.0 * tps[start], side="left"))
@@ -196,12 +201,13 @@ class Matcher:
             else:
                 half = 0.5 * group[:, None]
                 ok = (tau[None, :] >= -half) & (tau[None, :] <= t_end - half)
-            masked = np.where(ok, np.abs(share), -1.0)
-            i, j = np.unravel_index(int(np.argmax(masked)), masked.shape)
-            if masked[i, j] > abs(best[0]):
-                best = (float(share[i, j]), float(group[i]), float(tau[j]))
+            for sign in (1, -1):
+                masked = np.where(ok, sign * share, -1.0)
+                i, j = np.unravel_index(int(np.argmax(masked)), masked.shape)
+                if masked[i, j] > abs(best[sign][0]):
+                    best[sign] = (float(share[i, j]), float(group[i]), float(tau[j]))
             start = stop
-        return best
+        return sorted(best.values(), key=lambda b: -abs(b[0]))
 
     def _band_share(self, shape, group):
         m = int(math.ceil(BAND_CYCLES / group[0] * self.nfft * self.dt)) + 1

@@ -46,6 +46,11 @@ DEFAULT_SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
 #: ratio between neighbouring periods of the coarse grid (6 %: the matched-filter score of every
 #: shape changes by well under 1 % across one step, so the right basin is never missed)
 GRID_RATIO = 1.06
+#: for the antisymmetric shapes, a match of the other polarity is refined too when it explains
+#: at least this share of what the best match explains
+SECOND_START = 0.85
+#: shapes that match nearly as well with the opposite polarity half a lobe away
+_TWO_POLARITIES = ("ricker-anti", "sine")
 #: least margin (s) of record kept on each side of the pulse by the refinement: the straight-line
 #: baseline fitted with the pulse is pinned down by the motion around it, so that it does not
 #: trade off against a short pulse
@@ -301,11 +306,14 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     energy = float(x @ x)
     candidates = []
     for shape in shapes:
-        ap, tp, t0 = _coarse(matcher, shape, tps, t[-1])
-        ap, tp, t0, idx = _refine(x, t, dt, shape, ap, tp, t0, baseline)
-        p = ap * unit_samples(shape, tp, t0, t, dt)
-        resid = x - p
-        score = 1.0 - float(resid @ resid) / energy if energy > 0 else 0.0
+        score = -np.inf
+        for start in _coarse(matcher, shape, tps, t[-1]):
+            trial = _refine(x, t, dt, shape, *start, baseline)
+            p_trial = trial[0] * unit_samples(shape, trial[1], trial[2], t, dt)
+            resid = x - p_trial
+            s = 1.0 - float(resid @ resid) / energy if energy > 0 else 0.0
+            if s > score:
+                score, (ap, tp, t0, idx), p = s, trial, p_trial
         lo, hi = pulse_window(shape, tp, t0)
         inside = (t >= lo) & (t <= hi)
         xw, pw = x[inside], p[inside]
@@ -324,12 +332,23 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
 
 
 def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
-    """Best ``(ap, Tp, t0)`` of one shape on the grid of periods and the transform's time grid."""
-    share, tp, t0 = matcher.best_match(shape, tps, t_end)
-    # share = c|c| / (||w||^2 ||x||^2) and ap = c / ||w||^2, so |ap| = sqrt(|share|) ||x|| / ||w||
-    norm_w = math.sqrt(unit_energy(shape) * tp / matcher.dt)
-    ap = math.copysign(math.sqrt(abs(share) * matcher.energy) / norm_w, share)
-    return ap, tp, t0
+    """Starting ``(ap, Tp, t0)`` of one shape: its best match, and for the antisymmetric shapes
+    the best match of the other polarity when that explains at least :data:`SECOND_START` as
+    much of the record.
+
+    An antisymmetric shape matches a record nearly as well with the opposite polarity half a
+    lobe away; refining both and keeping the better avoids settling on the wrong lobe.
+    """
+    starts = []
+    matches = matcher.best_match(shape, tps, t_end)
+    for share, tp, t0 in matches:
+        if starts and (shape not in _TWO_POLARITIES or abs(share) < SECOND_START * abs(matches[0][0])):
+            break
+        # share = c|c| / (||w||^2 ||x||^2) and ap = c / ||w||^2, so |ap| = sqrt(|share|) ||x|| / ||w||
+        norm_w = math.sqrt(unit_energy(shape) * tp / matcher.dt)
+        ap = math.copysign(math.sqrt(abs(share) * matcher.energy) / norm_w, share)
+        starts.append((ap, tp, t0))
+    return starts
 
 
 def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
