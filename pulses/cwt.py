@@ -196,15 +196,14 @@ class Matcher:
             group = tps[start:stop]
             share, tau = self._band_share(shape, group)
             if shape.startswith("ricker"):
-                ok = (tau[None, :] >= 0.0) & (tau[None, :] <= t_end)
-                ok = np.broadcast_to(ok, share.shape)
+                ok = ((tau >= 0.0) & (tau <= t_end))[None, :]
             else:
                 half = 0.5 * group[:, None]
                 ok = (tau[None, :] >= -half) & (tau[None, :] <= t_end - half)
-            for sign in (1, -1):
-                masked = np.where(ok, sign * share, -1.0)
-                i, j = np.unravel_index(int(np.argmax(masked)), masked.shape)
-                if masked[i, j] > abs(best[sign][0]):
+            masked = np.where(ok, share, 0.0)
+            for sign, k in ((1, int(np.argmax(masked))), (-1, int(np.argmin(masked)))):
+                i, j = divmod(k, masked.shape[1])
+                if sign * masked[i, j] > abs(best[sign][0]):
                     best[sign] = (float(share[i, j]), float(group[i]), float(tau[j]))
             start = stop
         return sorted(best.values(), key=lambda b: -abs(b[0]))
