@@ -9,7 +9,8 @@ speed target ("at least 1000x faster and 1000x more accurate than the usual appr
 - the ground acceleration read linearly between samples (the same forcing every model sees);
 - a terminal event at ``theta = 0`` (impact): the integration stops, ``omega`` is multiplied by
   ``eta``, the side flips and ``solve_ivp`` is restarted from there;
-- a terminal event at ``|theta| = pi/2`` (overturned);
+- a terminal event at ``|theta| = pi/2`` (overturned), and a non-terminal one at ``omega = 0``
+  so that peaks between output points are located (max|theta| is taken over both);
 - rest: a block at rest uplifts when ``|ug''| > g tan(alpha)``; after an impact whose outgoing
   velocity is below an arbitrary threshold (``rest_tol * p * alpha``) the block is put at rest (the
   usual way to stop the chatter of a Zeno sequence; the answer depends on this threshold);
@@ -114,6 +115,9 @@ def simulate_usual(block, excitation, *, method="RK45", rtol=1e-3, atol=1e-6, ma
     overturn.terminal = True
     overturn.direction = 1.0
 
+    def peak(t, y, s):  # not terminal: locates the peaks between output points
+        return y[1]
+
     t, theta, omega, s = t_start, 0.0, 0.0, 0.0
     max_abs, n_imp, restarts = 0.0, 0, 0
     while t < t_end and restarts < max_restarts:
@@ -130,9 +134,11 @@ def simulate_usual(block, excitation, *, method="RK45", rtol=1e-3, atol=1e-6, ma
         stop = t_exc_end if t < t_exc_end else t_end
         step = max_step if t < t_exc_end else np.inf
         sol = solve_ivp(rhs, (t, stop), [theta, omega], method=method, rtol=rtol, atol=atol,
-                        max_step=step, events=(impact, overturn), args=(s,))
+                        max_step=step, events=(impact, overturn, peak), args=(s,))
         restarts += 1
         max_abs = max(max_abs, float(np.max(np.abs(sol.y[0]))))
+        if sol.y_events[2].size:
+            max_abs = max(max_abs, float(np.max(np.abs(sol.y_events[2][:, 0]))))
         if sol.status == 1 and sol.t_events[1].size:
             return UsualResult(True, HALF_PI, HALF_PI / alpha, n_imp, restarts, False)
         if sol.status == 1 and sol.t_events[0].size:
