@@ -6,9 +6,8 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    pulse as mother wavelet (:mod:`pulses.cwt`), on a log-spaced grid of periods.  The best match
    maximises the share of the record's energy explained by a pulse of least-squares amplitude.
 2. **Refine** ``ap``, ``Tp`` and ``t0`` by least squares on the record's samples inside a window
-   around the pulse (:func:`scipy.optimize.least_squares`, Levenberg-Marquardt with the
-   analytic Jacobian; for the rectangle a grid search over its two edges, see
-   :func:`_refine_rect`).  A straight-line baseline is fitted
+   around the pulse (Levenberg-Marquardt with the analytic Jacobian; for the rectangle a grid
+   search over its two edges, see :func:`_refine_rect`).  A straight-line baseline is fitted
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
 
@@ -33,7 +32,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
@@ -355,7 +353,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
     """Least-squares ``(ap, Tp, t0, window)`` near a starting guess; the guess if refinement fails.
 
     Levenberg-Marquardt on the samples inside the fit window, with the analytic Jacobian; the
-    straight-line baseline ``c0 + c1 (t - tc)`` is fitted alongside when ``baseline`` is True.
+    straight-line baseline ``c0 + c1 (t - tc)`` is fitted alongside when ``baseline`` is True
+    (projected out: the residual and Jacobian are taken orthogonal to 1 and ``t - tc``).
     """
 
     def window(tp, t0):
@@ -373,46 +372,81 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         if idx.stop - idx.start < 6:
             break
         tw, xw = t[idx], x[idx]
-        tc = float(tw.mean())
-        ones, ramp = np.ones_like(tw), tw - tc
+        ramp = tw - float(tw.mean())
+        ramp_norm = float(ramp @ ramp) or 1.0
 
-        jac = np.empty((tw.size, 5 if baseline else 3))
-        if baseline:
-            jac[:, 3], jac[:, 4] = -ones, -ramp
+        def project(v):
+            """Remove the straight-line baseline (least squares on 1 and t - tc, orthogonal)."""
+            if not baseline:
+                return v
+            v = v - v.mean(axis=-1, keepdims=True)
+            if v.ndim == 1:
+                return v - ramp * ((v @ ramp) / ramp_norm)
+            return v - np.outer(v @ ramp, ramp / ramp_norm)
 
-        def residual(p):
-            m = unit_samples(shape, max(p[1], 1e-9), p[2], tw, dt)
-            r = xw - p[0] * m
-            if baseline:
-                r = r - p[3] - p[4] * ramp
-            return r
+        xp = project(xw)
 
-        def jacobian(p):
+        def residual_and_jacobian(p):
             m, d_tp, d_t0 = unit_samples_and_derivatives(shape, max(p[1], 1e-9), p[2], tw, dt)
-            jac[:, 0] = -m
-            jac[:, 1] = -p[0] * d_tp
-            jac[:, 2] = -p[0] * d_t0
-            return jac.copy()
+            cols = np.empty((3, tw.size))
+            cols[0], cols[1], cols[2] = m, d_tp, d_t0
+            cols = project(cols)
+            cols[1:] *= p[0]
+            return xp - p[0] * cols[0], -cols.T
 
-        p0 = [ap, tp, t0] + ([0.0, 0.0] if baseline else [])
         try:
-            sol = least_squares(residual, p0, jac=jacobian, method="lm", xtol=1e-8, ftol=1e-10,
-                                gtol=1e-12, max_nfev=100)
-        except (ValueError, np.linalg.LinAlgError):
+            p_new, cost = _levenberg_marquardt(residual_and_jacobian, np.array([ap, tp, t0]),
+                                               scale=np.array([abs(ap) or 1.0, tp, tp]))
+        except np.linalg.LinAlgError:
             break
-        ap_new, tp_new, t0_new = (float(v) for v in sol.x[:3])
+        ap_new, tp_new, t0_new = (float(v) for v in p_new)
         if not all(map(math.isfinite, (ap_new, tp_new, t0_new))) or tp_new <= 2 * dt:
             break
         # accept when it beats the starting (Tp, t0) on this window's own objective
-        start = np.column_stack([unit_samples(shape, tp, t0, tw, dt)] + ([ones, ramp] if baseline else []))
-        coef, *_ = np.linalg.lstsq(start, xw, rcond=None)
-        if 2.0 * sol.cost > float(np.sum((xw - start @ coef) ** 2)) * (1 + 1e-12):
+        m0 = project(unit_samples(shape, tp, t0, tw, dt))
+        start_sse = float(xp @ xp) - float(m0 @ xp) ** 2 / max(float(m0 @ m0), 1e-300)
+        if cost > start_sse * (1 + 1e-12):
             break
         best = (ap_new, tp_new, t0_new, idx)
         ap, tp, t0 = ap_new, tp_new, t0_new
         if _covers(idx, shape, tp, t0, dt, x.size):
             break
     return best
+
+
+def _levenberg_marquardt(residual_and_jacobian, p, scale, xtol=1e-10, ftol=1e-11, max_iter=100):
+    """Minimise ``||r(p)||^2`` by Levenberg-Marquardt with Marquardt's diagonal scaling.
+
+    ``residual_and_jacobian(p)`` returns ``r`` and ``dr/dp``.  A small dense solver (three
+    unknowns) without the per-call overhead of a general one.  Stops when every step is below
+    ``xtol`` times ``scale`` or the sum of squares falls by less than ``ftol`` relative.
+    Returns ``(p, sum of squares)``.
+    """
+    r, J = residual_and_jacobian(p)
+    cost = float(r @ r)
+    lam = 1e-3
+    for _ in range(max_iter):
+        A = J.T @ J
+        g = J.T @ r
+        diag = np.diag(A).copy()
+        diag[diag <= 0] = 1.0
+        while True:
+            step = np.linalg.solve(A + lam * np.diag(diag), -g)
+            trial = p + step
+            r_trial, J_trial = residual_and_jacobian(trial)
+            cost_trial = float(r_trial @ r_trial)
+            if cost_trial <= cost:
+                lam = max(lam / 10.0, 1e-12)
+                break
+            lam *= 4.0
+            if lam > 1e12:
+                return p, cost
+        small_step = bool(np.all(np.abs(step) <= xtol * scale))
+        small_gain = cost - cost_trial <= ftol * cost
+        p, cost, r, J = trial, cost_trial, r_trial, J_trial
+        if small_step or small_gain:
+            break
+    return p, cost
 
 
 def _refine_rect(x, t, dt, best, window, baseline):
