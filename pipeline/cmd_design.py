@@ -84,9 +84,10 @@ def run(args) -> int:
         values = {
             "eq31": rocking.eq31(pulse.ap, pulse.tp, p),
             "eq20": rocking.eq20(pulse.ap, pulse.tp, p, lam),
-            "envelope": rocking.envelope_rule(pulse.ap, pulse.tp, p),
+            "envelope": rocking.envelope_rule(pulse.ap, pulse.tp, p, pulse.shape),
             "exact": exact.tan_alpha,
         }
+        out["envelope_shape"] = pulse.shape
         out["block"] = {"height_m": height, "width_m": width, "p_rad_s": p,
                         "tan_alpha": block.tan_alpha, "alpha_deg": math.degrees(block.alpha),
                         "eta": block.eta, "pTp": p * pulse.tp}
@@ -95,7 +96,8 @@ def run(args) -> int:
         for name, value in values.items():
             rules[name] = {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
     for name in ("eq31", "eq20", "envelope", "exact"):
-        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=args.criterion)
+        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=args.criterion,
+                                   shape=pulse.shape)
         rules.setdefault(name, {})
         rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
                             "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
@@ -111,7 +113,8 @@ def run(args) -> int:
         print(f"Block: {height:g} x {width:g} m, p = {b['p_rad_s']:.4g} rad/s, tan(alpha) = "
               f"{b['tan_alpha']:.4g} (alpha = {b['alpha_deg']:.3g} deg), eta = {b['eta']:.3f}, "
               f"pTp = {b['pTp']:.4g}")
-    labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})", "envelope": "envelope rule",
+    labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})",
+              "envelope": f"envelope ({pulse.shape})",
               "exact": f"exact ({args.criterion})"}
     head = f"{'rule':<22}"
     if block is not None:
@@ -130,4 +133,12 @@ def run(args) -> int:
         print(f"safe islands below the exact minimum (tan alpha): {isl}")
     print("Required widths solve B = H tan(alpha_min(p(B))), p depending on B; "
           "exact: smallest width surviving at it and every larger width.")
+    lo, hi = rocking.design.ENVELOPE_RANGE["ap/g"]
+    ptp_lo, ptp_hi = rocking.design.ENVELOPE_RANGE["pTp"]
+    ptps = [rules["envelope"]["p_at_width"] * pulse.tp]
+    if block is not None:
+        ptps.append(block.p * pulse.tp)
+    if not (lo <= ap_g <= hi) or any(not (ptp_lo <= x <= ptp_hi) for x in ptps):
+        print(f"note: the envelope rule was derived for {ptp_lo:g} <= pTp <= {ptp_hi:g} and "
+              f"{lo:g} <= ap/g <= {hi:g}; outside that range rely on the exact answer.")
     return 0
