@@ -168,7 +168,7 @@ def slenderness_chart(shapes=("rect", "sine", "ricker-sym", "ricker-anti"), p_tp
     return pd.DataFrame(rows)
 
 
-def plot_chart(frame, path=None):
+def plot_chart(frame, path=None, dpi=110):
     """Draw Fig. 8 from :func:`slenderness_chart`: one panel per shape, Eq. 31 dashed over it."""
     import matplotlib
 
@@ -197,6 +197,6 @@ def plot_chart(frame, path=None):
         ax.set_visible(False)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=110)
+        fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return fig
