@@ -167,6 +167,15 @@ def main(argv=None) -> int:
 
     chart = frame[frame["pTp"].isin(CHART_PTP)]
     rocking.plot_chart(chart, out / "design_chart.png", dpi=65)
+    # Fig. 5: overturning spectra, alpha = 14 deg, for the three realisable pulses
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    for ax, s in zip(axes, REALISABLE):
+        spec = rocking.overturning_spectrum(math.radians(14.0), s, np.linspace(0.5, 12, 160),
+                                            np.linspace(1.0, 6.0, 160))
+        spec.plot(ax=ax)
+    fig.tight_layout()
+    fig.savefig(out / "spectrum_fig5.png", dpi=65)
+    plt.close(fig)
     with open(out / "envelope_fit.json", "w") as fh:
         json.dump(fits, fh, indent=1)
     return 0

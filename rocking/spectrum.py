@@ -77,8 +77,8 @@ class OverturningSpectrum:
                       shading="nearest")
         ax.set_xlabel(r"$\omega_p / p$")
         ax.set_ylabel(r"$a_p / (g \tan\alpha)$")
-        ax.set_title(f"{self.shape} pulse, alpha = {math.degrees(self.alpha):.3g} deg: "
-                     "survive / |theta|>alpha / overturn", fontsize=9)
+        ax.set_title(f"{self.shape} pulse, alpha = {math.degrees(self.alpha):.3g} deg\n"
+                     "green: survive, yellow: |theta| > alpha, red: overturn", fontsize=8)
         if fig is not None:
             fig.tight_layout()
             if path is not None:
