@@ -359,7 +359,7 @@ def _unit_pulse(shape, tp):
 
 
 def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_scan=N_SCAN,
-                          rtol=RTOL, model="fast"):
+                          n_zone=None, rtol=RTOL, model="fast"):
     """Exact minimum slenderness for many ``(pTp, ap/g)`` points of one pulse shape at once.
 
     By the similarity law (SPEC section 4) the answer depends only on ``pTp`` and ``ap/g``, so
@@ -383,7 +383,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
         blocks = [Block(float(p_tp[i]), math.atan(t)) for i, t in zip(idx, tans)]
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol)
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, zone=n_zone != 0, n_zone=n_zone)
     out = []
     for i in range(p_tp.size):
         br = scan.brackets[i]
@@ -400,7 +400,8 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     return out
 
 
-def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL, model="fast"):
+def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, n_zone=None, rtol=RTOL,
+                    model="fast"):
     """Exact minimum slenderness (SPEC section 5, the paper's Fig. 8).
 
     The smallest ``tan(alpha)`` for which a block of frequency parameter ``p`` survives
@@ -418,8 +419,11 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL,
         Frequency parameter of the block, rad/s.
     criterion : {"overturn", "exceed"}
         What counts as failure: overturning, or ``|theta|`` passing ``alpha``.
-    n_scan, rtol : int, float
-        Scan density and bracket tolerance.
+    n_scan, n_zone, rtol : int, int, float
+        Uniform scan points; points of the dense zone scanned just above the highest failure
+        (default :data:`ZONE_POINTS`; 0 switches the zone off: about 3x fewer runs, but failure
+        slivers thinner than the scan step above the main boundary, found at large pTp, may then
+        be missed); relative width of the final brackets.
     model : str
         Solver model of :func:`rocking.simulate_many` (``"fast"`` or ``"reference"``).
 
@@ -436,7 +440,8 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL,
         if pulse.ap == 0:
             return MinSlenderness(0.0, (), p, criterion, 0.0, 0.0, 0, pulse)
         res = min_slenderness_batch(pulse.shape, p * pulse.tp, abs(pulse.ap) / G,
-                                    criterion=criterion, n_scan=n_scan, rtol=rtol, model=model)[0]
+                                    criterion=criterion, n_scan=n_scan, n_zone=n_zone, rtol=rtol,
+                                    model=model)[0]
         res.p, res.excitation = p, pulse
         return res
     # a record (or any excitation the solver accepts): scan tan(alpha) directly
@@ -450,7 +455,8 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL,
         blocks = [Block(p, math.atan(t)) for t in tans]
         return _failed(_batch(blocks, pulse, None, model=model), criterion)
 
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="top")
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="top", zone=n_zone != 0,
+                        n_zone=n_zone)
     br = scan.brackets[0]
     tan_alpha = 0.0
     for lo, hi, flo, fhi in br:
@@ -675,7 +681,7 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
 
     is_pulse = getattr(excitation, "shape", "record") in ("rect", "sine", "ricker-sym", "ricker-anti")
     scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="all" if is_pulse else "top",
-                        n_zone=n_zone)
+                        zone=n_zone != 0, n_zone=n_zone)
     br = scan.brackets[0]
     width, n_iter = 0.0, scan.calls
     for lo, hi, flo, fhi in br:
