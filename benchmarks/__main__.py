@@ -3,4 +3,5 @@ import sys
 
 from benchmarks.run import main
 
-sys.exit(main())
+if __name__ == "__main__":  # not in the worker processes of `pipeline run --jobs N` (forkserver)
+    sys.exit(main())

@@ -711,7 +711,9 @@ def section_solver(md, out, quick, records, rec_notes):
     md.append("| transition | x* (reference) | fast x*/x_ref - 1 | seconds to find |")
     md.append("|---|---|---|---|")
     for label, blk, make, x_ref, x_fast, sec in trans + rtrans:
-        md.append(f"| {label} | {x_ref:.10g} | {x_fast / x_ref - 1:+.1e} | {sec:.1f} |")
+        rel = x_fast / x_ref - 1
+        rel_s = f"{rel:+.1e}" if abs(rel) > 2e-10 else f"{rel:+.1e} (within the 1e-10 bisection tolerance)"
+        md.append(f"| {label} | {x_ref:.10g} | {rel_s} | {sec:.1f} |")
     md.append("")
     md.append("Pulses (each count is wrong verdicts / points at that distance):\n")
     md.append("| model / setting | wrong within 1e-2 | within 1e-4 | within 1e-6 |")
@@ -747,12 +749,13 @@ def section_linear(md, out, quick, records):
     p = 1.381
     tans = (0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5) if not quick else (0.01, 0.05, 0.2, 0.5)
     combos = [(1.0, 3.0), (2.0, 1.5), (4.0, 2.5)] if not quick else [(2.0, 1.5), (4.0, 2.5)]
-    recs = records[:3] if not quick else records[:1]
+    recs = records[:6] if not quick else records[:1]
     rows = []
     t_lin, t_fast = [], []
     for tan in tans:
         blk = Block.from_tan_alpha(p, tan)
         errs, wrong, n = [], 0, 0
+        kinds = []  # (error, "pulse"/"record", label) per surviving case
         cases = []
         for shape in ("rect", "sine", "ricker-sym", "ricker-anti"):
             for ptp, ratio in combos:
@@ -770,14 +773,20 @@ def section_linear(md, out, quick, records):
                 wrong += 1
             elif not truth.overturned:
                 errs.append(abs(lin.max_rotation_ratio - truth.max_rotation_ratio))
+                kinds.append((errs[-1], "record" if hasattr(exc, "dt") else "pulse",
+                              getattr(exc, "name", None) if hasattr(exc, "dt") else repr(exc)))
         # one record and one pulse for speed
         exc = cases[5]
         t_lin.append(per_call(lambda: rocking.simulate(blk, exc, model="linear", history=False), 0.02, 3))
         t_fast.append(per_call(lambda: rocking.simulate(blk, exc, model="fast", history=False), 0.02, 3))
         alpha = blk.alpha
         emax = max(errs) if errs else math.nan
+        ep = max([e for e, k, _ in kinds if k == "pulse"], default=math.nan)
+        er = max([e for e, k, _ in kinds if k == "record"], default=math.nan)
+        worst = max(kinds)[2] if kinds else ""
         rows.append(dict(tan=tan, alpha=alpha, n=n, wrong=wrong, emax=emax,
-                         emed=statistics.median(errs) if errs else math.nan, coeff=emax / alpha**2))
+                         emed=statistics.median(errs) if errs else math.nan, coeff=emax / alpha**2,
+                         cp=ep / alpha**2, cr=er / alpha**2, worst=worst))
         log(f"  tan alpha {tan}: max error {fmt_e(emax)}, error/alpha^2 {emax / alpha**2:.3g}, wrong {wrong}/{n}")
     # spot check against the reference at one slenderness
     blk = Block.from_tan_alpha(p, 0.05)
@@ -817,17 +826,24 @@ def section_linear(md, out, quick, records):
               "and to the figures of section 1 elsewhere), p = 1.381 rad/s, on the four shapes at (pTp, ap/(g tan alpha)) = "
               + ", ".join(f"({a:g}, {b:g})" for a, b in combos) +
               f" and {len(recs)} real record(s) at PGA = 1.5 g tan alpha. Verdict disagreements are counted apart.\n")
-    md.append("| tan alpha | alpha (rad) | cases | max error | median error | max error / alpha^2 | wrong verdicts | time linear / fast (one pulse) |")
-    md.append("|---|---|---|---|---|---|---|---|")
+    md.append("| tan alpha | alpha (rad) | cases | max error | median error | max error / alpha^2: pulses | records | worst case | wrong verdicts | time linear / fast (one pulse) |")
+    md.append("|---|---|---|---|---|---|---|---|---|---|")
     for r, tl, tf in zip(rows, t_lin, t_fast):
         md.append(f"| {r['tan']:g} | {r['alpha']:.4g} | {r['n']} | {fmt_e(r['emax'])} | {fmt_e(r['emed'])} | "
-                  f"{r['coeff']:.3g} | {r['wrong']} | {fmt_t(tl)} / {fmt_t(tf)} |")
+                  f"{r['cp']:.3g} | {r['cr']:.3g} | {r['worst']} | {r['wrong']} | {fmt_t(tl)} / {fmt_t(tf)} |")
+    cp = max((r["cp"] for r in rows if math.isfinite(r["cp"])), default=math.nan)
+    cr = max((r["cr"] for r in rows if math.isfinite(r["cr"])), default=math.nan)
+    out["linear"].update(coeff_pulses=cp, coeff_records=cr)
     ok = measured <= LINEAR_ERROR_COEFF
     md.append("")
     md.append(f"`model=\"auto\"` uses the linearised model when `LINEAR_ERROR_COEFF * alpha**2 <= tol`, with "
               f"`LINEAR_ERROR_COEFF = {LINEAR_ERROR_COEFF:g}`. The largest measured error/alpha^2 is **{measured:.3g}**: "
               + ("the coefficient is an upper bound of every measured case." if ok else
-                 f"**the coefficient is NOT an upper bound; the measured worst case is {measured:.3g}.**"))
+                 f"**the coefficient is NOT an upper bound; the measured worst case is {measured:.3g}** "
+                 f"(pulses alone: {cp:.3g}; records: {cr:.3g}). On pulses the error does grow like alpha^2; on long "
+                 "broadband records with hundreds of small impacts the two models' impact sequences drift apart "
+                 "(the fast engine and the reference agree there to 1e-10), so the error is not bounded by a "
+                 "multiple of alpha^2 alone."))
     md.append("")
     md.append("| tol | auto switches to linear for alpha below | tan alpha below | a column 1 m wide would be taller than |")
     md.append("|---|---|---|---|")
@@ -1064,6 +1080,17 @@ def section_design(md, out, quick):
         pulse = make_pulse(shape, 0.71 * G, 0.8)
         res[f"min_slenderness {shape}"] = per_call(lambda: rocking.min_slenderness(pulse, 1.381), 0.5, 3)
         log(f"  min_slenderness {shape}: {fmt_t(res[f'min_slenderness {shape}'])}")
+    import numba
+
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        for shape in ("sine", "ricker-sym"):
+            pulse = make_pulse(shape, 0.71 * G, 0.8)
+            res[f"min_slenderness {shape} 1 thread"] = per_call(lambda: rocking.min_slenderness(pulse, 1.381), 0.5, 3)
+            log(f"  min_slenderness {shape}, one thread: {fmt_t(res[f'min_slenderness {shape} 1 thread'])}")
+    finally:
+        numba.set_num_threads(threads)
     alpha = math.radians(14.0)
     wp, ratio = np.linspace(0.5, 12, 200), np.linspace(1, 6, 200)
     for shape in (("sine",) if quick else ("sine", "ricker-sym")):
@@ -1089,8 +1116,12 @@ def section_design(md, out, quick):
     md.append("| task | time | target |")
     md.append("|---|---|---|")
     for shape in ("rect", "sine", "ricker-sym", "ricker-anti"):
-        md.append(f"| exact minimum slenderness, {shape} 0.71 g, 0.8 s, p = 1.381 (median) | "
-                  f"{fmt_t(res[f'min_slenderness {shape}'])} | < 20 ms |")
+        t = res[f"min_slenderness {shape}"]
+        md.append(f"| exact minimum slenderness, {shape} 0.71 g, 0.8 s, p = 1.381: median (best) | "
+                  f"{fmt_t(t)} ({fmt_t(t.best)}) | < 20 ms |")
+        t1 = res.get(f"min_slenderness {shape} 1 thread")
+        if t1 is not None:
+            md.append(f"| the same with numba limited to one thread: median (best) | {fmt_t(t1)} ({fmt_t(t1.best)}) | |")
     for key, value in res.items():
         if key.startswith("spectrum"):
             md.append(f"| overturning {key} (one run) | {value:.2f} s | < 5 s |")
@@ -1137,6 +1168,12 @@ def section_pipeline(md, out, quick):
                                      "-q", "--jobs", "2"])
         res["cold_jobs2"] = n / cold
         log(f"  cold (fresh process), --jobs 2: {res['cold_jobs2']:.2f} records/s")
+        env = dict(os.environ, NUMBA_NUM_THREADS="1")
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "pipeline", "run", *recs, *bp.COLUMNS, "--out", str(tmp / "c2t1"),
+                        "--no-plots", "-q", "--jobs", "2"], capture_output=True, env=env, cwd=str(ROOT))
+        res["cold_jobs2_t1"] = n / (time.perf_counter() - t0)
+        log(f"  cold, --jobs 2, NUMBA_NUM_THREADS=1: {res['cold_jobs2_t1']:.2f} records/s")
         res["identical"] = all((tmp / "o1" / f).read_bytes() == (tmp / "o2" / f).read_bytes()
                                for f in ("summary.csv", "failures.csv") if (tmp / "o1" / f).exists())
         per_len = {}
@@ -1160,6 +1197,7 @@ def section_pipeline(md, out, quick):
     md.append("|---|---|---|")
     md.append(f"| warm, records/s | {res['warm_jobs1']:.2f} | {res['warm_jobs2']:.2f} |")
     md.append(f"| cold, records/s | - | {res['cold_jobs2']:.2f} |")
+    md.append(f"| cold, records/s, `NUMBA_NUM_THREADS=1` | - | {res['cold_jobs2_t1']:.2f} |")
     md.append(f"| exit status | {res['code_jobs1']} | {res['code_jobs2']} |")
     md.append(f"\nSpeed-up from 1 to 2 jobs (warm): {res['warm_jobs2'] / res['warm_jobs1']:.2f}x; "
               f"summary.csv and failures.csv identical for --jobs 1 and 2: {res['identical']}.\n")
