@@ -44,6 +44,12 @@ GAUS3_TP_PER_SCALE = 2.0 * math.pi / math.sqrt(6.0)
 PYWT_WAVELETS = {"ricker-sym": ("mexh", MEXH_TP_PER_SCALE), "ricker-anti": ("gaus3", GAUS3_TP_PER_SCALE)}
 
 
+def _dot(a, b) -> float:
+    """``sum(a * b)`` without BLAS: a multithreaded BLAS dot on long vectors (OpenBLAS uses
+    threads above 10 000 samples) can stall for milliseconds on a busy machine."""
+    return float(np.einsum("i,i->", a, b))
+
+
 def tp_from_scale(shape: str, scale: float, dt: float = 1.0) -> float:
     """Pulse period Tp (s) of PyWavelets' ``mexh``/``gaus3`` at ``scale`` (in samples of ``dt`` s)."""
     return PYWT_WAVELETS[shape][1] * scale * dt
@@ -142,7 +148,7 @@ class Matcher:
         self.freq = np.arange(m) / (self.nfft * dt)
         self.period = self.nfft * dt
         self.dtau = self.period / self.n_out
-        self.energy = float(acc @ acc)
+        self.energy = _dot(acc, acc)
         self.tp_max = float(tp_max)
 
     def transform(self, shape: str, tps) -> tuple[np.ndarray, np.ndarray]:

@@ -35,7 +35,7 @@ import numpy as np
 
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
-from .cwt import Matcher, unit_energy
+from .cwt import Matcher, _dot, unit_energy
 from .record import G, Record
 from .shapes import BETA, SHAPES, Pulse, make_pulse
 
@@ -307,7 +307,7 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     matcher = Matcher(x, dt, tp_min, tp_max)
     n_grid = max(2, int(math.ceil(math.log(tp_max / tp_min) / math.log(GRID_RATIO))) + 1)
     tps = np.geomspace(tp_min, tp_max, n_grid)
-    energy = float(x @ x)
+    energy = _dot(x, x)
     candidates = []
     for shape in shapes:
         score = -np.inf
@@ -315,14 +315,14 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
             trial = _refine(x, t, dt, shape, *start, baseline)
             p_trial = trial[0] * unit_samples(shape, trial[1], trial[2], t, dt)
             resid = x - p_trial
-            s = 1.0 - float(resid @ resid) / energy if energy > 0 else 0.0
+            s = 1.0 - _dot(resid, resid) / energy if energy > 0 else 0.0
             if s > score:
                 score, (ap, tp, t0, idx), p = s, trial, p_trial
         lo, hi = pulse_window(shape, tp, t0)
         inside = (t >= lo) & (t <= hi)
         xw, pw = x[inside], p[inside]
-        denom = math.sqrt(float(xw @ xw) * float(pw @ pw))
-        corr = float(xw @ pw) / denom if denom > 0 else 0.0
+        denom = math.sqrt(_dot(xw, xw) * _dot(pw, pw))
+        corr = _dot(xw, pw) / denom if denom > 0 else 0.0
         t0_abs = t0 + record.t_start
         window = None if idx is None else (record.t_start + idx.start * dt, record.t_start + (idx.stop - 1) * dt)
         candidates.append(Candidate(shape, ap, tp, t0_abs, score, corr, make_pulse(shape, ap, tp, t0_abs),
@@ -379,7 +379,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
             break
         tw, xw = t[idx], x[idx]
         ramp = tw - float(tw.mean())
-        ramp_norm = float(ramp @ ramp) or 1.0
+        ramp_norm = _dot(ramp, ramp) or 1.0
 
         def project(v):
             """Remove the straight-line baseline (least squares on 1 and t - tc, orthogonal)."""
@@ -387,8 +387,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
                 return v
             v = v - v.mean(axis=-1, keepdims=True)
             if v.ndim == 1:
-                return v - ramp * ((v @ ramp) / ramp_norm)
-            return v - np.outer(v @ ramp, ramp / ramp_norm)
+                return v - ramp * (_dot(v, ramp) / ramp_norm)
+            return v - np.outer(np.einsum("ij,j->i", v, ramp), ramp / ramp_norm)
 
         xp = project(xw)
 
@@ -412,7 +412,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
             break
         # accept when it beats the starting (Tp, t0) on this window's own objective
         m0 = project(unit_samples(shape, tp, t0, tw, dt))
-        start_sse = float(xp @ xp) - float(m0 @ xp) ** 2 / max(float(m0 @ m0), 1e-300)
+        start_sse = _dot(xp, xp) - _dot(m0, xp) ** 2 / max(_dot(m0, m0), 1e-300)
         if cost > start_sse * (1 + 1e-12):
             break
         best = (ap_new, tp_new, t0_new, idx)
@@ -422,7 +422,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
     return best
 
 
-def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-10, ftol=1e-11,
+def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-10, ftol=1e-9,
                          max_iter=100):
     """Minimise ``||r(p)||^2`` by Levenberg-Marquardt with Marquardt's diagonal scaling.
 
@@ -433,11 +433,11 @@ def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-
     relative.  Returns ``(p, sum of squares)``.
     """
     r, J = residual_and_jacobian(p)
-    cost = float(r @ r)
+    cost = _dot(r, r)
     lam = 1e-3
     for _ in range(max_iter):
-        A = J.T @ J
-        g = J.T @ r
+        A = np.einsum("ij,ik->jk", J, J)
+        g = np.einsum("ij,i->j", J, r)
         diag = np.diag(A).copy()
         diag[diag <= 0] = 1.0
         while True:
@@ -445,7 +445,7 @@ def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-
             trial = p + step
             if np.all(trial >= lower) and np.all(trial <= upper):
                 r_trial, J_trial = residual_and_jacobian(trial)
-                cost_trial = float(r_trial @ r_trial)
+                cost_trial = _dot(r_trial, r_trial)
             else:
                 cost_trial = np.inf
             if cost_trial <= cost:
@@ -484,9 +484,9 @@ def _refine_rect(x, t, dt, best, window, baseline, tp0, t00):
         ramp = tw - tc if baseline else np.zeros(n)
         # with the baseline (columns 1 and t - tc, orthogonal since tc is the mean time) projected
         # out, the amplitude and the remaining sum of squares follow from a few dot products
-        n_ramp = float(ramp @ ramp) or 1.0
-        x_perp = xw - (xw.mean() + ramp * (ramp @ xw) / n_ramp if baseline else 0.0)
-        sxx = float(x_perp @ x_perp)
+        n_ramp = _dot(ramp, ramp) or 1.0
+        x_perp = xw - (xw.mean() + ramp * _dot(ramp, xw) / n_ramp if baseline else 0.0)
+        sxx = _dot(x_perp, x_perp)
         prefix_x = np.concatenate([[0.0], np.cumsum(x_perp)])
         prefix_r = np.concatenate([[0.0], np.cumsum(ramp)])
 
