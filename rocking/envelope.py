@@ -163,7 +163,7 @@ def main(argv=None) -> int:
     fig.savefig(out / "design_ratio.png", dpi=90)
     plt.close(fig)
 
-    from rocking.spectrum import CHART_APG, CHART_PTP
+    from rocking.spectrum import CHART_PTP
 
     chart = frame[frame["pTp"].isin(CHART_PTP)]
     rocking.plot_chart(chart, out / "design_chart.png", dpi=65)
