@@ -207,6 +207,23 @@ def test_safe_island_found_and_confirmed():
         assert r.overturned is expect
 
 
+def test_slenderness_island_below_the_exact_minimum():
+    """A safe island in tan(alpha): why one bisection on (0, ap/g] cannot be trusted."""
+    pulse = make_pulse("ricker-sym", *RINALDI)
+    ms = rocking.min_slenderness(pulse, 1.381)
+    # measured: fails below 0.01054, survives 0.01054-0.02413, fails again up to 0.13341
+    assert ms.tan_alpha == pytest.approx(0.13341, abs=1e-4)
+    assert len(ms.safe_islands) == 1
+    low, high = ms.safe_islands[0]
+    assert (low, high) == pytest.approx((0.01054, 0.02413), abs=1e-4)
+    # the reference solver agrees on each side
+    for tan, expect in [(0.5 * low, True), (0.5 * (low + high), False),
+                        (0.5 * (high + ms.tan_alpha), True), (1.01 * ms.tan_alpha, False)]:
+        r = rocking.simulate(Block.from_tan_alpha(1.381, tan), pulse, model="reference",
+                             history=False)
+        assert r.overturned is expect, tan
+
+
 def test_overturning_spectrum_matches_direct_simulation():
     alpha = math.radians(14.0)
     wp = np.array([1.0, 3.0, 6.0])
