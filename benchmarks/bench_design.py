@@ -1,6 +1,7 @@
 """Speed (and accuracy) of the design layer: issue 4's targets on this 2-core machine.
 
-    python benchmarks/bench_design.py
+    python benchmarks/bench_design.py            # timings (about 2 minutes)
+    python benchmarks/bench_design.py --brute    # also: the scan against a brute-force scan
 
 Targets: one exact minimum slenderness < 20 ms; a 200 x 200 overturning spectrum < 5 s; the
 whole Fig. 8 chart (4 shapes x 8 pTp x 20 ap/g) < 60 s.  Also measured: the verified width of
@@ -91,5 +92,36 @@ def run() -> dict:
     return out
 
 
+def brute_force_check() -> dict:
+    """The default scan (64 points + dense top zone) against a 3000-point uniform scan without zone.
+
+    240 hard cases: one-sine and both Rickers at pTp = 4, 6, 10, 20 and 20 values of ap/g, where
+    thin failure slivers lie above the main overturning boundary.  Returns the largest relative
+    differences (negative: the default answer is lower, i.e. it missed a sliver the brute force
+    found; positive: it found one the brute force missed).
+    """
+    from rocking import design
+    from rocking.spectrum import CHART_APG
+
+    pt, ag = np.meshgrid([4.0, 6.0, 10.0, 20.0], CHART_APG, indexing="ij")
+    worst_low, worst_high = 0.0, 0.0
+    t = time.perf_counter()
+    for shape in ("sine", "ricker-sym", "ricker-anti"):
+        ours = design.min_slenderness_batch(shape, pt.ravel(), ag.ravel())
+        brute = design.min_slenderness_batch(shape, pt.ravel(), ag.ravel(), n_scan=3000, n_zone=0)
+        d = np.array([a.tan_alpha / b.tan_alpha - 1.0 for a, b in zip(ours, brute)])
+        worst_low, worst_high = min(worst_low, d.min()), max(worst_high, d.max())
+    out = {"brute_force_cases": int(3 * pt.size), "brute_force_max_low": float(f"{worst_low:.3g}"),
+           "brute_force_max_high": float(f"{worst_high:.3g}"),
+           "brute_force_s": round(time.perf_counter() - t, 1)}
+    for key, value in out.items():
+        print(f"{key:<44}  {value}")
+    return out
+
+
 if __name__ == "__main__":
+    import sys
+
     run()
+    if "--brute" in sys.argv[1:]:
+        brute_force_check()

@@ -8,8 +8,9 @@ Exact answers (time-history analysis with the batch solver)
     safe islands of Fig. 5) and :func:`required_width` (sizing a column of given height).
 
 Overturning is not monotonic in either the amplitude or the slenderness, so every exact answer is
-found by a scan fine enough to see the islands followed by bracketed refinement of *every* verdict
-change found (vectorised: all brackets are bisected together, one batch-solver call per step).
+found by a scan fine enough to see the islands (denser just above the highest failure) followed by
+bracketed refinement of every verdict change found (vectorised: all brackets of all problems are
+cut together, one batch-solver call per step).
 """
 from __future__ import annotations
 
@@ -173,8 +174,8 @@ class _Scan:
 #: top zone of the scan: above the highest failing point found, ``ZONE_POINTS`` more points over
 #: ``ZONE_FRACTION`` of its value, repeated while failures keep turning up in the zone's upper
 #: half (at most ``ZONE_ROUNDS`` times).  Failure slivers just above the main boundary (long
-#: pulses) are thinner than the coarse step; see ``benchmarks/bench_design.py`` for the check
-#: against a 20x finer brute-force scan.
+#: pulses) are thinner than the coarse step; ``python benchmarks/bench_design.py --brute`` checks
+#: the result against a 3000-point brute-force scan (agreement 5e-4 relative on 240 hard cases).
 ZONE_FRACTION = 0.15
 ZONE_POINTS = 160
 ZONE_ROUNDS = 4
