@@ -14,7 +14,7 @@ import pytest
 import pulses
 import rocking
 from pipeline import report
-from pipeline.batch import Column, record_ids
+from pipeline.batch import Column, Options, record_ids
 from pipeline.cli import main
 from pulses import G
 
@@ -159,6 +159,42 @@ def test_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
         report.write_atomic(target, "new content\n")
     assert target.read_text() == "old\n"
     assert [p.name for p in tmp_path.iterdir()] == ["summary.csv"]
+
+
+def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
+    """SIGINT in the middle of a batch: exit 130, no temporary files, every CSV complete."""
+    import signal
+    import time
+
+    out = tmp_path / "out"
+    good = [p for p in batch20 if "good" in p]
+    proc = subprocess.Popen([sys.executable, "-m", "pipeline", "run", *good, *BATCH_ARGS, "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(out.glob("good*.csv"))) < 2 and proc.poll() is None:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "interrupted" in err and "Traceback" not in err
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
+    for path in files:  # every report written is whole: the header and one row
+        rows = read_csv(path)
+        assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
+
+
+def test_progress_bar_only_when_asked_or_on_a_terminal(tmp_path, capsys):
+    from pipeline.runner import run
+
+    rec = write_good(tmp_path, 3)
+    opts = Options(shapes=("sine",), plots=False)
+    run([str(rec)], [Column(6.0)], tmp_path / "a", options=opts, progress=True)
+    err = capsys.readouterr().err
+    assert "pipeline run" in err and "1/1" in err  # tqdm's bar
+    run([str(rec)], [Column(6.0)], tmp_path / "b", options=opts, quiet=True)
+    captured = capsys.readouterr()
+    assert captured.err == "" and captured.out == ""  # --quiet: silent
 
 
 def test_record_ids_are_unique_and_safe():
