@@ -190,11 +190,14 @@ class Matcher:
 
         Returns
         -------
-        list of (float, float, float)
+        polarities : list of (float, float, float)
             The best positive and the best negative match, the better first.
+        octaves : list of (float, float, float)
+            The best match (either polarity) of each octave of periods, the better first.
         """
         tps = np.sort(np.asarray(tps, dtype=float))
         best = {1: (0.0, float(tps[0]), 0.0), -1: (-0.0, float(tps[0]), 0.0)}
+        octaves = []
         start = 0
         while start < tps.size:
             stop = int(np.searchsorted(tps, 2.0 * tps[start], side="left"))
@@ -207,12 +210,17 @@ class Matcher:
                 half = 0.5 * group[:, None]
                 ok = (tau[None, :] >= -half) & (tau[None, :] <= t_end - half)
             masked = np.where(ok, share, 0.0)
+            in_octave = []
             for sign, k in ((1, int(np.argmax(masked))), (-1, int(np.argmin(masked)))):
                 i, j = divmod(k, masked.shape[1])
+                match = (float(share[i, j]), float(group[i]), float(tau[j]))
+                in_octave.append(match)
                 if sign * masked[i, j] > abs(best[sign][0]):
-                    best[sign] = (float(share[i, j]), float(group[i]), float(tau[j]))
+                    best[sign] = match
+            octaves.append(max(in_octave, key=lambda b: abs(b[0])))
             start = stop
-        return sorted(best.values(), key=lambda b: -abs(b[0]))
+        by_size = lambda b: -abs(b[0])  # noqa: E731
+        return sorted(best.values(), key=by_size), sorted(octaves, key=by_size)
 
     def _band_share(self, shape, group):
         m = int(math.ceil(BAND_CYCLES / group[0] * self.nfft * self.dt)) + 1

@@ -336,18 +336,28 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
 
 
 def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
-    """Starting ``(ap, Tp, t0)`` of one shape: its best match, and for the antisymmetric shapes
-    the best match of the other polarity when that explains at least :data:`SECOND_START` as
-    much of the record.
+    """Starting ``(ap, Tp, t0)`` of one shape for the least squares.
 
-    An antisymmetric shape matches a record nearly as well with the opposite polarity half a
-    lobe away; refining both and keeping the better avoids settling on the wrong lobe.
+    The best match; for the antisymmetric shapes also the best match of the other polarity, and
+    for every shape the best match of a clearly different period (another octave), each when it
+    explains at least :data:`SECOND_START` as much of the record.  An antisymmetric shape
+    matches nearly as well with the opposite polarity half a lobe away, and in strong background
+    motion a pulse and a swell of another period can match about equally: refining both and
+    keeping the better avoids settling on the wrong one.
     """
-    starts = []
-    matches = matcher.best_match(shape, tps, t_end)
-    for share, tp, t0 in matches:
-        if starts and (shape not in _TWO_POLARITIES or abs(share) < SECOND_START * abs(matches[0][0])):
+    polarities, octaves = matcher.best_match(shape, tps, t_end)
+    first = polarities[0]
+    picks = [first]
+    if shape in _TWO_POLARITIES and abs(polarities[1][0]) >= SECOND_START * abs(first[0]):
+        picks.append(polarities[1])
+    for match in octaves:
+        if abs(match[0]) < SECOND_START * abs(first[0]):
             break
+        if not (first[1] / TP_LEASH <= match[1] <= first[1] * TP_LEASH):
+            picks.append(match)
+            break
+    starts = []
+    for share, tp, t0 in picks:
         # share = c|c| / (||w||^2 ||x||^2) and ap = c / ||w||^2, so |ap| = sqrt(|share|) ||x|| / ||w||
         norm_w = math.sqrt(unit_energy(shape) * tp / matcher.dt)
         ap = math.copysign(math.sqrt(abs(share) * matcher.energy) / norm_w, share)
