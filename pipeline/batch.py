@@ -135,14 +135,25 @@ def failure(task: Task, stage: str, exc: BaseException) -> dict:
             "error": type(exc).__name__, "reason": reason}
 
 
+def _interrupted(exc: BaseException) -> bool:
+    """True if ``exc`` is, or was caused by, Ctrl-C (compiled code wraps it in a SystemError)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def _stage(stage, fn, *args, **kwargs):
     try:
         return fn(*args, **kwargs)
     except (KeyboardInterrupt, SystemExit):
         raise
-    except MemoryError as exc:
-        raise StageError(stage, exc) from exc
     except Exception as exc:  # every failure of a record is reported, never raised
+        if _interrupted(exc):
+            raise KeyboardInterrupt from exc
         raise StageError(stage, exc) from exc
 
 

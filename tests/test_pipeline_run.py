@@ -168,14 +168,18 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
 
     out = tmp_path / "out"
     good = [p for p in batch20 if "good" in p]
-    proc = subprocess.Popen([sys.executable, "-m", "pipeline", "run", *good, *BATCH_ARGS, "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    args = [a for a in BATCH_ARGS if a != "--quiet"]
+    # SIGINT may be ignored by a test runner started in the background: restore the default, so
+    # that the child gets Python's KeyboardInterrupt as at an interactive terminal
+    proc = subprocess.Popen([sys.executable, "-m", "pipeline", "run", *good, *args, "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.time() + 120
     while time.time() < deadline and len(list(out.glob("good*.csv"))) < 2 and proc.poll() is None:
         time.sleep(0.05)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
+    stdout, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stdout + err
     assert "interrupted" in err and "Traceback" not in err
     files = [p for p in out.rglob("*") if p.is_file()]
     assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
