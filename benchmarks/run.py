@@ -812,7 +812,8 @@ def section_linear(md, out, quick, records):
 
     fig, ax = plt.subplots(figsize=(6.2, 4.6))
     a = np.array([r["alpha"] for r in rows])
-    ax.loglog(a, [r["emax"] for r in rows], "o-", label="linear: max error")
+    ax.loglog(a, [r["cp"] * r["alpha"] ** 2 for r in rows], "o-", label="linear: max error, pulses")
+    ax.loglog(a, [r["cr"] * r["alpha"] ** 2 for r in rows], "^-", label="linear: max error, records")
     ax.loglog(a, [r["emed"] for r in rows], "s--", label="linear: median error")
     aa = np.geomspace(a.min(), a.max(), 50)
     ax.loglog(aa, LINEAR_ERROR_COEFF * aa**2, "k:", label=f"bound used by auto: {LINEAR_ERROR_COEFF:g} alpha^2")
@@ -961,9 +962,12 @@ def section_cost(md, out, quick, records):
     a1.legend(fontsize=8)
     a1.set_title("Cost against record length (Temple column)")
     N = [r["N"] for r in brows]
-    a2.loglog(N, [r["tp"] for r in brows], "o-", label="one-sine pulse")
-    a2.loglog([r["N"] for r in brows if math.isfinite(r["tr"])], [r["tr"] for r in brows if math.isfinite(r["tr"])],
-              "s-", label="20 s record, 200 Hz")
+    a2.loglog(N, [r["tp"] for r in brows], "o-", color="C0", label="one-sine pulse: median")
+    a2.loglog(N, [r["tp"].best for r in brows], "o--", color="C0", alpha=0.6, label="one-sine pulse: best")
+    fin = [r for r in brows if math.isfinite(r["tr"])]
+    a2.loglog([r["N"] for r in fin], [r["tr"] for r in fin], "s-", color="C1", label="20 s record, 200 Hz: median")
+    a2.loglog([r["N"] for r in fin], [r["tr"].best for r in fin], "s--", color="C1", alpha=0.6,
+              label="20 s record, 200 Hz: best")
     a2.set_xlabel("blocks in one simulate_many call")
     a2.set_ylabel("time per call (s)")
     a2.grid(True, which="both", alpha=0.3)
