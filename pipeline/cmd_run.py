@@ -14,9 +14,9 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
     parser.add_argument("--out", metavar="DIR", default=default_out,
                         help=f"folder for the reports (default ./{default_out}); re-running into it "
                              "gives identical files")
-    parser.add_argument("--jobs", "-j", metavar="N", default="1",
-                        help="number of worker processes (default 1; 0 = one per CPU); the output "
-                             "does not depend on it")
+    parser.add_argument("--jobs", "-j", metavar="N", default=None,
+                        help="number of worker processes (default 1, or one per CPU with --dask "
+                             "local; 0 = one per CPU); the output does not depend on it")
     parser.add_argument("--dask", metavar="SCHEDULER",
                         help="distribute records over a dask.distributed cluster: a scheduler "
                              "address (tcp://host:8786) or 'local' for a local cluster of --jobs "
@@ -55,7 +55,10 @@ def add_parser(subparsers) -> None:
     p.set_defaults(func=main)
 
 
-def parse_jobs(text) -> int:
+def parse_jobs(text) -> int | None:
+    """``--jobs``: None when not given, else a positive count (0 means one per CPU)."""
+    if text is None:
+        return None
     try:
         jobs = int(str(text))
     except ValueError:

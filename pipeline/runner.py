@@ -146,17 +146,18 @@ def _dask(tasks, address, jobs):
             cluster.close()
 
 
-def execute(tasks, jobs: int = 1, dask: str | None = None):
+def execute(tasks, jobs: int | None = 1, dask: str | None = None):
     """Results of :func:`process_record` for every task, in completion order."""
     if dask:
         return _dask(tasks, dask, jobs)
+    jobs = jobs or 1
     if jobs <= 1 or len(tasks) <= 1:
         return _serial(tasks)
     return _pool(tasks, min(jobs, len(tasks)))
 
 
 # -- the whole run -----------------------------------------------------------------------------------
-def run(paths, columns, out, *, options: Options = Options(), jobs: int = 1, dask: str | None = None,
+def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None) -> RunSummary:
     """Process ``paths`` for ``columns`` and write every report into ``out``."""
     out = pathlib.Path(out)
