@@ -118,6 +118,11 @@ def process_record(task: Task) -> dict:
     except StageError as err:
         out["failure"] = failure(task, err.stage, err.exc)
         return out
+    except Exception as exc:  # anything unforeseen fails this record only, never the batch
+        if _interrupted(exc):
+            raise KeyboardInterrupt from exc
+        out["failure"] = failure(task, "internal", exc)
+        return out
     if task.options.plots:
         from .plots import record_figure_png
 

@@ -145,8 +145,8 @@ FAILURE_COLUMNS = [
     ("record", "-", "Record id (as in the per-record reports)."),
     ("file", "-", "The record's path as given."),
     ("stage", "-", "Where it failed: `read` (reading the file), `fit` (pulse fitting), `design` "
-                   "(design rules), `verify` (full-record time histories), `plot`, or `worker` (the "
-                   "process running it died)."),
+                   "(design rules), `verify` (full-record time histories), `plot`, `worker` (the "
+                   "process running it died) or `internal` (an unforeseen error: please report it)."),
     ("error", "-", "Type of the error."),
     ("reason", "-", "The error message, in one line."),
 ]
