@@ -368,3 +368,21 @@ def test_demo_from_another_directory(tmp_path):
             k = t["shape"].replace("-", "_")
             assert float(r[f"{k}_ap_g"]) == pytest.approx(float(t["ap_g"]), rel=0.12)
             assert float(r[f"{k}_tp_s"]) == pytest.approx(float(t["tp_s"]), rel=0.12)
+
+
+def test_example_records_regenerate_identically(tmp_path):
+    """data/make_examples.py rebuilds the committed example records byte for byte (fixed seeds)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_examples", DATA / "make_examples.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    paths = mod.main(tmp_path)
+    assert len(paths) == 5
+    for path in paths:
+        assert path.read_bytes() == (DATA / path.name).read_bytes(), path.name
+        assert path.stat().st_size < 20_000
+        rec = pulses.read_record(path)
+        assert rec.metadata["units"] == "nm/s2" and rec.metadata["units_source"] == "file"
+        assert 20.0 <= rec.duration <= 30.0 and rec.dt == 0.01
+    assert (tmp_path / "examples.csv").read_bytes() == (DATA / "examples.csv").read_bytes()
