@@ -127,6 +127,8 @@ def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
         raise RecordError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise RecordError(f"{path}: is a directory, not a record file") from None
+    except OSError as exc:
+        raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
     lines = text.splitlines()
     if not text.strip():
         raise RecordError(f"{path}: the file is empty")

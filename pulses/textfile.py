@@ -86,6 +86,8 @@ def read_text_file(path, column: int | None = None):
         raise RecordError(f"{path}: no such file") from None
     except UnicodeDecodeError:
         raise RecordError(f"{path}: not a text file (and not a format obspy recognises)") from None
+    except OSError as exc:
+        raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
     comments, rows, names = [], [], None
     for lineno, line in enumerate(lines, start=1):
         s = line.strip()
