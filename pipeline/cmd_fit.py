@@ -153,7 +153,8 @@ def format_fit(record, fit) -> str:
 
 
 def plot_fit(record, fit, folder) -> str:
-    """Record (g) with the best and runner-up pulses over it, like the paper's Fig. 4."""
+    """Record with every fitted pulse over it, like the paper's Fig. 4: acceleration (g) above,
+    velocity below (the record's after the baseline correction of :mod:`pulses.baseline`)."""
     import pathlib
 
     import matplotlib
@@ -164,23 +165,31 @@ def plot_fit(record, fit, folder) -> str:
 
     from pulses import G
 
+    from pulses.baseline import corrected_velocity, velocity
+
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     t = record.time
-    fig, ax = plt.subplots(figsize=(9, 3.6))
+    fig, (ax, axv) = plt.subplots(2, 1, figsize=(9, 5.4), sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 2]})
     ax.plot(t, record.acc / G, color="0.35", lw=0.7, label=record.name)
+    axv.plot(t, corrected_velocity(record.acc, record.dt), color="0.35", lw=0.8)
     styles = ["C3", "C0", "C2", "C1"]
     for c, color in zip(fit.candidates, styles):
         lw = 2.0 if c.rank == 1 else 1.1
-        ax.plot(t, c.pulse(t) / G, color=color, lw=lw,
+        p = c.pulse(t)
+        ax.plot(t, p / G, color=color, lw=lw,
                 label=f"{c.shape}: ap {abs(c.ap_g):.2f} g, Tp {c.tp:.2f} s, score {c.score:.2f}")
+        axv.plot(t, velocity(p, record.dt), color=color, lw=lw)
     best = fit.best
     lo, hi = best.pulse.support
     span = max(hi - lo, best.tp)
     ax.set_xlim(max(t[0], lo - 2 * span), min(t[-1], hi + 2 * span))
-    ax.axhline(0, color="k", lw=0.4)
-    ax.set_xlabel("time (s)")
+    for a in (ax, axv):
+        a.axhline(0, color="k", lw=0.4)
+    axv.set_xlabel("time (s)")
     ax.set_ylabel("ground acceleration (g)")
+    axv.set_ylabel("velocity (m/s)")
     ax.set_title(f"{record.name}: pulses fitted (best: {best.shape})")
     ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
