@@ -3,6 +3,7 @@
     python -m benchmarks            # the full report (under 10 minutes on the 2-core machine)
     python -m benchmarks --quick    # a smaller version of every section (about 2-3 minutes)
     python benchmarks/run.py --only solver,linear   # some sections only (the report says which)
+    python -m benchmarks --quick --out /tmp/bench   # write the report somewhere else
 
 Every figure is measured in the same run, side by side; times are medians of repeated runs (or a
 single run for the slow models, said so where it applies).  The machine (CPU, cores, load, Python
@@ -44,6 +45,9 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 RECORDS_DIR = pathlib.Path(os.environ.get("ROCKING_RECORDS", ROOT.parent / "shared" / "records" / "raw"))
+
+#: where RESULTS.md and the plots go (``--out``; default this folder)
+OUT = HERE
 
 SECTIONS = ("solver", "linear", "cost", "fit", "design", "pipeline")
 
@@ -666,7 +670,7 @@ def section_solver(md, out, quick, records, rec_notes):
     plots = {"(a) pulses, all shapes": (pres, pref_t)}
     if rres:
         plots["(b) real records"] = (rres, rref_t)
-    plot_work_precision(plots, HERE / "work_precision.png")
+    plot_work_precision(plots, OUT / "work_precision.png")
 
     # ---------------------------------------------------------------- markdown
     md.append("## 1. The solver: speed against error\n")
@@ -825,7 +829,7 @@ def section_linear(md, out, quick, records):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(HERE / "linear_error.png", dpi=110)
+    fig.savefig(OUT / "linear_error.png", dpi=110)
     plt.close(fig)
 
     md.append("## 2. The linearised model and `model=\"auto\"`\n")
@@ -974,7 +978,7 @@ def section_cost(md, out, quick, records):
     a2.legend(fontsize=8)
     a2.set_title("Cost against batch size")
     fig.tight_layout()
-    fig.savefig(HERE / "cost.png", dpi=110)
+    fig.savefig(OUT / "cost.png", dpi=110)
     plt.close(fig)
 
     md.append("## 3. Cost growth\n")
@@ -1265,14 +1269,19 @@ def write_report(md_sections, mach, load0, cal0, quick, only, total=None, load1=
         head.append(f"- Total run time of this report: {total:.0f} s.")
     head.append("")
     text = "\n".join(head + sum(([*s, ""] for s in md_sections), []))
-    (HERE / "RESULTS.md").write_text(text)
+    (OUT / "RESULTS.md").write_text(text)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller version of every section")
     ap.add_argument("--only", help="comma-separated sections: " + ",".join(SECTIONS))
+    ap.add_argument("--out", help="folder for RESULTS.md and the plots (default: benchmarks/)")
     args = ap.parse_args(argv)
+    global OUT
+    if args.out:
+        OUT = pathlib.Path(args.out)
+        OUT.mkdir(parents=True, exist_ok=True)
     only = [s.strip() for s in args.only.split(",")] if args.only else None
     if only:
         bad = [s for s in only if s not in SECTIONS]
@@ -1322,7 +1331,7 @@ def main(argv=None) -> int:
     total = time.perf_counter() - T_START
     ordered = [sections[k] for k in SECTIONS if k in sections]
     write_report(ordered, mach, load0, cal0, quick, only, total=total, load1=loadavg(), cal1=cal1)
-    log(f"done in {total:.0f} s: {HERE / 'RESULTS.md'}")
+    log(f"done in {total:.0f} s: {OUT / 'RESULTS.md'}")
     return 0
 
 
