@@ -51,7 +51,11 @@ def record_figure_png(record_id, record, fit, fitting, histories) -> bytes:
 
     plt = _pyplot()
     n = 1 + len(histories)
-    fig, axes = plt.subplots(n, 1, figsize=(8.0, 2.4 + 2.0 * len(histories)), squeeze=False)
+    height = 2.4 + 2.0 * len(histories)
+    fig, axes = plt.subplots(n, 1, figsize=(8.0, height), squeeze=False)
+    # fixed margins (in inches) rather than tight_layout, which draws the figure twice
+    fig.subplots_adjust(left=0.09, right=0.98, top=1.0 - 0.35 / height, bottom=0.5 / height,
+                        hspace=0.75 / 2.0)
     axes = axes[:, 0]
     ax = axes[0]
     t = record.time
@@ -82,7 +86,6 @@ def record_figure_png(record_id, record, fit, fitting, histories) -> bytes:
         ax.set_xlim(record.t_start, record.t_start + record.duration)
     axes[-1].set_xlabel("time (s)")
     axes[0].set_xlim(record.t_start, record.t_start + record.duration)
-    fig.tight_layout()
     return _png(fig)
 
 
