@@ -332,8 +332,8 @@ def test_simulate_many_matches_simulate():
 
 
 def test_auto_uses_linear_only_where_its_error_is_inside_tol():
-    slender = Block.from_tan_alpha(1.0, 0.005)
-    pulse = OneSine(0.02 * G, 2.0)
+    slender = Block.from_tan_alpha(1.0, 0.002)  # 100 alpha^2 = 4e-4 <= tol = 1e-3
+    pulse = OneSine(0.008 * G, 2.0)
     auto = simulate(slender, pulse, tol=1e-3)
     assert auto.model == "linear"
     ref = simulate(slender, pulse, model="reference")
