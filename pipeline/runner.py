@@ -167,10 +167,14 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         progress = (not quiet) and sys.stderr.isatty()
     bar = None
     if progress:
+        import shutil
+
         from tqdm import tqdm
 
-        bar = tqdm(total=len(tasks), unit="record", file=sys.stderr, dynamic_ncols=True,
-                   desc="pipeline run")
+        # a terminal that reports a size of 0 x 0 (some pseudo-terminals) would hide the bar
+        size = shutil.get_terminal_size((100, 24))
+        bar = tqdm(total=len(tasks), unit="record", file=sys.stderr, desc="pipeline run",
+                   ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
 
     def say(msg):
         if quiet:
