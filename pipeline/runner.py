@@ -196,6 +196,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
                 report.remove_quietly(report.record_csv_path(out, rid))
             if res.get("plot"):
                 report.write_atomic(plots_dir / f"{rid}.png", res["plot"])
+                res["plot"] = None  # thousands of records: keep only the rows in memory
             elif options.plots:
                 report.remove_quietly(plots_dir / f"{rid}.png")
             if res["failure"]:
