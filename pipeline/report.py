@@ -263,9 +263,10 @@ def columns_markdown() -> str:
         "| column | unit | meaning |",
         "|---|---|---|",
     ]
-    lines += [f"| `{n}` | {u} | {d} |" for n, u, d in COLUMNS]
+    cell = lambda text: text.replace("|", "\\|")  # a bare | would end the table cell
+    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in COLUMNS]
     lines += ["", "## Columns of `failures.csv`", "", "| column | unit | meaning |", "|---|---|---|"]
-    lines += [f"| `{n}` | {u} | {d} |" for n, u, d in FAILURE_COLUMNS]
+    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in FAILURE_COLUMNS]
     return "\n".join(lines) + "\n"
 
 

@@ -121,6 +121,11 @@ def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20)
     md = (out / "columns.md").read_text()
     for name in list(summary[0]) + list(report.FAILURE_FIELDS):
         assert f"| `{name}` |" in md
+    import re
+
+    for line in md.splitlines():  # table rows keep their 3 cells (| inside text is escaped)
+        if line.startswith("| `"):
+            assert len(re.findall(r"(?<!\\)\|", line)) == 4, line
 
 
 def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
