@@ -123,6 +123,9 @@ def summary_figure_png(rows) -> bytes:
     ax1.grid(alpha=0.3)
     if blocks:
         ax1.legend(fontsize=7)
+    else:
+        ax1.text(0.5, 0.5, "no column as it stands (--block) in this run", ha="center", va="center",
+                 transform=ax1.transAxes, fontsize=9, color="0.4")
     x = np.array([_num(r, "eq31_width_tan_alpha") for r in rows])
     y = np.array([_num(r, "verified_tan_alpha") for r in rows])
     bad = np.array([bool(r.get("eq31_width_overturns")) for r in rows], dtype=bool)
