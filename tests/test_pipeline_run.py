@@ -266,7 +266,11 @@ def test_cli_end_to_end_numbers_match_library(tmp_path):
     assert fitting[0] == best.shape
     for shape in fitting:
         k = shape.replace("-", "_")
-        assert r[f"{k}_fits"] == "True" and r[f"{k}_exact_tan_alpha"] != ""
+        c = next(c for c in fit.candidates if c.shape == shape)
+        assert r[f"{k}_fits"] == "True"
+        assert close(r[f"{k}_eq31_tan_alpha"], rocking.eq31(c.ap, c.tp, block.p))
+        assert close(r[f"{k}_exact_tan_alpha"], rocking.min_slenderness(c.pulse, block.p).tan_alpha)
+        assert close(r[f"{k}_eq31_width_m"], rocking.required_width(7.5, c.pulse, rule="eq31").width)
     widths = {c.shape: rocking.required_width(7.5, c.pulse, rule="eq31").width
               for c in fit.candidates if c.shape in fitting}
     assert max(widths.values()) == pytest.approx(w31)
