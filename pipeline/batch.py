@@ -4,8 +4,8 @@
 runs the same in this process, in a process pool or on a dask worker.  It never raises for a bad record:
 the failure comes back with the stage it happened in and the reason.  Everything it computes comes from
 the library (``pulses.read_record``, ``pulses.fit_pulse``, ``rocking.simulate``, ``rocking.eq31``,
-``rocking.envelope_rule``, ``rocking.min_slenderness``, ``rocking.required_width``); nothing here is a
-second implementation of them.
+``rocking.envelope_rule``, ``rocking.min_slenderness_batch`` (``rocking.min_slenderness`` for several
+blocks at once), ``rocking.required_width``); nothing here is a second implementation of them.
 """
 from __future__ import annotations
 
