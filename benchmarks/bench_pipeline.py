@@ -8,6 +8,8 @@
   cold (a fresh ``pipeline`` process, as a user runs it).
 - The same with plots, ``--jobs 2``.
 - Record length: 4 records each of 10, 20, 40, 80 s, ``--jobs 1``: seconds per record.
+- Where the time goes: median seconds per record in each stage (fit, exact slenderness, verified
+  width, time histories, plot), 10 records, one process.
 
 Every run is one repeat by default (``run(repeats=...)``): on this machine the whole takes minutes.
 """
@@ -55,6 +57,18 @@ def make_records(folder, n, durations, dt=0.01, seed=0):
     return paths
 
 
+def stage_split(paths, plots=True) -> dict:
+    """Median seconds per record spent in each stage (``process_record``'s ``seconds``), one process."""
+    from pipeline.batch import Column, Options, process_record
+    from pipeline.runner import make_tasks
+
+    tasks = make_tasks(paths, [Column(7.5, 1.8), Column(6.0, 1.2)], Options(plots=plots))
+    process_record(tasks[0])  # warm-up
+    per = [process_record(t)["seconds"] for t in tasks]
+    keys = sorted({k for d in per for k in d})
+    return {k: round(float(np.median([d.get(k, 0.0) for d in per])), 4) for k in keys}
+
+
 def _timed_main(argv):
     from pipeline.cli import main
 
@@ -95,6 +109,7 @@ def run(n_records: int = 40, repeats: int = 1, cold: bool = True, plots: bool = 
             results["warm_jobs2_with_plots_records_per_s"] = round(len(recs) / secs, 3)
         results["jobs1_jobs2_identical"] = all(
             (tmp / "o1" / f).read_bytes() == (tmp / "o2" / f).read_bytes() for f in ("summary.csv", "failures.csv"))
+        results["median_seconds_per_record_by_stage"] = stage_split(recs[:10])
         by_length = {}
         for duration in lengths:
             lrecs = make_records(tmp / f"len{duration:g}", per_length, durations=[duration], seed=1)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 import pathlib
 import re
+import threading
+import time
 from dataclasses import dataclass, field
 
 from .report import FIT_TOLERANCE, SHAPE_NAMES, _shape_key
@@ -109,7 +111,21 @@ def _sim(block, record, history):
 
 
 def process_record(task: Task) -> dict:
-    """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot"}``."""
+    """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot", "seconds"}``.
+
+    ``seconds`` maps each stage (``"verify:verified_width"``, ...) to the time it took; it is for
+    benchmarks and never written to the reports (which must not depend on timing).
+    """
+    _local.timings = {}
+    try:
+        out = _process_record(task)
+    finally:
+        timings, _local.timings = _local.timings, None
+    out["seconds"] = timings
+    return out
+
+
+def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
            "failure": None, "plot": None}
     try:
@@ -151,7 +167,12 @@ def _interrupted(exc: BaseException) -> bool:
     return False
 
 
+#: per-thread accumulator of the time spent in each stage of the record being processed
+_local = threading.local()
+
+
 def _stage(stage, fn, *args, **kwargs):
+    t0 = time.perf_counter()
     try:
         return fn(*args, **kwargs)
     except (KeyboardInterrupt, SystemExit):
@@ -160,6 +181,11 @@ def _stage(stage, fn, *args, **kwargs):
         if _interrupted(exc):
             raise KeyboardInterrupt from exc
         raise StageError(stage, exc) from exc
+    finally:
+        timings = getattr(_local, "timings", None)
+        if timings is not None:
+            key = f"{stage}:{getattr(fn, '__name__', 'call').strip('_')}"
+            timings[key] = timings.get(key, 0.0) + time.perf_counter() - t0
 
 
 def _process(task: Task):
@@ -219,9 +245,11 @@ def _process(task: Task):
         curves = []
 
         # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
+        def eq31_widths():
+            return [(float(rocking.required_width(H, c.pulse, rule="eq31").width), c) for c in fitting]
+
         if H not in eq31_cache:
-            eq31_cache[H] = _stage("design", lambda: [
-                (float(rocking.required_width(H, c.pulse, rule="eq31").width), c) for c in fitting])
+            eq31_cache[H] = _stage("design", eq31_widths)
         widths = eq31_cache[H]
         w31, gov = max(widths, key=lambda wc: wc[0])  # ties: the better fit (ranked first)
         row.update({"governing_shape": gov.shape, "governing_ap_g": _g(gov.ap),
@@ -277,8 +305,11 @@ def _process(task: Task):
             histories.append((col.label, curves))
 
         # -- verified width: smallest width surviving the full record (islands respected) ---------
+        def verified_width():
+            return rocking.required_width(H, record, rule="exact")
+
         if H not in verified_cache:
-            verified_cache[H] = _stage("verify", lambda: rocking.required_width(H, record, rule="exact"))
+            verified_cache[H] = _stage("verify", verified_width)
         ver = verified_cache[H]
         row.update({"verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / H})
         if col.width is not None:
