@@ -270,15 +270,18 @@ USUAL_DEFAULT = dict(method="RK45", rtol=1e-3, atol=1e-6)
 
 def settings(kind: str):
     """Settings for ``kind`` = "pulse" or "record"."""
+    from rocking import solver
+
     out = []
     if kind == "pulse":
-        for n in (50, 100, 200, 400):
-            out.append(Setting(f"fast o8, {n} steps/Tp" + (" (default)" if n == 200 else ""),
+        default = solver.STEPS_PER_TP
+        for n in sorted({12, default, 50, 100, 200}):
+            out.append(Setting(f"fast o8, {n} steps/Tp" + (" (default)" if n == default else ""),
                                "fast o8", "fast", res=n))
         for ph in (0.4, 0.1):
             out.append(Setting(f"fast o8, ph_max {ph}", "fast o8 ph_max", "fast", ph_max=ph))
         for n in (200, 400, 800, 1600):
-            out.append(Setting(f"fast o4, {n} steps/Tp" + (" (default)" if n == 200 else ""),
+            out.append(Setting(f"fast o4, {n} steps/Tp" + (" (default)" if n == default else ""),
                                "fast o4", "fast", res=n, order=4))
         for ph in (0.1, 0.025):
             out.append(Setting(f"fast o4, ph_max {ph}", "fast o4 ph_max", "fast", order=4, ph_max=ph))

@@ -92,3 +92,21 @@ def parse_positive(text: str, what: str) -> float:
     except (TypeError, ValueError):
         raise ArgumentError(f"{what}: expected a number, got {text!r}") from None
     return _finite_positive(value, what)
+
+
+def parse_shapes(items):
+    """``["sine", "ricker-sym"]`` or ``["all"]`` (commas allowed) -> tuple of shape names."""
+    if not items:
+        return None
+    from pulses import SHAPES
+
+    names = []
+    for item in items:
+        for name in str(item).replace(",", " ").split():
+            if name == "all":
+                names.extend(SHAPES)
+            elif name in SHAPES:
+                names.append(name)
+            else:
+                raise ArgumentError(f"unknown pulse shape {name!r}; choose from {', '.join(SHAPES)} or all")
+    return tuple(dict.fromkeys(names))

@@ -14,7 +14,7 @@ import json
 import math
 import sys
 
-from .args import ArgumentError
+from .args import ArgumentError, parse_shapes
 
 
 def add_record_arguments(p) -> None:
@@ -52,24 +52,6 @@ def record_options(args) -> dict:
         if opts["column"] < 1:
             raise ArgumentError(f"--column counts from 1, got {args.column!r}")
     return opts
-
-
-def parse_shapes(items):
-    """``["sine", "ricker-sym"]`` or ``["all"]`` (commas allowed) -> tuple of shape names."""
-    if not items:
-        return None
-    from pulses import SHAPES
-
-    names = []
-    for item in items:
-        for name in str(item).replace(",", " ").split():
-            if name == "all":
-                names.extend(SHAPES)
-            elif name in SHAPES:
-                names.append(name)
-            else:
-                raise ArgumentError(f"unknown pulse shape {name!r}; choose from {', '.join(SHAPES)} or all")
-    return tuple(dict.fromkeys(names))
 
 
 def add_parser(subparsers) -> None:

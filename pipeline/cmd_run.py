@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from .args import ArgumentError, parse_block, parse_length, parse_positive
+from .args import ArgumentError, parse_block, parse_length, parse_positive, parse_shapes
 
 DEFAULT_OUT = "pipeline-output"
 
@@ -66,23 +66,6 @@ def parse_jobs(text) -> int | None:
     if jobs < 0:
         raise ArgumentError(f"--jobs must be 0 (one per CPU) or more, got {jobs}")
     return jobs or (os.cpu_count() or 1)
-
-
-def parse_shapes(items):
-    if not items:
-        return None
-    from pulses import SHAPES
-
-    names = []
-    for item in items:
-        for name in str(item).replace(",", " ").split():
-            if name == "all":
-                names.extend(SHAPES)
-            elif name in SHAPES:
-                names.append(name)
-            else:
-                raise ArgumentError(f"unknown pulse shape {name!r}; choose from {', '.join(SHAPES)} or all")
-    return tuple(dict.fromkeys(names))
 
 
 def parse_units(text):
