@@ -34,10 +34,11 @@ PH_MAX = 0.2
 #: to broadband records amplify local errors, and RK4 at one step per 200 Hz sample can be off by
 #: 1e-4 rad in max|theta| (see benchmarks)
 PH_MAX_RK4 = 0.05
-#: steps per pulse period, at least (resolves the forcing of the pulse itself; with the 8th-order
-#: formula 25 agree with the reference to ~5e-12 in max|theta|/alpha on 48 pulses of all shapes,
-#: p*Tp 0.3-10, as 200 do: the reference's own accuracy)
-STEPS_PER_TP = 25
+#: steps per pulse period, at least (resolves the forcing of the pulse itself).  With the
+#: 8th-order formula, on 48 pulses of all shapes (p*Tp 0.3-10, ap/(g tan alpha) 1.2-3.5),
+#: max|theta|/alpha agrees with the reference to 1e-11 at 16 steps, 4e-12 at 25 and 200
+#: (the reference's own accuracy), 3e-11 at 12 (benchmarks/RESULTS.md, section 1a).
+STEPS_PER_TP = 16
 #: ``model="auto"`` picks the linearised model when ``LINEAR_ERROR_COEFF * alpha**2 <= tol``.
 #: Its error in ``max|theta|/alpha`` against the nonlinear solution grows like alpha**2; the
 #: worst measured ratio error/alpha**2 is 5 on pulses (four shapes, p*Tp 0.5-8,
