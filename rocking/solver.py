@@ -35,9 +35,9 @@ PH_MAX = 0.2
 #: 1e-4 rad in max|theta| (see benchmarks)
 PH_MAX_RK4 = 0.05
 #: steps per pulse period, at least (resolves the forcing of the pulse itself).  With the
-#: 8th-order formula, on 48 pulses of all shapes (p*Tp 0.3-10, ap/(g tan alpha) 1.2-3.5),
-#: max|theta|/alpha agrees with the reference to 1e-11 at 16 steps, 4e-12 at 25 and 200
-#: (the reference's own accuracy), 3e-11 at 12 (benchmarks/RESULTS.md, section 1a).
+#: 8th-order formula max|theta|/alpha agrees with the reference to 2e-10 at 16 steps and 4e-12
+#: at 50 (24 pulses of all shapes near overturning, benchmarks/RESULTS.md section 1a; 1e-11 at
+#: 16 on 48 other pulses), far inside the 1e-6 asked for, at two thirds of the cost of 50.
 STEPS_PER_TP = 16
 #: ``model="auto"`` picks the linearised model when ``LINEAR_ERROR_COEFF * alpha**2 <= tol``.
 #: Its error in ``max|theta|/alpha`` against the nonlinear solution grows like alpha**2; the
