@@ -430,16 +430,27 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                     if s * th_e > 0.0:
                         lo = -1.0
                 if lo >= 0.0 and (events < _MAX_EVENTS_PER_STEP):
-                    # bisection on the cubic, then Newton on the re-integrated solution
+                    # bisection then Newton on the cubic (cheap), then Newton on the
+                    # re-integrated solution: its first iteration corrects the interpolation
+                    # error, the second confirms convergence to rounding
                     for _ in range(60):
                         mid = 0.5 * (lo + hi)
                         if s * _cubic(c0, c1, c2, c3, mid) > 0.0:
                             lo = mid
                         else:
                             hi = mid
-                        if hi - lo < 1e-6:
+                        if hi - lo < 1e-4:
                             break
                     x = hi
+                    for _ in range(6):
+                        d = c1 + x * (2.0 * c2 + 3.0 * c3 * x)
+                        if d == 0.0:
+                            break
+                        xn = x - _cubic(c0, c1, c2, c3, x) / d
+                        if not (lo <= xn <= hi):
+                            break
+                        x = xn
+                    converged = False
                     for _ in range(8):
                         th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
                                           theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
@@ -451,9 +462,10 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         converged = abs(xn - x) < 4e-16
                         x = xn
                         if converged:
-                            break
-                    th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
-                                      theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
+                            break  # (th_x, om_x) is the state 4e-16 h before x: kept as is
+                    if not converged:
+                        th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
+                                          theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
                     t_imp = t + x * h
                     if t_imp <= t:
                         t_imp = t + 1e-16 * max(abs(t), 1.0)
