@@ -15,7 +15,6 @@ reads them with their units and no option.  The true pulse of each record is lis
 from __future__ import annotations
 
 import csv
-import math
 import pathlib
 
 import numpy as np

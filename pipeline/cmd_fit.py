@@ -11,7 +11,6 @@ are shared with ``pipeline convert`` through :func:`add_record_arguments` and
 from __future__ import annotations
 
 import json
-import math
 import sys
 
 from .args import ArgumentError, parse_shapes
@@ -143,7 +142,6 @@ def plot_fit(record, fit, folder) -> str:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
     from pulses import G
 

@@ -28,7 +28,7 @@ import numpy as np
 from .at2 import _is_at2, read_at2_file
 from .errors import RecordError
 from .record import G, Record
-from .sac import IACC, idep_units, shortest_float32
+from .sac import idep_units, shortest_float32
 from .textfile import hint_from_comments, read_text_file, sniff_text
 from .units import (
     PLAUSIBLE_MAX_G,

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from pulses import G, Pulse, Record
+from pulses import G, Record
 
 from . import engine
 from .block import Block

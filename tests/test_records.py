@@ -10,7 +10,7 @@ import pytest
 
 import pulses
 from pulses import G, Record, RecordError, read_record, write_sac
-from pulses.at2 import _is_at2, _read_at2, parse_npts_dt, read_at2_file
+from pulses.at2 import _is_at2, _read_at2, parse_npts_dt
 
 from .conftest import shared_record
 
