@@ -344,7 +344,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
 
     Returns
     -------
-    status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted, n_rest
+    status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted
     """
     tan_a = math.tan(alpha)
     kt = np.empty(N_STAGES)
@@ -364,7 +364,6 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     uplifted = s != 0.0
     max_abs = abs(theta)
     n_imp = 0
-    n_rest = 0
     rest_until = -np.inf
     omega_zeno = zeno_tol * p * alpha
     status = ROCKING if s != 0.0 else REST
@@ -495,7 +494,6 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                             rest_until = t + t_z
                             s = 0.0
                             omega = 0.0
-                            n_rest += 1
                             status = REST
                     continue
                 if lo >= 0.0:  # too many events in one step: settle (never loops forever)
@@ -539,7 +537,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
             break
     if status == REST:
         theta, omega = 0.0, 0.0
-    return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted, n_rest
+    return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted
 
 
 @njit(cache=True)
@@ -547,7 +545,7 @@ def _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub
              linear, zeno_tol, high_order, overturned, max_abs, n_impacts, uplifted):
     """Run ``i`` of a batch (no history), then the energy rule; results written at index ``i``."""
     empty = np.zeros(0)
-    st, th, om, te, mx, ni, nh, up, nr = run(
+    st, th, om, te, mx, ni, nh, up = run(
         kind, amp[i], tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub[i],
         p[i], alpha[i], eta[i], 0.0, 0.0, linear, zeno_tol, False,
         empty, empty, empty, empty, False, high_order)

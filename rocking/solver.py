@@ -304,14 +304,14 @@ def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_t
                      grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta, theta0, omega0,
                      linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om, impacts, history,
                      high_order)
-    status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
+    status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
         out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes,
                          grid.t_start, grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta,
                          theta0, omega0, linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om,
                          impacts, history, high_order)
-        status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
+        status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted = out
     return (status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts[:n_imp],
             hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist])
 
