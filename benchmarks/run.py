@@ -457,29 +457,36 @@ def find_transitions(quick):
         def verdict(x, model):
             return rocking.simulate(blk, make(x), model=model, history=False).overturned
 
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            if verdict(mid, "fast"):
-                hi = mid
-            else:
-                lo = mid
-            if hi - lo < 1e-12 * hi:
-                break
-        x_fast = 0.5 * (lo + hi)
-        lo, hi = x_fast * (1 - 1e-5), x_fast * (1 + 1e-5)
-        if verdict(lo, "reference") or not verdict(hi, "reference"):
+        found = _fast_and_reference_transition(verdict, lo, hi)
+        if found is None:
             log(f"  {label}: reference does not bracket the fast transition within 1e-5; skipped")
             continue
-        while hi - lo > 1e-10 * hi:
-            mid = 0.5 * (lo + hi)
-            if verdict(mid, "reference"):
-                hi = mid
-            else:
-                lo = mid
-        x_ref = 0.5 * (lo + hi)
+        x_fast, x_ref = found
         out.append((label, blk, make, x_ref, x_fast, time.perf_counter() - t_case))
         log(f"  transition {label}: ap/(g tan alpha) = {x_ref:.10f} (fast: {x_fast / x_ref - 1:+.1e} rel.)")
     return out
+
+
+def _bisect(fails, lo, hi, rtol):
+    """Narrow ``[lo, hi]`` (``fails(lo)`` False, ``fails(hi)`` True) to ``rtol``; the midpoint."""
+    while hi - lo > rtol * hi:
+        mid = 0.5 * (lo + hi)
+        if fails(mid):
+            hi = mid
+        else:
+            lo = mid
+    return 0.5 * (lo + hi)
+
+
+def _fast_and_reference_transition(verdict, lo, hi):
+    """The overturning transition in ``[lo, hi]`` by the fast model (to 1e-12), then by the
+    reference inside +-1e-5 of it (to 1e-10): ``(x_fast, x_ref)``, or None if the reference does
+    not change its verdict there."""
+    x_fast = _bisect(lambda x: verdict(x, "fast"), lo, hi, 1e-12)
+    lo, hi = x_fast * (1 - 1e-5), x_fast * (1 + 1e-5)
+    if verdict(lo, "reference") or not verdict(hi, "reference"):
+        return None
+    return x_fast, _bisect(lambda x: verdict(x, "reference"), lo, hi, 1e-10)
 
 
 def record_transition(rec):
@@ -501,23 +508,10 @@ def record_transition(rec):
     def verdict(x, model):
         return rocking.simulate(blk, rec.scaled(x), model=model, history=False).overturned
 
-    while hi - lo > 1e-12 * hi:
-        mid = 0.5 * (lo + hi)
-        if verdict(mid, "fast"):
-            hi = mid
-        else:
-            lo = mid
-    x_fast = 0.5 * (lo + hi)
-    lo, hi = x_fast * (1 - 1e-5), x_fast * (1 + 1e-5)
-    if verdict(lo, "reference") or not verdict(hi, "reference"):
+    found = _fast_and_reference_transition(verdict, lo, hi)
+    if found is None:
         return None
-    while hi - lo > 1e-10 * hi:
-        mid = 0.5 * (lo + hi)
-        if verdict(mid, "reference"):
-            hi = mid
-        else:
-            lo = mid
-    x_ref = 0.5 * (lo + hi)
+    x_fast, x_ref = found
     log(f"  transition {rec.name}: scale {x_ref:.10f} (fast: {x_fast / x_ref - 1:+.1e} rel.)")
     return (f"{rec.name} (record scale)", blk, (lambda x: rec.scaled(x)), x_ref, x_fast,
             time.perf_counter() - t_case)
