@@ -7,11 +7,15 @@ breakpoints and extrema subdivided into equal steps) and handles everything betw
   monotonic (records are linear between samples, pulse grids include every extremum), so the
   first time ``|ug''| = g tan(alpha)`` is found exactly and the block uplifts to
   ``sgn(theta) = -sgn(ug'')``;
-* **stepping**: classical RK4 on the full nonlinear equation (``linear=False``), or the exact
-  ``cosh``/``sinh`` solution of the linearised equation for forcing linear on each interval
-  (``linear=True``);
-* **impacts**: located on the cubic Hermite interpolant of the step, then refined by Newton
-  iterations that re-integrate from the start of the step, so the impact time is as accurate as
+* **stepping** of the full nonlinear equation (``linear=False``) by its Taylor series (default:
+  the series of ``theta``, ``sin`` and ``cos`` of the angle to the corner and of the forcing
+  follow from recurrences, summed to rounding level, so each step is exact to rounding and its
+  polynomial is the solution everywhere inside the step), or by the fixed-step 8th-order
+  Dormand-Prince formula or classical RK4 (for comparison); or the exact ``cosh``/``sinh``
+  solution of the linearised equation for forcing linear on each interval (``linear=True``);
+* **impacts**: detected on the cubic Hermite interpolant of the step, then located by Newton
+  iterations on the step's Taylor polynomial (or, for the Runge-Kutta and linear steppers, on
+  the solution re-integrated from the start of the step), so the impact time is as accurate as
   the stepper itself; the angular velocity is multiplied by ``eta``;
 * **Zeno sequences**: once the post-impact velocity falls below ``zeno_tol * p * alpha`` while
   both sides are restoring, the remaining geometric series of hops is summed in closed form and
@@ -32,6 +36,9 @@ import numpy as np
 from numba import njit, prange
 from scipy.integrate._ivp import dop853_coefficients as _dop853
 
+from ._taylor_fixed import ORDERS as FIXED_ORDERS
+from ._taylor_fixed import taylor_fixed
+
 #: Butcher tableau of the 8th-order Dormand-Prince formula (the 12 stages of DOP853)
 N_STAGES = _dop853.N_STAGES
 RK8_A = np.ascontiguousarray(_dop853.A[:N_STAGES, :N_STAGES])
@@ -48,6 +55,18 @@ BETA = abs((3.0 - math.sqrt(6.0) - 3.0) * math.sqrt(3.0 - math.sqrt(6.0))
 FREE = -1
 NODAL = 0  # piecewise linear between node values (records; sampled pulses for the linear model)
 RECT, SINE, RICKER_SYM, RICKER_ANTI = 1, 2, 3, 4
+
+# stepping methods of the nonlinear equation
+TAYLOR, RK8, RK4 = 0, 1, 2
+METHODS = {"taylor": TAYLOR, "rk8": RK8, "rk4": RK4}
+#: highest order of a Taylor step (steps are kept short enough, ``p h <= PH_MAX``, that the series
+#: reaches rounding level far below it)
+NMAX = 40
+#: a Taylor series is cut once two consecutive terms of theta and of ``h * omega`` fall below
+#: ``TAYLOR_EPS`` times the size of the step's leading terms
+TAYLOR_EPS = 1e-16
+_INV = np.array([0.0] + [1.0 / k for k in range(1, NMAX + 3)])
+_INV2 = np.array([1.0 / ((k + 1) * (k + 2)) for k in range(NMAX + 3)])
 
 # status codes returned by run()
 REST, ROCKING, OVERTURNED = 0, 1, 2
@@ -92,11 +111,12 @@ def _rhs(theta, s, u, p2, sa, ca, linear):
 
 @njit(cache=True)
 def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
-         high_order, kt, kw):
+         method, kt, kw):
     """Advance ``(theta, omega)`` on side ``s`` from ``t`` by ``h`` (inside interval ``j``).
 
-    Nonlinear: the 8th-order Dormand-Prince formula (fixed step; the 12 stages of DOP853) or,
-    with ``high_order=False``, classical RK4.  Linear: the exact solution.
+    Nonlinear: the 8th-order Dormand-Prince formula (fixed step; the 12 stages of DOP853) for
+    ``method == RK8``, classical RK4 otherwise (the Taylor stepper is :func:`taylor_series`,
+    called by :func:`run` directly).  Linear: the exact solution.
     """
     p2 = p * p
     if linear:
@@ -111,7 +131,7 @@ def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, l
         chm1 = 2.0 * math.sinh(0.5 * p * h) ** 2
         return (theta + y0 * chm1 + dy0 / p * sh + u1 * h,
                 omega + y0 * p * sh + dy0 * chm1)
-    if high_order:
+    if method == RK8:
         return _step_rk8(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p2, sa, ca,
                          kt, kw)
     hh = 0.5 * h
@@ -149,6 +169,131 @@ def _step_rk8(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p2, sa,
         th_new += h * RK8_B[i] * kt[i]
         om_new += h * RK8_B[i] * kw[i]
     return th_new, om_new
+
+
+# --------------------------------------------------------------------------- Taylor series
+@njit(cache=True, inline="always")
+def linear_forcing(kind, amp, uval, j, ta, tb, t, h):
+    """``(u0, u1)`` with ``u(t + x h) = u0 + u1 x`` for forcing linear over the step (records,
+    rectangular pulse, free motion)."""
+    if kind == NODAL:
+        slope = amp * (uval[j + 1] - uval[j]) / (tb - ta)
+        return amp * uval[j] + slope * (t - ta), slope * h
+    if kind == RECT:
+        return amp, 0.0
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U):
+    """Taylor coefficients of ``u(t + x h)`` in powers of ``x`` (``u = ug''/g``), into ``U``.
+
+    Returns the number of coefficients written (the rest are zero): 2 for records (linear on
+    the interval), 1 for the rectangular pulse and free motion, ``NMAX + 1`` for the smooth
+    pulses (their series from the recurrence ``E' = g' E`` for ``E = exp(g)``).
+    """
+    if kind == NODAL or kind == FREE or kind == RECT:
+        U[0], U[1] = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
+        return 2
+    n = NMAX + 1
+    if kind == SINE:
+        w = TWO_PI * h / tp
+        sn = math.sin(TWO_PI * (t - t0) / tp)
+        cs = math.cos(TWO_PI * (t - t0) / tp)
+        c = amp
+        for k in range(n):
+            r = k % 4
+            U[k] = c * (sn if r == 0 else (cs if r == 1 else (-sn if r == 2 else -cs)))
+            c *= w * _INV[k + 1]
+        return n
+    # Ricker pulses: P(y) exp(g(y)) with y = y0 + dy x linear in x
+    if kind == RICKER_SYM:
+        y0 = math.pi * (t - t0) / tp
+        dy = math.pi * h / tp
+        g1, g2 = -2.0 * y0 * dy, -dy * dy
+        e_prev, e = 0.0, math.exp(-y0 * y0)
+        p0, p1, p2, p3 = 1.0 - 2.0 * y0 * y0, -4.0 * y0 * dy, -2.0 * dy * dy, 0.0
+        scale = amp
+    else:
+        y0 = TWO_PI * (t - t0) / (tp * SQRT3)
+        dy = TWO_PI * h / (tp * SQRT3)
+        g1, g2 = -y0 * dy, -0.5 * dy * dy
+        e_prev, e = 0.0, math.exp(-0.5 * y0 * y0)
+        p0, p1, p2, p3 = y0 * (y0 * y0 - 3.0), 3.0 * (y0 * y0 - 1.0) * dy, 3.0 * y0 * dy * dy, dy ** 3
+        scale = amp / BETA
+    # E_k = (g1 E_{k-1} + 2 g2 E_{k-2}) / k;  U_k = sum_i P_i E_{k-i}
+    e1, e2, e3 = 0.0, 0.0, 0.0  # E_{k-1}, E_{k-2}, E_{k-3}
+    for k in range(n):
+        if k > 0:
+            e = (g1 * e1 + 2.0 * g2 * e2) * _INV[k]
+        U[k] = scale * (p0 * e + p1 * e1 + p2 * e2 + p3 * e3)
+        e1, e2, e3 = e, e1, e2
+    return n
+
+
+@njit(cache=True)
+def taylor_series(U, nu, h, theta, omega, s, p2, sa, ca, cf, S, C, sc_known, s0, c0):
+    """Taylor coefficients of ``theta(t + x h)`` in powers of ``x``, into ``cf``.
+
+    Returns ``(n, s1, c1)``: the order ``n`` of the polynomial, and ``sin(phi)``, ``cos(phi)`` at
+    the end of the step (their series summed), which the next step takes as its ``s0``, ``c0``
+    when ``sc_known`` (so a step needs no function evaluation at all).
+
+    With ``phi = s alpha - theta``, Eq. 3 reads ``phi'' = p^2 (sin(phi) + u cos(phi))``; the
+    series of ``S = sin(phi)`` and ``C = cos(phi)`` follow from ``S' = C phi'``, ``C' = -S phi'``
+    (``S_k = (1/k) sum_j j phi_j C_{k-j}``), so each order costs one short convolution and no
+    function evaluation.  The series is cut when two consecutive terms of ``theta`` and of
+    ``h omega`` fall below :data:`TAYLOR_EPS` times the leading terms.
+    """
+    if sc_known:
+        S[0], C[0] = s0, c0
+    else:
+        sn, cs = math.sin(theta), math.cos(theta)
+        S[0] = s * sa * cs - ca * sn
+        C[0] = ca * cs + s * sa * sn
+    q = p2 * h * h
+    cf[0] = theta
+    cf[1] = omega * h
+    cf[2] = -0.5 * q * (S[0] + U[0] * C[0])
+    tol = TAYLOR_EPS * (abs(theta) + abs(cf[1]) + abs(cf[2]))
+    n = 2
+    D = U[NMAX + 3:]  # D[i] = i cf[i] = -i phi_i: the series of h theta'
+    D[1] = cf[1]
+    D[2] = 2.0 * cf[2]
+    for k in range(1, NMAX - 1):
+        sk = 0.0
+        ck = 0.0
+        for i in range(1, k + 1):
+            sk -= D[i] * C[k - i]
+            ck += D[i] * S[k - i]
+        sk *= _INV[k]
+        ck *= _INV[k]
+        S[k] = sk
+        C[k] = ck
+        f = sk
+        for i in range(min(nu, k + 1)):
+            f += U[i] * C[k - i]
+        cf[k + 2] = -q * f * _INV2[k]
+        n = k + 2
+        D[n] = n * cf[n]
+        if abs(D[n]) <= tol and abs(D[n - 1]) <= tol:
+            break
+    s1, c1 = 0.0, 0.0
+    for k in range(n - 2, -1, -1):  # S_{n-1}, C_{n-1} are as small as cf[n - 1]
+        s1 += S[k]
+        c1 += C[k]
+    return n, s1, c1
+
+
+@njit(cache=True, inline="always")
+def taylor_eval(cf, n, x, h):
+    """``(theta, omega)`` at ``t + x h`` from the coefficients of :func:`taylor_series`."""
+    th = cf[n]
+    om = n * cf[n]
+    for k in range(n - 1, 0, -1):
+        th = th * x + cf[k]
+        om = om * x + k * cf[k]
+    return th * x + cf[0], om / h
 
 
 # --------------------------------------------------------------------------- Hermite helpers
@@ -216,13 +361,44 @@ def _first_crossing(c0, c1, c2, c3, s, level):
 
 
 @njit(cache=True)
-def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
-               s, p, sa, ca, linear, high_order, kt, kw):
-    """Largest ``|theta|`` at a turning point strictly inside a step (0 if none).
+def _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, x, theta, omega, s, p, sa, ca, linear,
+         method, kt, kw, cf, n):
+    """State at ``t + x h`` inside the current step of length ``h`` that starts at
+    ``(t, theta, omega)``: the step's Taylor polynomial when it has one (``n > 0``), else the
+    solution re-integrated from the start of the step."""
+    if n > 0:
+        return taylor_eval(cf, n, x, h)
+    return step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h, theta, omega, s, p, sa, ca, linear,
+                method, kt, kw)
 
-    The turning point is located on the cubic Hermite interpolant, the solution is re-integrated
-    to it, and the small residual velocity is removed by one quadratic (Newton) correction, so the
-    peak is as accurate as the stepper rather than the interpolant.
+
+@njit(cache=True)
+def _advance(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
+             method, kt, kw, U, S, C, cf, sc_known, s0, c0):
+    """One step of length ``h``: ``(theta, omega, n, s1, c1)`` at ``t + h``, with ``n`` the order
+    of the Taylor polynomial left in ``cf`` (0 when another stepper was used) and ``s1``, ``c1``
+    as returned by :func:`taylor_series`."""
+    if method == TAYLOR and not linear:
+        nu = forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U)
+        n, s1, c1 = taylor_series(U, nu, h, theta, omega, s, p * p, sa, ca, cf, S, C,
+                                  sc_known, s0, c0)
+        th, om = taylor_eval(cf, n, 1.0, h)
+        return th, om, n, s1, c1
+    th, om = step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
+                  method, kt, kw)
+    return th, om, 0, 0.0, 0.0
+
+
+@njit(cache=True)
+def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
+               s, p, sa, ca, linear, method, kt, kw, h_step, cf, n):
+    """Largest ``|theta|`` at a turning point strictly inside ``[t, t + h]`` (0 if none).
+
+    ``[t, t + h]`` is the start of the current step of length ``h_step`` (see :func:`_sub`).
+    The turning point is located on the cubic Hermite interpolant, the solution is evaluated
+    there (Taylor polynomial, or re-integration), and the small residual velocity is removed by
+    one quadratic (Newton) correction, so the peak is as accurate as the stepper rather than the
+    interpolant.
     """
     c0, c1, c2, c3 = _hermite(th_a, om_a, th_b, om_b, h)
     e1, e2 = _stationary(c1, c2, c3)
@@ -231,8 +407,8 @@ def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
         x = e1 if k == 0 else e2
         if np.isnan(x):
             continue
-        th_e, om_e = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h, th_a, om_a, s, p, sa, ca,
-                          linear, high_order, kt, kw)
+        th_e, om_e = _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h_step, x * h / h_step, th_a,
+                          om_a, s, p, sa, ca, linear, method, kt, kw, cf, n)
         u_e = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + x * h)
         acc = _rhs(th_e, s, u_e, p * p, sa, ca, linear)
         value = th_e
@@ -324,7 +500,7 @@ def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
 @njit(cache=True)
 def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
         p, alpha, eta, theta0, omega0, linear, zeno_tol, stop_at_rest,
-        hist_t, hist_theta, hist_omega, impacts, record, high_order=True):
+        hist_t, hist_theta, hist_omega, impacts, record, method=TAYLOR):
     """Integrate the rocking block over ``n_int`` intervals of the grid.
 
     Parameters
@@ -336,7 +512,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     p, alpha, eta : block (rad/s, rad, -).
     theta0, omega0 : initial state (rad, rad/s).
     linear : use the linearised equation (exact stepping) instead of the nonlinear one.
-    high_order : nonlinear stepping by the 8th-order formula (default) or, if False, RK4.
+    method : nonlinear stepping: ``TAYLOR`` (default), ``RK8`` or ``RK4``.
     zeno_tol : Zeno sequences are summed once ``|omega| < zeno_tol * p * alpha``.
     stop_at_rest : stop as soon as the block is at rest (free motion only).
     hist_t, hist_theta, hist_omega : output arrays of length ``n_int + 1`` (when ``record``).
@@ -349,6 +525,15 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     tan_a = math.tan(alpha)
     kt = np.empty(N_STAGES)
     kw = np.empty(N_STAGES)
+    U, S, C, cf = (np.zeros(2 * (NMAX + 3)), np.zeros(NMAX + 3), np.zeros(NMAX + 3),
+                   np.zeros(NMAX + 3))
+    sc_known, s_phi, c_phi = False, 0.0, 1.0  # sin, cos of s alpha - theta when known
+    # forcing linear over each step: unrolled Taylor steps of a fixed order, adapted as we go
+    # (raised as soon as a step's last terms are too large, lowered after a run of steps where
+    # a lower one would have done); any other step takes the general loop
+    fixed = method == TAYLOR and not linear and (kind == NODAL or kind == RECT or kind == FREE)
+    order, n_low = FIXED_ORDERS[2], 0
+    p2 = p * p
     if linear:
         sa, ca = alpha, 1.0
     else:
@@ -386,6 +571,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                 events += 1
                 if s == 0.0:
                     # ---- at rest: wait for |ug''| > g tan(alpha)
+                    sc_known = False
                     if stop_at_rest:
                         status = REST
                         t = max(t, rest_until)
@@ -410,22 +596,48 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                     if t >= t2:
                         break
                 h = t2 - t
-                th2, om2 = step(kind, amp, tp, t0, uval, j, ta, tb, t, h,
-                                theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
+                if fixed and order <= FIXED_ORDERS[-1]:
+                    if not sc_known:
+                        sn, cs = math.sin(theta), math.cos(theta)
+                        s_phi = s * sa * cs - ca * sn
+                        c_phi = ca * cs + s * sa * sn
+                        sc_known = True
+                    u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
+                    th2, wh2, s_next, c_next, flag = taylor_fixed(
+                        order, u0, u1, p2 * h * h, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
+                    nt = 0
+                    if flag != 0:
+                        nt = order
+                        n_low = n_low + 1 if flag == 2 else 0
+                        if n_low >= 16 and order > FIXED_ORDERS[0]:
+                            order -= 2
+                            n_low = 0
+                        om2 = wh2 / h
+                else:
+                    nt = 0
+                if nt == 0:
+                    th2, om2, nt, s_next, c_next = _advance(
+                        kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca,
+                        linear, method, kt, kw, U, S, C, cf, sc_known, s_phi, c_phi)
+                    if fixed and nt > 0:
+                        order = max(FIXED_ORDERS[0], nt + (nt & 1))
+                # sin and cos of the angle to the corner carry over only to an accepted step
+                sc_known = False
                 if omega * om2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI:
                     # fast path: no turning point, so theta is monotonic over the step and can
                     # neither reach 0 nor peak inside it (the common case)
                     if abs(th2) > max_abs:
                         max_abs = abs(th2)
                     theta, omega, t = th2, om2, t2
+                    sc_known, s_phi, c_phi = nt > 0, s_next, c_next
                     continue
                 c0, c1, c2, c3 = _hermite(theta, omega, th2, om2, h)
                 # ---- impact: theta reaches 0 (first crossing of the step, grazes included)
                 lo, hi, interior = _first_crossing(c0, c1, c2, c3, s, 0.0)
                 if interior:
                     # a dip of the interpolant inside the step: real only if the solution dips
-                    th_e, _ = step(kind, amp, tp, t0, uval, j, ta, tb, t, hi * h,
-                                   theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
+                    th_e, _ = _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, hi, theta, omega,
+                                   s, p, sa, ca, linear, method, kt, kw, cf, nt)
                     if s * th_e > 0.0:
                         lo = -1.0
                 if lo >= 0.0 and (events < _MAX_EVENTS_PER_STEP):
@@ -451,8 +663,8 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         x = xn
                     converged = False
                     for _ in range(8):
-                        th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
-                                          theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
+                        th_x, om_x = _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, x, theta,
+                                          omega, s, p, sa, ca, linear, method, kt, kw, cf, nt)
                         if om_x == 0.0:
                             break
                         xn = x - th_x / (om_x * h)
@@ -463,14 +675,15 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         if converged:
                             break  # (th_x, om_x) is the state 4e-16 h before x: kept as is
                     if not converged:
-                        th_x, om_x = step(kind, amp, tp, t0, uval, j, ta, tb, t, x * h,
-                                          theta, omega, s, p, sa, ca, linear, high_order, kt, kw)
+                        th_x, om_x = _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, x, theta,
+                                          omega, s, p, sa, ca, linear, method, kt, kw, cf, nt)
                     t_imp = t + x * h
                     if t_imp <= t:
                         t_imp = t + 1e-16 * max(abs(t), 1.0)
                     # peak between t and the impact
                     pk = _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, t_imp - t, theta,
-                                    omega, th_x, om_x, s, p, sa, ca, linear, high_order, kt, kw)
+                                    omega, th_x, om_x, s, p, sa, ca, linear, method, kt, kw,
+                                    h, cf, nt)
                     if pk > max_abs:
                         max_abs = pk
                     if n_imp < impacts.shape[0]:
@@ -522,12 +735,13 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                     status = OVERTURNED
                     break
                 pk = _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, th2, om2,
-                                s, p, sa, ca, linear, high_order, kt, kw)
+                                s, p, sa, ca, linear, method, kt, kw, h, cf, nt)
                 if pk > max_abs:
                     max_abs = pk
                 if abs(th2) > max_abs:
                     max_abs = abs(th2)
                 theta, omega, t = th2, om2, t2
+                sc_known, s_phi, c_phi = nt > 0, s_next, c_next
             if status == OVERTURNED or (stop_at_rest and status == REST):
                 break
         if record:
@@ -542,13 +756,13 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
 
 @njit(cache=True)
 def _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
-             linear, zeno_tol, high_order, overturned, max_abs, n_impacts, uplifted):
+             linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted):
     """Run ``i`` of a batch (no history), then the energy rule; results written at index ``i``."""
     empty = np.zeros(0)
     st, th, om, te, mx, ni, nh, up = run(
         kind, amp[i], tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub[i],
         p[i], alpha[i], eta[i], 0.0, 0.0, linear, zeno_tol, False,
-        empty, empty, empty, empty, False, high_order)
+        empty, empty, empty, empty, False, method)
     if st == OVERTURNED:
         over = True
     elif st == ROCKING:
@@ -565,18 +779,18 @@ def _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub
 
 @njit(cache=True)
 def _batch_serial(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                  eta, linear, zeno_tol, high_order, overturned, max_abs, n_impacts, uplifted):
+                  eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted):
     for i in range(p.shape[0]):
         _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                 eta, linear, zeno_tol, high_order, overturned, max_abs, n_impacts, uplifted)
+                 eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted)
 
 
 @njit(cache=True, parallel=True)
 def _batch_parallel(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                    eta, linear, zeno_tol, high_order, overturned, max_abs, n_impacts, uplifted):
+                    eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted):
     for i in prange(p.shape[0]):
         _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                 eta, linear, zeno_tol, high_order, overturned, max_abs, n_impacts, uplifted)
+                 eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted)
 
 
 #: batches at least this large use threads: on small batches (and on a busy machine, or inside
@@ -586,7 +800,7 @@ PARALLEL_MIN_RUNS = 256
 
 
 def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
-             linear, zeno_tol, high_order=True):
+             linear, zeno_tol, method=TAYLOR):
     """:func:`run` for many blocks/amplitudes at once (arrays ``amp``, ``p``, ``alpha``, ``eta``,
     ``n_sub`` of equal length), then the energy rule; no histories are kept.
 
@@ -597,5 +811,5 @@ def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p
            np.zeros(n, dtype=np.bool_))
     batch = _batch_parallel if n >= PARALLEL_MIN_RUNS else _batch_serial
     batch(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
-          linear, zeno_tol, high_order, *out)
+          linear, zeno_tol, method, *out)
     return out

@@ -218,7 +218,7 @@ def _choose_model(model: str, block: Block, tol: float) -> str:
 # --------------------------------------------------------------------------- simulate
 def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: float = 0.0,
              duration: float | None = None, model: str = "auto", tol: float = 1e-6,
-             history: bool = True, zeno_tol: float = ZENO_TOL, order: int = 8,
+             history: bool = True, zeno_tol: float = ZENO_TOL, method: str = "taylor",
              ph_max: float | None = None) -> RockingResult:
     """Rocking response of ``block`` to ``excitation``.
 
@@ -243,11 +243,14 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         Keep ``t``, ``theta``, ``omega`` (set False to save memory on very long records).
     zeno_tol : float
         Post-impact ``|omega| / (p alpha)`` below which a Zeno sequence is summed in closed form.
-    order : {8, 4}
-        Fast engine only: the 8th-order Dormand-Prince formula (default) or classical RK4.
+    method : {"taylor", "rk8", "rk4"}
+        Fast engine only: how each step is taken.  ``"taylor"`` (default): the Taylor series of
+        the solution, summed to rounding level (exact to rounding for forcing linear over the
+        step, and its polynomial locates impacts and peaks); ``"rk8"``: the 8th-order
+        Dormand-Prince formula; ``"rk4"``: classical RK4 (both for comparison, see benchmarks).
     ph_max : float, optional
         Fast engine only: largest ``p_eff * h`` of a step (default :data:`PH_MAX`, or
-        :data:`PH_MAX_RK4` for ``order=4``); smaller means more sub-steps per sample.
+        :data:`PH_MAX_RK4` for ``method="rk4"``); smaller means more sub-steps per sample.
 
     Returns
     -------
@@ -262,10 +265,9 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         raise ValueError(f"theta0 must lie inside (-pi/2, pi/2), got {theta0!r}")
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be positive and finite, got {duration!r}")
-    if order not in (4, 8):
-        raise ValueError(f"order must be 8 or 4, got {order!r}")
+    stepper = _check_method(method)
     if ph_max is None:
-        ph_max = PH_MAX if order == 8 else PH_MAX_RK4
+        ph_max = _default_ph_max(method)
     chosen = _choose_model(model, block, tol)
     at_rest = theta0 == 0.0 and omega0 == 0.0
     if excitation is not None and at_rest and model in ("auto", "fast", "linear"):
@@ -278,7 +280,17 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         return simulate_reference(block, excitation, theta0=theta0, omega0=omega0,
                                   duration=duration, zeno_tol=zeno_tol)
     return _simulate_compiled(block, excitation, theta0, omega0, duration, chosen == "linear",
-                              history, zeno_tol, order == 8, ph_max)
+                              history, zeno_tol, stepper, ph_max)
+
+
+def _check_method(method: str) -> int:
+    if method not in engine.METHODS:
+        raise ValueError(f"method must be one of {', '.join(engine.METHODS)}; got {method!r}")
+    return engine.METHODS[method]
+
+
+def _default_ph_max(method: str) -> float:
+    return PH_MAX_RK4 if method == "rk4" else PH_MAX
 
 
 def _never_uplifts(block, excitation, duration, history):
@@ -292,7 +304,7 @@ def _never_uplifts(block, excitation, duration, history):
 
 
 def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_tol,
-              stop_at_rest=False, high_order=True, ph_max=PH_MAX):
+              stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX):
     h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
     n_sub = int(_n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else ph_max))
     if linear and grid.kind in (engine.NODAL, engine.RECT, engine.FREE):
@@ -303,14 +315,14 @@ def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_t
     out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes, grid.t_start,
                      grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta, theta0, omega0,
                      linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om, impacts, history,
-                     high_order)
+                     method)
     status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
         out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes,
                          grid.t_start, grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta,
                          theta0, omega0, linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om,
-                         impacts, history, high_order)
+                         impacts, history, method)
         status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted = out
     return (status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts[:n_imp],
             hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist])
@@ -327,7 +339,7 @@ def _free_grid(block: Block, t_start: float, length: float, h_hint: float | None
 
 
 def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, history, zeno_tol,
-                       high_order=True, ph_max=PH_MAX):
+                       method=engine.TAYLOR, ph_max=PH_MAX):
     name = "linear" if linear else "fast"
     if excitation is None:
         # free rocking: the energy rule already knows the verdict; integrate for the history
@@ -335,7 +347,7 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
         length = duration if duration is not None else _free_rocking_horizon(block)
         grid = _free_grid(block, 0.0, length, None)
         res = _run_grid(grid, block, theta0, omega0, linear, history, zeno_tol,
-                        stop_at_rest=duration is None, high_order=high_order, ph_max=ph_max)
+                        stop_at_rest=duration is None, method=method, ph_max=ph_max)
         status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
         if status == engine.OVERTURNED:
             over, verdict_by, t_over = True, "integration", t_end
@@ -349,7 +361,7 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
 
     grid = _grid(excitation, block.p, linear, duration, ph_max)
     res = _run_grid(grid, block, theta0, omega0, linear, history, zeno_tol,
-                    high_order=high_order, ph_max=ph_max)
+                    method=method, ph_max=ph_max)
     status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
     t_over = math.nan
     if status == engine.OVERTURNED:
@@ -366,7 +378,7 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
         h_hint = excitation.dt if isinstance(excitation, Record) else excitation.tp / 50
         free = _free_grid(block, t_end, start + duration - t_end, h_hint)
         res2 = _run_grid(free, block, theta, omega, linear, history, zeno_tol,
-                         high_order=high_order, ph_max=ph_max)
+                         method=method, ph_max=ph_max)
         status2, _, _, t_end2, max2, n2, _, imp2, t2, th2, om2 = res2
         if status2 == engine.OVERTURNED:
             t_over = t_end2
@@ -400,7 +412,7 @@ def _result(block, over, max_abs, impacts, n_imp, t, th, om, model, verdict_by, 
 
 # --------------------------------------------------------------------------- batch
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
-                  model: str = "fast", order: int = 8) -> BatchResult:
+                  model: str = "fast", method: str = "taylor") -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
 
     Parameters
@@ -413,7 +425,7 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         False: ``blocks`` and ``scales`` broadcast pairwise (1-D result).  True: every block
         against every scale, results of shape ``(n_blocks, n_scales)``.
     model : {"fast", "linear"}
-    order : {8, 4}
+    method : {"taylor", "rk8", "rk4"}
         Stepping formula of the fast engine (see :func:`simulate`).
 
     Returns
@@ -441,7 +453,8 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         shape = p.shape
     p, alpha, eta, scales = (np.ascontiguousarray(a, dtype=float).ravel()
                              for a in (p, alpha, eta, scales))
-    ph_max = PH_MAX if order == 8 else PH_MAX_RK4
+    stepper = _check_method(method)
+    ph_max = _default_ph_max(method)
     g = _grid(excitation, float(p.max()), linear, None, ph_max)
     amp = g.amp * scales
     h = g.h if g.nodes.size == 0 else float(np.max(np.diff(g.nodes)))
@@ -451,7 +464,7 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         n_sub[:] = 1
     over, max_abs, n_imp, up = engine.run_many(g.kind, amp, g.tp, g.t0, g.uval, g.nodes,
                                                g.t_start, g.h, g.n_int, n_sub, p, alpha, eta,
-                                               linear, ZENO_TOL, order == 8)
+                                               linear, ZENO_TOL, stepper)
     ratio = max_abs / alpha
     return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
                        max_abs.reshape(shape), ratio.reshape(shape), n_imp.reshape(shape),
