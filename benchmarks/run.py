@@ -14,8 +14,10 @@ headline speed figures are ratios measured interleaved, which drift cancels.
 Sections:
 
 ``solver``      work-precision of every model and setting on (a) pulses, (b) real records,
-                (c) near-overturning cases (wrong verdicts); the log-log plot of time against error;
-                the issue-2 ratio (fast against the usual approach on a 20 s, 200 Hz record).
+                (c) near-overturning cases (wrong verdicts), the fast engine with each stepping
+                method (``taylor``, the default; ``rk8``; ``rk4``); the log-log plot of time against
+                error; the issue-2 ratio (fast, default method and rk8 side by side, against the
+                usual approach on a 20 s, 200 Hz record).
 ``linear``      the linearised model's error against alpha, and where ``model="auto"`` switches.
 ``cost``        time against record length (10 s to 1 h) and against blocks in a batch;
                 the 100 x 100 spectrum grid; ``pipeline simulate`` cold start.
@@ -234,11 +236,18 @@ def headline_record():
 
 # =========================================================================== models
 class Setting:
-    """One model and setting of the work-precision study."""
+    """One model and setting of the work-precision study.
 
-    def __init__(self, label, family, kind, res=None, order=8, ph_max=None, usual=None, slow=False):
+    ``method``: the fast engine's stepper ("taylor", "rk8", "rk4"); ``res``: steps per pulse
+    period (pulses) or sub-steps per sample (records); ``steps``: steps per pulse period when
+    ``res`` is None (the ``ph_max`` sweeps on pulses; None = 200).
+    """
+
+    def __init__(self, label, family, kind, res=None, method="taylor", ph_max=None, usual=None, slow=False,
+                 steps=None):
         self.label, self.family, self.kind, self.res = label, family, kind, res
-        self.order, self.ph_max, self.usual, self.slow = order, ph_max, usual, slow
+        self.method, self.ph_max, self.usual, self.slow = method, ph_max, usual, slow
+        self.steps = steps
 
     def run(self, block, exc):
         """(overturned, max|theta|/alpha)."""
@@ -257,12 +266,30 @@ class Setting:
         if isinstance(exc, Record):
             if self.res is not None:  # res = sub-steps per sample
                 ph = exc.dt * block.p * math.sqrt(1.0 + exc.pga / G) / self.res
-            r = rocking.simulate(block, exc, model="fast", order=self.order, ph_max=ph, history=False)
+            r = rocking.simulate(block, exc, model="fast", method=self.method, ph_max=ph, history=False)
             return r.overturned, r.max_rotation_ratio
-        steps = self.res if self.res is not None else 200
+        steps = self.res if self.res is not None else (self.steps or 200)
         with steps_per_tp(steps):
-            r = rocking.simulate(block, exc, model="fast", order=self.order, ph_max=ph, history=False)
+            r = rocking.simulate(block, exc, model="fast", method=self.method, ph_max=ph, history=False)
         return r.overturned, r.max_rotation_ratio
+
+
+#: the fast engine's stepping methods in the work-precision study: (method, family label)
+FAST_FAMILIES = (("taylor", "fast taylor"), ("rk8", "fast rk8"), ("rk4", "fast rk4"))
+
+
+def _default_method() -> str:
+    """The default ``method`` of ``rocking.simulate`` (read from its signature)."""
+    import inspect
+
+    import rocking
+
+    return inspect.signature(rocking.simulate).parameters["method"].default
+
+
+def _method_label(method: str) -> str:
+    """``"fast taylor (default method)"`` for the default stepper of ``rocking.simulate``."""
+    return f"fast {method}" + (" (default method)" if method == _default_method() else "")
 
 
 USUAL_DEFAULT = dict(method="RK45", rtol=1e-3, atol=1e-6)
@@ -273,29 +300,37 @@ def settings(kind: str):
     from rocking import solver
 
     out = []
+    default_n, default_ph = solver.STEPS_PER_TP, solver.PH_MAX
+    rk4_ph = getattr(solver, "PH_MAX_RK4", None)
+
+    def dflt(value, default):
+        return " (default)" if value == default else ""
+
+    # per method: steps per Tp (pulses) or sub-steps per sample (records), and ph_max values; the
+    # ph_max sweeps on pulses run at ``ph_steps`` steps per Tp (the default for taylor and rk8,
+    # where the ph_max cap then binds for the longer pulses; 200 for rk4, which needs small steps)
     if kind == "pulse":
-        default = solver.STEPS_PER_TP
-        for n in sorted({12, default, 50, 100, 200}):
-            out.append(Setting(f"fast o8, {n} steps/Tp" + (" (default)" if n == default else ""),
-                               "fast o8", "fast", res=n))
-        for ph in (0.4, 0.1):
-            out.append(Setting(f"fast o8, ph_max {ph}", "fast o8 ph_max", "fast", ph_max=ph))
-        for n in (200, 400, 800, 1600):
-            out.append(Setting(f"fast o4, {n} steps/Tp" + (" (default)" if n == default else ""),
-                               "fast o4", "fast", res=n, order=4))
-        for ph in (0.1, 0.025):
-            out.append(Setting(f"fast o4, ph_max {ph}", "fast o4 ph_max", "fast", order=4, ph_max=ph))
+        plan = {"taylor": (sorted({4, 8, default_n, 50}), (0.1, default_ph, 0.5), default_n),
+                "rk8": (sorted({12, default_n, 50, 200}), (0.1, 0.4), default_n),
+                "rk4": ((200, 400, 800, 1600), (0.1, 0.025), 200)}
     else:
-        for k in (1, 2, 4):
-            out.append(Setting(f"fast o8, {k} sub-step/sample" + (" (default)" if k == 1 else ""),
-                               "fast o8", "fast", res=k))
-        for ph in (0.4, 0.1):
-            out.append(Setting(f"fast o8, ph_max {ph}", "fast o8 ph_max", "fast", ph_max=ph))
-        for k in (1, 2, 4, 8):
-            out.append(Setting(f"fast o4, {k} sub-step/sample" + (" (default)" if k == 1 else ""),
-                               "fast o4", "fast", res=k, order=4))
-        for ph in (0.1, 0.025):
-            out.append(Setting(f"fast o4, ph_max {ph}", "fast o4 ph_max", "fast", order=4, ph_max=ph))
+        plan = {"taylor": ((1, 2, 4), (0.1, 0.5), None),
+                "rk8": ((1, 2, 4), (0.1, 0.4), None),
+                "rk4": ((1, 2, 4, 8), (0.1, 0.025), None)}
+    for method, family in FAST_FAMILIES:
+        name = _method_label(method)
+        ress, phs, ph_steps = plan[method]
+        ph_default = rk4_ph if method == "rk4" else default_ph
+        for n in ress:
+            if kind == "pulse":
+                label = f"{name}, {n} steps/Tp{dflt(n, default_n)}"
+            else:
+                label = f"{name}, {n} sub-step/sample" + (" (default)" if n == 1 else "")
+            out.append(Setting(label, family, "fast", res=n, method=method))
+        for ph in phs:
+            at = f" at {ph_steps} steps/Tp{dflt(ph_steps, default_n)}" if kind == "pulse" else ""
+            out.append(Setting(f"{name}, ph_max {ph:g}{dflt(ph, ph_default)}{at}", family + " ph_max", "fast",
+                               method=method, ph_max=ph, steps=ph_steps))
     out.append(Setting("linear", "linear", "linear"))
     out.append(Setting("reference (DOP853 rtol 1e-12, split at samples)", "reference", "reference", slow=True))
     out.append(Setting("usual: RK45 default tol (issue 2 baseline)", "usual RK45", "usual",
@@ -556,28 +591,40 @@ def headline(quick):
             break
     exc = rec.scaled(scale)
     ref = rocking.simulate(blk, exc, model="reference", history=False)
-    fast = rocking.simulate(blk, exc, model="fast", history=False)
+    fast = rocking.simulate(blk, exc, model="fast", history=False)  # the default method
+    rk8 = rocking.simulate(blk, exc, model="fast", method="rk8", history=False)  # the previous default
     usual = simulate_usual(blk, exc, **USUAL_DEFAULT)
     n_round = 3 if quick else 7
-    t_fast, t_fast_hist, t_usual, t_many = [], [], [], []
-    for _ in range(n_round):  # interleaved, so the ratio sees the same machine state
+    t_fast, t_fast_hist, t_usual, t_many, t_rk8, t_many_rk8 = [], [], [], [], [], []
+    for _ in range(n_round):  # interleaved, so the ratios see the same machine state
         t_fast.append(per_call(lambda: rocking.simulate(blk, exc, model="fast", history=False),
                                budget=0.05, repeat=3))
+        t_rk8.append(per_call(lambda: rocking.simulate(blk, exc, model="fast", method="rk8", history=False),
+                              budget=0.05, repeat=3))
         t_fast_hist.append(per_call(lambda: rocking.simulate(blk, exc, model="fast"), budget=0.05, repeat=3))
         t_many.append(timed(lambda: rocking.simulate_many([blk] * 200, exc))[1] / 200)
+        t_many_rk8.append(timed(lambda: rocking.simulate_many([blk] * 200, exc, method="rk8"))[1] / 200)
         t_usual.append(timed(lambda: simulate_usual(blk, exc, **USUAL_DEFAULT))[1])
     ratios = [u / f for u, f in zip(t_usual, t_fast)]
+    ratios_rk8 = [u / f for u, f in zip(t_usual, t_rk8)]
     e_fast = abs(fast.max_rotation_ratio - ref.max_rotation_ratio)
+    e_rk8 = abs(rk8.max_rotation_ratio - ref.max_rotation_ratio)
     e_usual = abs(usual.max_rotation_ratio - ref.max_rotation_ratio)
     return dict(record=rec.name, scale=scale, npts=exc.npts, ref_ratio=ref.max_rotation_ratio,
                 ref_over=ref.overturned, n_impacts=ref.n_impacts, fast_ratio=fast.max_rotation_ratio,
                 usual_ratio=usual.max_rotation_ratio, usual_restarts=usual.n_restarts,
+                method=_default_method(),
                 t_fast=statistics.median(t_fast), t_fast_best=min(t.best for t in t_fast),
                 t_usual_best=min(t_usual), t_fast_hist=statistics.median(t_fast_hist),
                 t_many=statistics.median(t_many), t_usual=statistics.median(t_usual),
                 speed_ratio=statistics.median(ratios), speed_ratio_min=min(ratios),
                 e_fast=e_fast, e_usual=e_usual,
-                acc_ratio=(e_usual / e_fast) if e_fast > 0 else math.inf, n_round=n_round)
+                acc_ratio=(e_usual / e_fast) if e_fast > 0 else math.inf, n_round=n_round,
+                t_rk8=statistics.median(t_rk8), t_rk8_best=min(t.best for t in t_rk8),
+                t_many_rk8=statistics.median(t_many_rk8), e_rk8=e_rk8,
+                speed_ratio_rk8=statistics.median(ratios_rk8), speed_ratio_rk8_min=min(ratios_rk8),
+                rk8_over_default=statistics.median([r / f for r, f in zip(t_rk8, t_fast)]),
+                acc_ratio_rk8=(e_usual / e_rk8) if e_rk8 > 0 else math.inf)
 
 
 def plot_work_precision(results, path):
@@ -588,10 +635,10 @@ def plot_work_precision(results, path):
 
     floor = 1e-16
     fig, axes = plt.subplots(1, len(results), figsize=(6.2 * len(results), 5.0), squeeze=False)
-    colours = {"fast o8": "C0", "fast o8 ph_max": "C0", "fast o4": "C1", "fast o4 ph_max": "C1",
-               "linear": "C2", "usual RK45": "C3", "usual DOP853": "C4"}
-    markers = {"fast o8": "o", "fast o8 ph_max": "s", "fast o4": "o", "fast o4 ph_max": "s",
-               "linear": "D", "usual RK45": "^", "usual DOP853": "v"}
+    colours = {"fast taylor": "C5", "fast taylor ph_max": "C5", "fast rk8": "C0", "fast rk8 ph_max": "C0",
+               "fast rk4": "C1", "fast rk4 ph_max": "C1", "linear": "C2", "usual RK45": "C3", "usual DOP853": "C4"}
+    markers = {"fast taylor": "o", "fast taylor ph_max": "s", "fast rk8": "o", "fast rk8 ph_max": "s",
+               "fast rk4": "o", "fast rk4 ph_max": "s", "linear": "D", "usual RK45": "^", "usual DOP853": "v"}
     for ax, (title, (res, ref_time)) in zip(axes[0], results.items()):
         fams = {}
         for label, r in res.items():
@@ -622,11 +669,14 @@ def plot_work_precision(results, path):
 
 
 def section_solver(md, out, quick, records, rec_notes):
+    from rocking import solver
+
     log("solver: headline (issue 2 ratio on a 20 s, 200 Hz record)")
     h = headline(quick)
     out["headline"] = h
-    log(f"  fast {fmt_t(h['t_fast'])}, usual {fmt_t(h['t_usual'])}, ratio {h['speed_ratio']:.0f}x; "
-        f"errors fast {fmt_e(h['e_fast'])}, usual {fmt_e(h['e_usual'])}")
+    log(f"  fast ({h['method']}) {fmt_t(h['t_fast'])}, rk8 {fmt_t(h['t_rk8'])}, usual {fmt_t(h['t_usual'])}, "
+        f"ratio {h['speed_ratio']:.0f}x (rk8: {h['speed_ratio_rk8']:.0f}x); errors fast {fmt_e(h['e_fast'])}, "
+        f"rk8 {fmt_e(h['e_rk8'])}, usual {fmt_e(h['e_usual'])}")
 
     log("solver: (a) pulses of all shapes: reference")
     pcases = pulse_cases(quick)
@@ -678,15 +728,25 @@ def section_solver(md, out, quick, records, rec_notes):
               "RK45 at default tolerances, `max_step` = dt, an impact event restarting the integration at "
               f"every impact ({h['usual_restarts']} restarts here), overturning at |theta| = pi/2. "
               f"Medians of {h['n_round']} interleaved rounds.\n")
-    md.append("| | time per run | error of max\\|theta\\|/alpha vs reference |")
-    md.append("|---|---|---|")
-    md.append(f"| fast engine, `simulate(..., history=False)` | {fmt_t(h['t_fast'])} (best {fmt_t(h['t_fast_best'])}) | {fmt_e(h['e_fast'])} |")
-    md.append(f"| fast engine, `simulate(...)` with history | {fmt_t(h['t_fast_hist'])} | same |")
-    md.append(f"| fast engine in a batch (`simulate_many`, 200 blocks, 2 threads), per run | {fmt_t(h['t_many'])} | same |")
-    md.append(f"| usual approach (RK45 default) | {fmt_t(h['t_usual'])} (best {fmt_t(h['t_usual_best'])}) | {fmt_e(h['e_usual'])} |")
+    m = h["method"]
+    md.append("| | time per run | error of max\\|theta\\|/alpha vs reference | usual approach's time / this |")
+    md.append("|---|---|---|---|")
+    md.append(f"| fast engine, default `method=\"{m}\"`, `simulate(..., history=False)` | {fmt_t(h['t_fast'])} "
+              f"(best {fmt_t(h['t_fast_best'])}) | {fmt_e(h['e_fast'])} | **{h['speed_ratio']:.0f}x** |")
+    md.append(f"| fast engine, `method=\"rk8\"` (the previous default), `history=False` | {fmt_t(h['t_rk8'])} "
+              f"(best {fmt_t(h['t_rk8_best'])}) | {fmt_e(h['e_rk8'])} | {h['speed_ratio_rk8']:.0f}x |")
+    md.append(f"| fast engine, `method=\"{m}\"`, `simulate(...)` with history | {fmt_t(h['t_fast_hist'])} | same as above | |")
+    md.append(f"| fast engine in a batch (`simulate_many`, 200 blocks, 2 threads), per run, `method=\"{m}\"` / "
+              f"`\"rk8\"` | {fmt_t(h['t_many'])} / {fmt_t(h['t_many_rk8'])} | same as above | |")
+    md.append(f"| usual approach (RK45 default) | {fmt_t(h['t_usual'])} (best {fmt_t(h['t_usual_best'])}) | "
+              f"{fmt_e(h['e_usual'])} | 1 |")
     acc = "infinite (fast error is 0)" if math.isinf(h["acc_ratio"]) else f"{h['acc_ratio']:.2g}x"
-    md.append(f"\n**Speed ratio {h['speed_ratio']:.0f}x** (slowest round {h['speed_ratio_min']:.0f}x; target 1000x); "
-              f"**accuracy ratio {acc}** (target 1000x).\n")
+    acc8 = "infinite (its error is 0)" if math.isinf(h["acc_ratio_rk8"]) else f"{h['acc_ratio_rk8']:.2g}x"
+    md.append(f"\n**Speed ratio {h['speed_ratio']:.0f}x** with the default `method=\"{m}\"` (slowest round "
+              f"{h['speed_ratio_min']:.0f}x; target 1000x); **accuracy ratio {acc}** (target 1000x). "
+              f"With `method=\"rk8\"`, measured in the same rounds: {h['speed_ratio_rk8']:.0f}x (slowest round "
+              f"{h['speed_ratio_rk8_min']:.0f}x), accuracy ratio {acc8}; rk8 takes {h['rk8_over_default']:.2f}x "
+              f"the time of {m} (median over rounds).\n")
 
     md.append("### (a) Pulses of all shapes\n")
     md.append(f"{len(pcases)} cases: the four shapes on the Temple column (tan alpha = 0.24, p = 1.381 rad/s) at "
@@ -694,7 +754,14 @@ def section_solver(md, out, quick, records, rec_notes):
               ", each at 60 % and 95 % of its smallest overturning amplitude (found by a fast scan), so the "
               "column rocks hard and survives. Error = |max|theta|/alpha - reference| over the cases where both survive; a different "
               "verdict is counted instead. Times are medians over the cases of each model's median time. "
-              "The usual approach uses `max_step` = Tp/200 on pulses.\n")
+              "The usual approach uses `max_step` = Tp/200 on pulses. The fast engine is measured with each "
+              "stepping `method` (`taylor`: the Taylor series summed to rounding, the default; `rk8`: 8th-order "
+              "Dormand-Prince, the previous default; `rk4`: classical RK4) against steps per Tp "
+              f"(`rocking.solver.STEPS_PER_TP`, default {solver.STEPS_PER_TP}) and `ph_max` (default "
+              f"{solver.PH_MAX:g}"
+              + (f", {solver.PH_MAX_RK4:g} for rk4" if hasattr(solver, "PH_MAX_RK4") else "") +
+              "; the cap on p_eff h, which binds for the longer pulses), the `ph_max` sweeps at the steps per "
+              "Tp their label says.\n")
     md += wp_table(pres, pref_t)
     if rres:
         md.append("\n### (b) Real records\n")
