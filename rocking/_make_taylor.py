@@ -26,6 +26,14 @@ from numba import njit
 '''
 
 
+def _tree(terms: list[str]) -> str:
+    """A sum written as a balanced tree (shorter dependency chains than left to right)."""
+    if len(terms) == 1:
+        return terms[0]
+    mid = len(terms) // 2
+    return f"({_tree(terms[:mid])} + {_tree(terms[mid:])})"
+
+
 def _function(n: int) -> str:
     lines = [f"\n\n@njit(cache=True)\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf):",
              "    S_0 = s0",
@@ -34,8 +42,8 @@ def _function(n: int) -> str:
              "    c_2 = -0.5 * q * (S_0 + u0 * C_0)",
              "    D_2 = 2.0 * c_2"]
     for k in range(1, n - 1):
-        sk = " + ".join(f"D_{i} * C_{k - i}" for i in range(1, k + 1))
-        ck = " + ".join(f"D_{i} * S_{k - i}" for i in range(1, k + 1))
+        sk = _tree([f"D_{i} * C_{k - i}" for i in range(1, k + 1)])
+        ck = _tree([f"D_{i} * S_{k - i}" for i in range(1, k + 1)])
         lines += [f"    S_{k} = -({sk}) * {1.0 / k!r}",
                   f"    C_{k} = ({ck}) * {1.0 / k!r}",
                   f"    c_{k + 2} = -q * (S_{k} + u0 * C_{k} + u1 * C_{k - 1}) * {1.0 / ((k + 1) * (k + 2))!r}",

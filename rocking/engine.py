@@ -64,7 +64,7 @@ METHODS = {"taylor": TAYLOR, "rk8": RK8, "rk4": RK4}
 NMAX = 40
 #: a Taylor series is cut once two consecutive terms of theta and of ``h * omega`` fall below
 #: ``TAYLOR_EPS`` times the size of the step's leading terms
-TAYLOR_EPS = 1e-16
+TAYLOR_EPS = 1e-15
 _INV = np.array([0.0] + [1.0 / k for k in range(1, NMAX + 3)])
 _INV2 = np.array([1.0 / ((k + 1) * (k + 2)) for k in range(NMAX + 3)])
 
@@ -498,6 +498,64 @@ def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
 
 
 @njit(cache=True)
+def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omega, s, sa, ca, p2,
+            max_abs, sc_known, s_phi, c_phi, order, n_low, cf, record, hist_t, hist_theta,
+            hist_omega, n_hist):
+    """Whole intervals from ``j`` on, each one unrolled Taylor step, while nothing happens.
+
+    Stops (returning the state at the start of interval ``j``, for :func:`run` to take that
+    interval the general way) at the first interval where ``theta`` or ``omega`` would change
+    sign or reach ``pi/2``, or where the series needs more terms than the unrolled orders have.
+    The block must be rocking at the start of interval ``j`` (``t`` is its start).
+    """
+    uniform = nodes.shape[0] == 0
+    while j < n_int:
+        if uniform:
+            ta = t_start + j * h_uniform
+            tb = t_start + (j + 1) * h_uniform
+        else:
+            ta, tb = nodes[j], nodes[j + 1]
+        if t != ta:
+            break
+        h = tb - ta
+        inv_h = 1.0 / h  # (off the chain of dependent operations from step to step)
+        if not sc_known:
+            sn, cs = math.sin(theta), math.cos(theta)
+            s_phi = s * sa * cs - ca * sn
+            c_phi = ca * cs + s * sa * sn
+            sc_known = True
+        if kind == NODAL:
+            u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        else:
+            u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
+        q = p2 * h * h
+        th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, omega * h, s_phi,
+                                                      c_phi, TAYLOR_EPS, cf)
+        while flag == 0 and order < FIXED_ORDERS[-1]:
+            order += 2  # the series needs more terms: the next order up
+            th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, omega * h,
+                                                          s_phi, c_phi, TAYLOR_EPS, cf)
+        if flag == 0:
+            break
+        n_low = n_low + 1 if flag == 2 else 0
+        if n_low >= 64 and order > FIXED_ORDERS[0]:
+            order -= 2  # a lower order has been enough for a while
+            n_low = 0
+        om2 = wh2 * inv_h
+        if not (omega * om2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            break  # a turning point, an impact or overturning: the general way
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, omega, t = th2, om2, tb
+        s_phi, c_phi = s_next, c_next
+        if record:
+            hist_t[n_hist], hist_theta[n_hist], hist_omega[n_hist] = t, theta, omega
+            n_hist += 1
+        j += 1
+    return j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low, n_hist
+
+
+@njit(cache=True)
 def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
         p, alpha, eta, theta0, omega0, linear, zeno_tol, stop_at_rest,
         hist_t, hist_theta, hist_omega, impacts, record, method=TAYLOR):
@@ -557,7 +615,16 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     if record:
         hist_t[0], hist_theta[0], hist_omega[0] = t, theta, omega
         n_hist = 1
-    for j in range(n_int):
+    j = 0
+    while j < n_int:
+        if fixed and n_sub == 1 and s != 0.0 and order <= FIXED_ORDERS[-1]:
+            # the common case, whole intervals with no event, in a tight loop
+            (j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low,
+             n_hist) = _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta,
+                               omega, s, sa, ca, p2, max_abs, sc_known, s_phi, c_phi, order,
+                               n_low, cf, record, hist_t, hist_theta, hist_omega, n_hist)
+            if j >= n_int:
+                break
         if uniform:
             ta = t_start + j * h_uniform
             tb = t_start + (j + 1) * h_uniform
@@ -603,23 +670,30 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         c_phi = ca * cs + s * sa * sn
                         sc_known = True
                     u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
+                    q = p2 * h * h
                     th2, wh2, s_next, c_next, flag = taylor_fixed(
-                        order, u0, u1, p2 * h * h, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
+                        order, u0, u1, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
+                    while flag == 0 and order < FIXED_ORDERS[-1]:
+                        order += 2  # the series needs more terms: the next order up
+                        th2, wh2, s_next, c_next, flag = taylor_fixed(
+                            order, u0, u1, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
                     nt = 0
                     if flag != 0:
                         nt = order
                         n_low = n_low + 1 if flag == 2 else 0
-                        if n_low >= 16 and order > FIXED_ORDERS[0]:
-                            order -= 2
+                        if n_low >= 64 and order > FIXED_ORDERS[0]:
+                            order -= 2  # a lower order has been enough for a while
                             n_low = 0
                         om2 = wh2 / h
+                    else:
+                        order += 2  # beyond the unrolled orders: the general loop
                 else:
                     nt = 0
                 if nt == 0:
                     th2, om2, nt, s_next, c_next = _advance(
                         kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca,
                         linear, method, kt, kw, U, S, C, cf, sc_known, s_phi, c_phi)
-                    if fixed and nt > 0:
+                    if fixed and nt > 0:  # back to the unrolled steps when they suffice
                         order = max(FIXED_ORDERS[0], nt + (nt & 1))
                 # sin and cos of the angle to the corner carry over only to an accepted step
                 sc_known = False
@@ -749,6 +823,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
             n_hist += 1
         if status == OVERTURNED or (stop_at_rest and status == REST):
             break
+        j += 1
     if status == REST:
         theta, omega = 0.0, 0.0
     return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted
