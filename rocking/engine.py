@@ -617,6 +617,18 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
         n_hist = 1
     j = 0
     while j < n_int:
+        if s == 0.0 and kind == NODAL and uniform and not stop_at_rest and rest_until <= t:
+            # at rest: on to the first interval whose ends exceed the uplift threshold (the
+            # forcing is linear between them); the history meanwhile is zero
+            while j < n_int and abs(amp * uval[j]) <= tan_a and abs(amp * uval[j + 1]) <= tan_a:
+                j += 1
+                if record:
+                    hist_t[n_hist] = t_start + j * h_uniform
+                    hist_theta[n_hist], hist_omega[n_hist] = 0.0, 0.0
+                    n_hist += 1
+            t = max(t, t_start + j * h_uniform)
+            if j >= n_int:
+                break
         if fixed and n_sub == 1 and s != 0.0 and order <= FIXED_ORDERS[-1]:
             # the common case, whole intervals with no event, in a tight loop
             (j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low,

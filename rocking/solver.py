@@ -150,13 +150,15 @@ def _pulse_grid(pulse: Pulse, h_max: float, t_end: float | None = None) -> np.nd
     start, end = pulse.support
     if t_end is not None:
         end = min(end, t_end)
-    marks = sorted({start, end, *[x for x in _pulse_extrema(pulse) if start < x < end]})
-    pieces = []
-    for a, b in zip(marks[:-1], marks[1:]):
-        n = max(1, math.ceil((b - a) / h_max - 1e-9))
-        pieces.append(np.linspace(a, b, n + 1)[:-1])
-    pieces.append(np.array([end]))
-    return np.concatenate(pieces)
+    marks = np.array(sorted({start, end, *[x for x in _pulse_extrema(pulse) if start < x < end]}))
+    a, b = marks[:-1], marks[1:]
+    n = np.maximum(1, np.ceil((b - a) / h_max - 1e-9)).astype(np.int64)
+    piece = np.repeat(np.arange(n.size), n)  # piece of each node but the last
+    k = np.arange(piece.size) - np.repeat(np.cumsum(n) - n, n)  # its index inside the piece
+    nodes = np.empty(piece.size + 1)
+    nodes[:-1] = a[piece] + (b - a)[piece] * (k / n[piece])
+    nodes[-1] = end
+    return nodes
 
 
 def _n_sub(h: float, p_eff: np.ndarray | float, ph_max: float) -> np.ndarray | int:
@@ -178,15 +180,16 @@ class _Grid:
 
 
 def _grid(excitation, p_max: float, linear: bool, duration: float | None,
-          ph_max: float = PH_MAX) -> _Grid:
+          ph_max: float = PH_MAX, pga: float | None = None) -> _Grid:
     empty = np.zeros(0)
     if isinstance(excitation, Record):
         n_int = excitation.npts - 1
         if duration is not None:
             n_int = min(n_int, max(1, math.ceil(duration / excitation.dt - 1e-9)))
-        uval = excitation.acc / G
-        return _Grid(engine.NODAL, 1.0, 1.0, 0.0, uval, empty, excitation.t_start, excitation.dt,
-                     n_int, float(np.max(np.abs(uval))))
+        # node values in m/s^2, scaled by 1/g in the engine
+        pga = excitation.pga if pga is None else pga
+        return _Grid(engine.NODAL, 1.0 / G, 1.0, 0.0, excitation.acc, empty, excitation.t_start,
+                     excitation.dt, n_int, pga / G)
     if isinstance(excitation, Pulse):
         u_peak = abs(excitation.ap) / G
         p_eff = p_max * math.sqrt(1.0 + u_peak)
@@ -270,8 +273,10 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         ph_max = _default_ph_max(method)
     chosen = _choose_model(model, block, tol)
     at_rest = theta0 == 0.0 and omega0 == 0.0
-    if excitation is not None and at_rest and model in ("auto", "fast", "linear"):
+    peak = None
+    if excitation is not None:
         peak = excitation.pga if isinstance(excitation, Record) else abs(excitation.ap)
+    if excitation is not None and at_rest and model in ("auto", "fast", "linear"):
         if peak / G <= block.tan_alpha:
             return _never_uplifts(block, excitation, duration, history)
     if chosen == "reference":
@@ -280,7 +285,7 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         return simulate_reference(block, excitation, theta0=theta0, omega0=omega0,
                                   duration=duration, zeno_tol=zeno_tol)
     return _simulate_compiled(block, excitation, theta0, omega0, duration, chosen == "linear",
-                              history, zeno_tol, stepper, ph_max)
+                              history, zeno_tol, stepper, ph_max, peak)
 
 
 def _check_method(method: str) -> int:
@@ -339,7 +344,7 @@ def _free_grid(block: Block, t_start: float, length: float, h_hint: float | None
 
 
 def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, history, zeno_tol,
-                       method=engine.TAYLOR, ph_max=PH_MAX):
+                       method=engine.TAYLOR, ph_max=PH_MAX, peak=None):
     name = "linear" if linear else "fast"
     if excitation is None:
         # free rocking: the energy rule already knows the verdict; integrate for the history
@@ -359,7 +364,7 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
         return _result(block, over, max_abs, impacts, n_imp, t, th, om, name, verdict_by,
                        uplifted or theta0 != 0 or omega0 != 0, t_over)
 
-    grid = _grid(excitation, block.p, linear, duration, ph_max)
+    grid = _grid(excitation, block.p, linear, duration, ph_max, peak)
     res = _run_grid(grid, block, theta0, omega0, linear, history, zeno_tol,
                     method=method, ph_max=ph_max)
     status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
