@@ -99,13 +99,20 @@ def forcing(kind, amp, tp, t0, uval, j, ta, tb, t):
 
 # --------------------------------------------------------------------------- steppers
 @njit(cache=True, inline="always")
+def corner_sincos(theta, s, sa, ca):
+    """``sin`` and ``cos`` of ``s alpha - theta`` (by angle addition; none needed at ``theta = 0``,
+    just after an uplift or an impact)."""
+    if theta == 0.0:
+        return s * sa, ca
+    sn, cs = math.sin(theta), math.cos(theta)
+    return s * sa * cs - ca * sn, ca * cs + s * sa * sn
+
+
+@njit(cache=True, inline="always")
 def _rhs(theta, s, u, p2, sa, ca, linear):
     if linear:
         return p2 * (theta - s * sa - u)  # sa carries alpha itself in the linear model
-    # sin(alpha s - theta) and cos(alpha s - theta) by angle addition
-    sn, cs = math.sin(theta), math.cos(theta)
-    sin_d = s * sa * cs - ca * sn
-    cos_d = ca * cs + s * sa * sn
+    sin_d, cos_d = corner_sincos(theta, s, sa, ca)
     return -p2 * (sin_d + u * cos_d)
 
 
@@ -248,9 +255,7 @@ def taylor_series(U, nu, h, theta, omega, s, p2, sa, ca, cf, S, C, sc_known, s0,
     if sc_known:
         S[0], C[0] = s0, c0
     else:
-        sn, cs = math.sin(theta), math.cos(theta)
-        S[0] = s * sa * cs - ca * sn
-        C[0] = ca * cs + s * sa * sn
+        S[0], C[0] = corner_sincos(theta, s, sa, ca)
     q = p2 * h * h
     cf[0] = theta
     cf[1] = omega * h
@@ -294,6 +299,15 @@ def taylor_eval(cf, n, x, h):
         th = th * x + cf[k]
         om = om * x + k * cf[k]
     return th * x + cf[0], om / h
+
+
+@njit(cache=True, inline="always")
+def taylor_acc(cf, n, x, h):
+    """``theta''`` at ``t + x h`` from the coefficients of :func:`taylor_series`."""
+    acc = n * (n - 1) * cf[n]
+    for k in range(n - 1, 1, -1):
+        acc = acc * x + k * (k - 1) * cf[k]
+    return acc / (h * h)
 
 
 # --------------------------------------------------------------------------- Hermite helpers
@@ -409,8 +423,11 @@ def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
             continue
         th_e, om_e = _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h_step, x * h / h_step, th_a,
                           om_a, s, p, sa, ca, linear, method, kt, kw, cf, n)
-        u_e = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + x * h)
-        acc = _rhs(th_e, s, u_e, p * p, sa, ca, linear)
+        if n > 0:
+            acc = taylor_acc(cf, n, x * h / h_step, h_step)
+        else:
+            u_e = forcing(kind, amp, tp, t0, uval, j, ta, tb, t + x * h)
+            acc = _rhs(th_e, s, u_e, p * p, sa, ca, linear)
         value = th_e
         if acc != 0.0:
             value = th_e - 0.5 * om_e * om_e / acc
@@ -506,8 +523,11 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
     Stops (returning the state at the start of interval ``j``, for :func:`run` to take that
     interval the general way) at the first interval where ``theta`` or ``omega`` would change
     sign or reach ``pi/2``, or where the series needs more terms than the unrolled orders have.
-    The block must be rocking at the start of interval ``j`` (``t`` is its start).
+    The block must be rocking at the start of interval ``j`` (``t`` is its start).  When it stops
+    at an event, the step it took is handed over (``pending``, the end state, the end ``sin`` and
+    ``cos``, its polynomial in ``cf``) so that it is not taken twice.
     """
+    pending, th2, om2, s_next, c_next, n_used = False, 0.0, 0.0, 0.0, 1.0, 0
     uniform = nodes.shape[0] == 0
     while j < n_int:
         if uniform:
@@ -520,9 +540,7 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
         h = tb - ta
         inv_h = 1.0 / h  # (off the chain of dependent operations from step to step)
         if not sc_known:
-            sn, cs = math.sin(theta), math.cos(theta)
-            s_phi = s * sa * cs - ca * sn
-            c_phi = ca * cs + s * sa * sn
+            s_phi, c_phi = corner_sincos(theta, s, sa, ca)
             sc_known = True
         if kind == NODAL:
             u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
@@ -537,12 +555,14 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
                                                           s_phi, c_phi, TAYLOR_EPS, cf)
         if flag == 0:
             break
+        n_used = order
         n_low = n_low + 1 if flag == 2 else 0
         if n_low >= 64 and order > FIXED_ORDERS[0]:
             order -= 2  # a lower order has been enough for a while
             n_low = 0
         om2 = wh2 * inv_h
         if not (omega * om2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            pending = True
             break  # a turning point, an impact or overturning: the general way
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -552,7 +572,8 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
             hist_t[n_hist], hist_theta[n_hist], hist_omega[n_hist] = t, theta, omega
             n_hist += 1
         j += 1
-    return j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low, n_hist
+    return (j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low, n_hist,
+            pending, th2, om2, s_next, c_next, n_used)
 
 
 @njit(cache=True)
@@ -586,6 +607,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     U, S, C, cf = (np.zeros(2 * (NMAX + 3)), np.zeros(NMAX + 3), np.zeros(NMAX + 3),
                    np.zeros(NMAX + 3))
     sc_known, s_phi, c_phi = False, 0.0, 1.0  # sin, cos of s alpha - theta when known
+    pending, th2, om2, s_next, c_next, nt, n_pending = False, 0.0, 0.0, 0.0, 1.0, 0, 0
     # forcing linear over each step: unrolled Taylor steps of a fixed order, adapted as we go
     # (raised as soon as a step's last terms are too large, lowered after a run of steps where
     # a lower one would have done); any other step takes the general loop
@@ -631,10 +653,11 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                 break
         if fixed and n_sub == 1 and s != 0.0 and order <= FIXED_ORDERS[-1]:
             # the common case, whole intervals with no event, in a tight loop
-            (j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low,
-             n_hist) = _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta,
-                               omega, s, sa, ca, p2, max_abs, sc_known, s_phi, c_phi, order,
-                               n_low, cf, record, hist_t, hist_theta, hist_omega, n_hist)
+            (j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low, n_hist,
+             pending, th2, om2, s_next, c_next, n_pending) = _cruise(
+                kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omega, s, sa, ca,
+                p2, max_abs, sc_known, s_phi, c_phi, order, n_low, cf, record, hist_t,
+                hist_theta, hist_omega, n_hist)
             if j >= n_int:
                 break
         if uniform:
@@ -675,11 +698,13 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                     if t >= t2:
                         break
                 h = t2 - t
-                if fixed and order <= FIXED_ORDERS[-1]:
+                nt = 0
+                if pending:  # the step the tight loop took and stopped at
+                    nt = n_pending
+                    pending = False
+                elif fixed and order <= FIXED_ORDERS[-1]:
                     if not sc_known:
-                        sn, cs = math.sin(theta), math.cos(theta)
-                        s_phi = s * sa * cs - ca * sn
-                        c_phi = ca * cs + s * sa * sn
+                        s_phi, c_phi = corner_sincos(theta, s, sa, ca)
                         sc_known = True
                     u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
                     q = p2 * h * h
@@ -699,8 +724,6 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         om2 = wh2 / h
                     else:
                         order += 2  # beyond the unrolled orders: the general loop
-                else:
-                    nt = 0
                 if nt == 0:
                     th2, om2, nt, s_next, c_next = _advance(
                         kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca,
@@ -736,7 +759,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                             lo = mid
                         else:
                             hi = mid
-                        if hi - lo < 1e-4:
+                        if hi - lo < 1e-2:
                             break
                     x = hi
                     for _ in range(6):
