@@ -634,6 +634,7 @@ def plot_work_precision(results, path):
     import matplotlib.pyplot as plt
 
     floor = 1e-16
+    default = _default_method()
     fig, axes = plt.subplots(1, len(results), figsize=(6.2 * len(results), 5.0), squeeze=False)
     colours = {"fast taylor": "C5", "fast taylor ph_max": "C5", "fast rk8": "C0", "fast rk8 ph_max": "C0",
                "fast rk4": "C1", "fast rk4 ph_max": "C1", "linear": "C2", "usual RK45": "C3", "usual DOP853": "C4"}
@@ -649,7 +650,8 @@ def plot_work_precision(results, path):
         for fam, pts in fams.items():
             xs, ys = [p[0] for p in pts], [p[1] for p in pts]
             ax.plot(xs, ys, marker=markers.get(fam, "o"), color=colours.get(fam, "k"),
-                    linestyle="-" if "ph_max" not in fam else "none", label=fam, alpha=0.85)
+                    linestyle="-" if "ph_max" not in fam else "none", alpha=0.85,
+                    label=fam.replace(f"fast {default}", f"fast {default} (default)"))
             for x, y, label, wrong in pts:
                 if wrong:
                     ax.annotate(f"{wrong} wrong", (x, y), fontsize=7, color="red")
