@@ -759,7 +759,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                             lo = mid
                         else:
                             hi = mid
-                        if hi - lo < 1e-2:
+                        if hi - lo < 1e-4:
                             break
                     x = hi
                     for _ in range(6):
