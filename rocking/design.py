@@ -184,7 +184,7 @@ KSECTION = 8
 
 
 def _scan_refine(evaluate, x, known=None, rtol=RTOL, zone=True, refine="all", n_zone=None,
-                 max_iter=100):
+                 max_iter=100, ksection=KSECTION):
     """Scan every problem on its abscissae ``x`` and refine every verdict change.
 
     ``evaluate(idx, xs)`` returns the failure verdicts of problems ``idx`` at abscissae ``xs``
@@ -196,7 +196,9 @@ def _scan_refine(evaluate, x, known=None, rtol=RTOL, zone=True, refine="all", n_
     relative; where a step reveals more than one change inside a bracket the highest is followed
     (so the top fail-to-survive transition is always the highest one found).  ``refine="top"``
     refines only each problem's top fail-to-survive bracket (records, whose verdicts can change
-    hundreds of times); the other changes are then reported at scan resolution.
+    hundreds of times); the other changes are then reported at scan resolution.  ``ksection=2``
+    (bisection) needs about half the runs of the default in twice as many batch calls: cheaper
+    when only a few problems are refined at once.
     """
     n_zone = ZONE_POINTS if n_zone is None else int(n_zone)
     x = np.asarray(x, dtype=float)
@@ -266,7 +268,7 @@ def _scan_refine(evaluate, x, known=None, rtol=RTOL, zone=True, refine="all", n_
         prob, lo, hi, flo, fhi = prob[top_mask], lo[top_mask], hi[top_mask], flo[top_mask], fhi[top_mask]
     else:
         done_p, done_lo, done_hi, done_flo, done_fhi = [], [], [], [], []
-    k = KSECTION
+    k = int(ksection)
     frac = np.arange(1, k) / k
     for _ in range(max_iter):
         narrow = (hi - lo) <= rtol * np.abs(hi)
@@ -360,12 +362,17 @@ def _unit_pulse(shape, tp):
 
 
 def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_scan=N_SCAN,
-                          n_zone=None, rtol=RTOL, model="fast"):
+                          n_zone=None, rtol=RTOL, model="fast", refine="all", ksection=KSECTION):
     """Exact minimum slenderness for many ``(pTp, ap/g)`` points of one pulse shape at once.
 
     By the similarity law (SPEC section 4) the answer depends only on ``pTp`` and ``ap/g``, so
     every point is solved with ``Tp = 1 s`` and ``p = pTp``; all scans share one batch-solver call
     and all brackets are refined together.  Returns a list of :class:`MinSlenderness`.
+
+    ``refine="top"`` refines only the transition that decides ``tan_alpha`` (the others, and so
+    :attr:`MinSlenderness.safe_islands`, stay at scan resolution) and ``ksection=2`` refines by
+    bisection: the same ``tan_alpha`` (to ``rtol``) from fewer runs, which is what
+    ``pipeline run`` needs for a few blocks per record.
     """
     _check_criterion(criterion)
     p_tp = np.atleast_1d(np.asarray(p_tp, dtype=float)).ravel()
@@ -384,7 +391,8 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
         blocks = [Block(float(p_tp[i]), math.atan(t)) for i, t in zip(idx, tans)]
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, zone=n_zone != 0, n_zone=n_zone)
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, zone=n_zone != 0, n_zone=n_zone,
+                        refine=refine, ksection=ksection)
     out = []
     for i in range(p_tp.size):
         br = scan.brackets[i]
@@ -596,7 +604,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 
 
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
-                   shape=None, lam=1.0, n_scan=N_SCAN, n_zone=None, rtol=RTOL, model="fast"):
+                   shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=RTOL, model="fast"):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -619,10 +627,13 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     lam : float
         The lambda of Eq. 20 for ``rule="eq20"``.
     n_scan, n_zone, rtol : int, int, float
-        ``rule="exact"``: uniform scan points up to the no-uplift width ``H peak/g``, points of
-        the dense zone just above the widest failing width (default :data:`ZONE_POINTS`), and
-        the relative width of the final bracket.  For a record only the top transition is
-        refined (its verdicts may change hundreds of times with the width).
+        ``rule="exact"``: uniform scan points up to the no-uplift width ``H peak/g`` (default
+        :data:`N_SCAN` for a pulse, :data:`REC_SCAN` for a record), points of the dense zone
+        just above the widest failing width (pulse: :data:`ZONE_POINTS` uniform; record:
+        :data:`REC_ZONE_POINTS` geometric, see :func:`_record_width`; 0 switches it off), and the
+        relative width of the final bracket.  For a record only the top transition is refined
+        (its verdicts may change hundreds of times with the width) and the widths scanned are
+        chosen adaptively; the answer holds at the resolution stated in :func:`_record_width`.
 
     Returns
     -------
@@ -672,17 +683,26 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
     top = height * _peak(excitation) / G       # wider than this the column never uplifts
     if top <= 0:
         return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion)
-    x = _scan_points(np.array([top]), n_scan)
-    known = np.zeros(x.shape, dtype=bool)
-    known[:, -1] = True
 
     def evaluate(idx, widths):
         blocks = [Block.from_dimensions(height, float(b), eta) for b in widths]
         return _failed(_batch(blocks, excitation, None, model=model), criterion)
 
     is_pulse = getattr(excitation, "shape", "record") in ("rect", "sine", "ricker-sym", "ricker-anti")
-    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="all" if is_pulse else "top",
-                        zone=n_zone != 0, n_zone=n_zone)
+    if not is_pulse:
+        def evaluate_record(widths):
+            blocks = [Block.from_dimensions(height, float(b), eta) for b in widths]
+            res = _batch(blocks, excitation, None, model=model)
+            return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
+
+        return _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
+                             n_scan=REC_SCAN if n_scan is None else n_scan, rtol=rtol,
+                             n_zone=REC_ZONE_POINTS if n_zone is None else n_zone)
+    x = _scan_points(np.array([top]), N_SCAN if n_scan is None else n_scan)
+    known = np.zeros(x.shape, dtype=bool)
+    known[:, -1] = True
+    scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="all", zone=n_zone != 0,
+                        n_zone=n_zone)
     br = scan.brackets[0]
     width, n_iter = 0.0, scan.calls
     for lo, hi, flo, fhi in br:
@@ -696,3 +716,133 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                 f"{scan.calls} batches)"),
         criterion=criterion, transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br),
         runs=scan.runs, eta=eta)
+
+
+#: Verified width under a whole record (:func:`_record_width`): uniform scan points up to the
+#: no-uplift width, plus a geometric tail of ``REC_TAIL`` points towards zero.
+REC_SCAN = 64
+REC_TAIL = 4
+#: zone checked above each candidate answer ``w``: ``REC_ZONE_POINTS`` widths ``w (1 + d)`` with
+#: ``d`` geometric from ``REC_ZONE_FIRST`` to ``REC_ZONE_FRACTION`` (neighbours 30 % of ``d``
+#: apart with the defaults: 0.03 % of ``w`` next to it, 4.5 % at the far end).
+REC_ZONE_POINTS = 20
+REC_ZONE_FIRST = 1e-3
+REC_ZONE_FRACTION = 0.15
+#: above the candidate, every gap between scanned widths wider than ``REC_GAP`` (relative) is
+#: halved while either end came within ``REC_NEAR`` of tipping (``max|theta|/alpha >= REC_NEAR``):
+#: isolated failing bands of real records sit where the block nearly overturns
+REC_GAP = 0.01
+REC_NEAR = 0.6
+#: at most this many rounds (a failure found above the candidate moves it up: check again)
+REC_ROUNDS = 6
+
+
+def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone):
+    """Verified width under a record: the smallest width above which every scanned width survives.
+
+    A record's verdict can change hundreds of times with the width (slender columns rock
+    chaotically; real records have isolated failing bands well above the main transition), so
+    the answer is defined by the widths examined.  They are chosen to need few runs (a run that
+    survives costs the whole record, and most runs here survive) while looking hardest where a
+    failure is likely:
+
+    1. ``REC_TAIL`` widths towards zero and ``n_scan`` uniform widths up to the no-uplift width
+       ``top`` (known to survive), one batch;
+    2. the bracket above the widest failing width is bisected (so the highest change is the one
+       followed) to :data:`REC_ZONE_FIRST` / 4 relative: the candidate ``w``;
+    3. a zone above it: ``n_zone`` widths ``w (1 + d)``, ``d`` geometric from
+       :data:`REC_ZONE_FIRST` to :data:`REC_ZONE_FRACTION`;
+    4. above ``w``, every gap between scanned widths wider than :data:`REC_GAP` (relative) is
+       halved, repeatedly, while either end reached ``max|theta|/alpha >= REC_NEAR``;
+    5. a failure found in 3 or 4 moves the candidate up (back to 2; at most
+       :data:`REC_ROUNDS` rounds); finally the top bracket is bisected to ``rtol`` relative.
+
+    Resolution (the caveat): a failing band is found if it is wider than the gap between the
+    scanned widths around it: 1 % or less wherever the block came near tipping (0.1-4.5 % of
+    ``w`` within 15 % above it from the zone alone), ``top / n_scan`` where it rocked little.
+    Bands narrower than that can be missed (so can they by any finite scan: slender columns
+    under real records have failing slivers far thinner than 0.1 %).  Islands of survival below
+    the widest failure never lower the answer; every verdict change among the scanned widths is
+    in ``transitions`` (the top one refined, the others at scan resolution).
+    ``tests/test_design.py`` checks the answer against dense brute-force scans.
+    """
+    tail = (1.0 / n_scan) * 2.0 ** -np.arange(REC_TAIL, 0, -1)
+    xs = top * np.concatenate([tail, np.arange(1, n_scan + 1) / n_scan])
+    runs = calls = 0
+    pts_x, pts_f, pts_r = [xs[-1:]], [np.zeros(1, dtype=bool)], [np.zeros(1)]  # top: no uplift
+
+    def run(widths):
+        nonlocal runs, calls
+        widths = np.atleast_1d(np.asarray(widths, dtype=float))
+        f, r = evaluate(widths)
+        runs += widths.size
+        calls += 1
+        pts_x.append(widths)
+        pts_f.append(np.asarray(f, dtype=bool))
+        pts_r.append(np.asarray(r, dtype=float))
+        return pts_f[-1]
+
+    def scanned():
+        x, f, r = np.concatenate(pts_x), np.concatenate(pts_f), np.concatenate(pts_r)
+        order = np.argsort(x, kind="stable")
+        return x[order], f[order], r[order]
+
+    def top_bracket():
+        x, f, _ = scanned()
+        if not f.any():
+            return None
+        j = np.nonzero(f)[0][-1]
+        return x[j], x[j + 1]                     # x[-1] = top survives, so j + 1 exists
+
+    def bisect(lo, hi, tol):
+        while hi - lo > tol * hi:
+            mid = 0.5 * (lo + hi)
+            if run([mid])[0]:
+                lo = mid
+            else:
+                hi = mid
+        return lo, hi
+
+    def near_gaps(w):
+        """Midpoints of the gaps above ``w`` to halve (step 4)."""
+        x, f, r = scanned()
+        sel = x >= w
+        x, r = x[sel], r[sel]
+        wide = (x[1:] - x[:-1]) > REC_GAP * x[:-1]
+        near = np.maximum(r[1:], r[:-1]) >= REC_NEAR
+        m = np.nonzero(wide & near)[0]
+        return 0.5 * (x[m] + x[m + 1])
+
+    run(xs[:-1])
+    br = top_bracket()
+    rounds = 0
+    while br is not None and rounds < REC_ROUNDS:
+        rounds += 1
+        lo, hi = bisect(*br, max(REC_ZONE_FIRST / 4.0, rtol))
+        found = False
+        if n_zone > 0:
+            z = hi * (1.0 + np.geomspace(REC_ZONE_FIRST, REC_ZONE_FRACTION, int(n_zone)))
+            z = z[z < top]
+            found = bool(z.size) and bool(run(z).any())
+        while not found:
+            mids = near_gaps(hi)
+            if not mids.size:
+                break
+            found = bool(run(mids).any())
+        if not found:
+            break
+        br = top_bracket()
+    width = 0.0
+    if br is not None:
+        width = bisect(*top_bracket(), rtol)[1]
+    x, f, _ = scanned()
+    ch = np.nonzero(f[1:] != f[:-1])[0]
+    transitions = tuple(float(t) for t in 0.5 * (x[ch] + x[ch + 1]))
+    return RequiredWidth(
+        width=float(width), height=height, rule="exact", iterations=calls,
+        method=(f"verified width: scan of {xs.size} widths up to the no-uplift width {top:.4g} m, "
+                f"then {rounds} round(s) of bisection above the widest failure and checks above "
+                f"it (a zone of {int(n_zone)} widths up to {REC_ZONE_FRACTION:.0%} above, gaps "
+                f"halved to {REC_GAP:.0%} where the block nearly tipped); {runs} solver runs in "
+                f"{calls} batches"),
+        criterion=criterion, transitions=transitions, runs=runs, eta=eta)
