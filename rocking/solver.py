@@ -26,18 +26,19 @@ from . import engine
 from .block import Block
 
 #: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
-#: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  With the
-#: 8th-order formula one step per sample of any usual record is far inside it; measured in
-#: ``benchmarks``: max|theta| agrees with the reference to ~1e-9 rad or better on pulses and records.
+#: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  The Taylor
+#: stepper sums its series to rounding whatever the step, but longer steps need more terms and
+#: make event detection on the cubic interpolant coarser; one step per sample of any usual record
+#: is far inside it.  Measured in ``benchmarks``: max|theta|/alpha agrees with the reference to
+#: ~1e-10 on pulses and 1e-12 or better on records, for the Taylor and the 8th-order formula alike.
 PH_MAX = 0.2
-#: the same knob for the RK4 option (``order=4``), which needs far smaller steps: rocking responses
-#: to broadband records amplify local errors, and RK4 at one step per 200 Hz sample can be off by
-#: 1e-4 rad in max|theta| (see benchmarks)
+#: the same knob for the RK4 option (``method="rk4"``), which needs far smaller steps: rocking
+#: responses to broadband records amplify local errors, and RK4 at one step per 200 Hz sample can
+#: be off by 1e-5 in max|theta|/alpha (see benchmarks)
 PH_MAX_RK4 = 0.05
-#: steps per pulse period, at least (resolves the forcing of the pulse itself).  With the
-#: 8th-order formula max|theta|/alpha agrees with the reference to 2e-10 at 16 steps and 4e-12
-#: at 50 (24 pulses of all shapes near overturning, benchmarks/RESULTS.md section 1a; 1e-11 at
-#: 16 on 48 other pulses), far inside the 1e-6 asked for, at two thirds of the cost of 50.
+#: steps per pulse period, at least (resolves the forcing of the pulse itself).  max|theta|/alpha
+#: agrees with the reference to 2e-10 at 16 steps and 4e-12 at 50 (24 pulses of all shapes near
+#: overturning, benchmarks/RESULTS.md section 1a), far inside the 1e-6 asked for.
 STEPS_PER_TP = 16
 #: ``model="auto"`` picks the linearised model when ``LINEAR_ERROR_COEFF * alpha**2 <= tol``.
 #: Its error in ``max|theta|/alpha`` against the nonlinear solution grows like alpha**2; the
