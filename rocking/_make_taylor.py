@@ -26,12 +26,12 @@ from numba import njit
 '''
 
 
-def _tree(terms: list[str]) -> str:
-    """A sum written as a balanced tree (shorter dependency chains than left to right)."""
-    if len(terms) == 1:
-        return terms[0]
-    mid = len(terms) // 2
-    return f"({_tree(terms[:mid])} + {_tree(terms[mid:])})"
+def _chain_sum(k: int, other: str) -> str:
+    """``sum_i D_i other_{k-i}``, i = 1..k, summed left to right from the terms whose factors are
+    ready first (middle ``i``) to those ready last (``i = 1`` and ``i = k``), which keeps the
+    chain of dependent operations from one order to the next short."""
+    terms = sorted(range(1, k + 1), key=lambda i: (max(i, k - i), i))
+    return " + ".join(f"D_{i} * {other}_{k - i}" for i in terms)
 
 
 def _function(n: int) -> str:
@@ -42,8 +42,8 @@ def _function(n: int) -> str:
              "    c_2 = -0.5 * q * (S_0 + u0 * C_0)",
              "    D_2 = 2.0 * c_2"]
     for k in range(1, n - 1):
-        sk = _tree([f"D_{i} * C_{k - i}" for i in range(1, k + 1)])
-        ck = _tree([f"D_{i} * S_{k - i}" for i in range(1, k + 1)])
+        sk = _chain_sum(k, "C")
+        ck = _chain_sum(k, "S")
         lines += [f"    S_{k} = -({sk}) * {1.0 / k!r}",
                   f"    C_{k} = ({ck}) * {1.0 / k!r}",
                   f"    c_{k + 2} = -q * (S_{k} + u0 * C_{k} + u1 * C_{k - 1}) * {1.0 / ((k + 1) * (k + 2))!r}",
