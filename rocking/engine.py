@@ -529,16 +529,18 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
     """
     pending, th2, om2, s_next, c_next, n_used = False, 0.0, 0.0, 0.0, 1.0, 0
     uniform = nodes.shape[0] == 0
+    h, q, inv_h = h_uniform, p2 * h_uniform * h_uniform, 1.0 / h_uniform if uniform else 0.0
     while j < n_int:
         if uniform:
             ta = t_start + j * h_uniform
             tb = t_start + (j + 1) * h_uniform
         else:
             ta, tb = nodes[j], nodes[j + 1]
+            h = tb - ta
+            q = p2 * h * h
+            inv_h = 1.0 / h
         if t != ta:
             break
-        h = tb - ta
-        inv_h = 1.0 / h  # (off the chain of dependent operations from step to step)
         if not sc_known:
             s_phi, c_phi = corner_sincos(theta, s, sa, ca)
             sc_known = True
@@ -546,7 +548,6 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
             u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         else:
             u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
-        q = p2 * h * h
         th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, omega * h, s_phi,
                                                       c_phi, TAYLOR_EPS, cf)
         while flag == 0 and order < FIXED_ORDERS[-1]:
