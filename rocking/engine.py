@@ -192,17 +192,18 @@ def linear_forcing(kind, amp, uval, j, ta, tb, t, h):
 
 
 @njit(cache=True)
-def forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U):
+def forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, n_terms):
     """Taylor coefficients of ``u(t + x h)`` in powers of ``x`` (``u = ug''/g``), into ``U``.
 
-    Returns the number of coefficients written (the rest are zero): 2 for records (linear on
-    the interval), 1 for the rectangular pulse and free motion, ``NMAX + 1`` for the smooth
-    pulses (their series from the recurrence ``E' = g' E`` for ``E = exp(g)``).
+    Returns ``(nu, complete)``: the number of coefficients written, and whether the rest are
+    zero.  Records (linear on the interval), the rectangular pulse and free motion: 2, complete.
+    Smooth pulses (their series from the recurrence ``E' = g' E`` for ``E = exp(g)``): the first
+    ``min(n_terms, NMAX + 1)``, complete only when that is ``NMAX + 1``.
     """
     if kind == NODAL or kind == FREE or kind == RECT:
         U[0], U[1] = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
-        return 2
-    n = NMAX + 1
+        return 2, True
+    n = min(n_terms, NMAX + 1)
     if kind == SINE:
         w = TWO_PI * h / tp
         sn = math.sin(TWO_PI * (t - t0) / tp)
@@ -212,7 +213,7 @@ def forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U):
             r = k % 4
             U[k] = c * (sn if r == 0 else (cs if r == 1 else (-sn if r == 2 else -cs)))
             c *= w * _INV[k + 1]
-        return n
+        return n, n == NMAX + 1
     # Ricker pulses: P(y) exp(g(y)) with y = y0 + dy x linear in x
     if kind == RICKER_SYM:
         y0 = math.pi * (t - t0) / tp
@@ -235,16 +236,17 @@ def forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U):
             e = (g1 * e1 + 2.0 * g2 * e2) * _INV[k]
         U[k] = scale * (p0 * e + p1 * e1 + p2 * e2 + p3 * e3)
         e1, e2, e3 = e, e1, e2
-    return n
+    return n, n == NMAX + 1
 
 
 @njit(cache=True)
-def taylor_series(U, nu, h, theta, omega, s, p2, sa, ca, cf, S, C, sc_known, s0, c0):
+def taylor_series(U, nu, complete, h, theta, omega, s, p2, sa, ca, cf, S, C, sc_known, s0, c0):
     """Taylor coefficients of ``theta(t + x h)`` in powers of ``x``, into ``cf``.
 
     Returns ``(n, s1, c1)``: the order ``n`` of the polynomial, and ``sin(phi)``, ``cos(phi)`` at
     the end of the step (their series summed), which the next step takes as its ``s0``, ``c0``
-    when ``sc_known`` (so a step needs no function evaluation at all).
+    when ``sc_known`` (so a step needs no function evaluation at all).  ``n = -1`` if the series
+    needs more than the ``nu`` forcing terms given and they are not ``complete``.
 
     With ``phi = s alpha - theta``, Eq. 3 reads ``phi'' = p^2 (sin(phi) + u cos(phi))``; the
     series of ``S = sin(phi)`` and ``C = cos(phi)`` follow from ``S' = C phi'``, ``C' = -S phi'``
@@ -266,6 +268,8 @@ def taylor_series(U, nu, h, theta, omega, s, p2, sa, ca, cf, S, C, sc_known, s0,
     D[1] = cf[1]
     D[2] = 2.0 * cf[2]
     for k in range(1, NMAX - 1):
+        if k >= nu and not complete:
+            return -1, 0.0, 0.0
         sk = 0.0
         ck = 0.0
         for i in range(1, k + 1):
@@ -388,14 +392,19 @@ def _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, x, theta, omega, s, p, sa, ca
 
 @njit(cache=True)
 def _advance(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
-             method, kt, kw, U, S, C, cf, sc_known, s0, c0):
+             method, kt, kw, U, S, C, cf, sc_known, s0, c0, n_hint):
     """One step of length ``h``: ``(theta, omega, n, s1, c1)`` at ``t + h``, with ``n`` the order
     of the Taylor polynomial left in ``cf`` (0 when another stepper was used) and ``s1``, ``c1``
-    as returned by :func:`taylor_series`."""
+    as returned by :func:`taylor_series`.  ``n_hint``: the order of the previous step (the
+    forcing series of smooth pulses is computed a few terms beyond it, and in full if needed)."""
     if method == TAYLOR and not linear:
-        nu = forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U)
-        n, s1, c1 = taylor_series(U, nu, h, theta, omega, s, p * p, sa, ca, cf, S, C,
+        nu, complete = forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, n_hint + 4)
+        n, s1, c1 = taylor_series(U, nu, complete, h, theta, omega, s, p * p, sa, ca, cf, S, C,
                                   sc_known, s0, c0)
+        if n < 0:
+            nu, complete = forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, NMAX + 1)
+            n, s1, c1 = taylor_series(U, nu, complete, h, theta, omega, s, p * p, sa, ca, cf, S,
+                                      C, sc_known, s0, c0)
         th, om = taylor_eval(cf, n, 1.0, h)
         return th, om, n, s1, c1
     th, om = step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
@@ -614,6 +623,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     # a lower one would have done); any other step takes the general loop
     fixed = method == TAYLOR and not linear and (kind == NODAL or kind == RECT or kind == FREE)
     order, n_low = FIXED_ORDERS[2], 0
+    n_general = FIXED_ORDERS[-1]  # order of the last step of the general Taylor loop
     p2 = p * p
     if linear:
         sa, ca = alpha, 1.0
@@ -728,7 +738,9 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                 if nt == 0:
                     th2, om2, nt, s_next, c_next = _advance(
                         kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca,
-                        linear, method, kt, kw, U, S, C, cf, sc_known, s_phi, c_phi)
+                        linear, method, kt, kw, U, S, C, cf, sc_known, s_phi, c_phi, n_general)
+                    if nt > 0:
+                        n_general = nt
                     if fixed and nt > 0:  # back to the unrolled steps when they suffice
                         order = max(FIXED_ORDERS[0], nt + (nt & 1))
                 # sin and cos of the angle to the corner carry over only to an accepted step

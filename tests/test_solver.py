@@ -391,8 +391,9 @@ def test_taylor_steps_match_an_independent_integrator(h):
         want = _one_step_dop853(block, s, u0, u1, h, theta, omega)
         # the general series (any order) and every unrolled order whose own test passes
         U[0], U[1] = u0, u1
-        n, _, _ = engine.taylor_series(U, 2, h, theta, omega, s, block.p**2, math.sin(block.alpha),
-                                       math.cos(block.alpha), cf, S, C, False, 0.0, 1.0)
+        n, _, _ = engine.taylor_series(U, 2, True, h, theta, omega, s, block.p**2,
+                                       math.sin(block.alpha), math.cos(block.alpha), cf, S, C,
+                                       False, 0.0, 1.0)
         got = engine.taylor_eval(cf, n, 1.0, h)
         # DOP853 at rtol 1e-13 over one step: ~1e-14 of the state; the series: ~1e-16
         scale = abs(theta) + abs(omega) * h + 1e-3 * block.alpha
@@ -420,8 +421,9 @@ def test_forcing_series_of_smooth_pulses_matches_the_pulse(shape):
     U = np.zeros(2 * (engine.NMAX + 3))
     h = pulse.tp / 8
     for t in np.linspace(pulse.support[0], pulse.support[1] - h, 7):
-        n = engine.forcing_series(pulse.kind, pulse.ap / G, pulse.tp, pulse.t0, np.zeros(0), 0,
-                                  0.0, 1.0, t, h, U)
+        n, complete = engine.forcing_series(pulse.kind, pulse.ap / G, pulse.tp, pulse.t0,
+                                            np.zeros(0), 0, 0.0, 1.0, t, h, U, engine.NMAX + 1)
+        assert complete
         x = np.linspace(0.0, 1.0, 9)
         series = np.polynomial.polynomial.polyval(x, U[:n])
         # the series to NMAX terms of an entire function over 1/8 of its period: rounding only
