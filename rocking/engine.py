@@ -37,7 +37,7 @@ from numba import njit, prange
 from scipy.integrate._ivp import dop853_coefficients as _dop853
 
 from ._taylor_fixed import ORDERS as FIXED_ORDERS
-from ._taylor_fixed import taylor_fixed
+from ._taylor_fixed import SMOOTH_ORDERS, taylor_fixed, taylor_smooth
 
 #: Butcher tableau of the 8th-order Dormand-Prince formula (the 12 stages of DOP853)
 N_STAGES = _dop853.N_STAGES
@@ -622,7 +622,9 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     # (raised as soon as a step's last terms are too large, lowered after a run of steps where
     # a lower one would have done); any other step takes the general loop
     fixed = method == TAYLOR and not linear and (kind == NODAL or kind == RECT or kind == FREE)
-    order, n_low = FIXED_ORDERS[2], 0
+    # smooth pulses: the same with the forcing's own series (unrolled up to SMOOTH_ORDERS[-1])
+    smooth = method == TAYLOR and not linear and not fixed and kind != FREE
+    order, n_low = (FIXED_ORDERS[2], 0) if fixed else (SMOOTH_ORDERS[2], 0)
     n_general = FIXED_ORDERS[-1]  # order of the last step of the general Taylor loop
     p2 = p * p
     if linear:
@@ -735,6 +737,28 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         om2 = wh2 / h
                     else:
                         order += 2  # beyond the unrolled orders: the general loop
+                elif smooth and order <= SMOOTH_ORDERS[-1]:
+                    if not sc_known:
+                        s_phi, c_phi = corner_sincos(theta, s, sa, ca)
+                        sc_known = True
+                    q = p2 * h * h
+                    forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, order - 1)
+                    th2, wh2, s_next, c_next, flag = taylor_smooth(
+                        order, U, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
+                    while flag == 0 and order < SMOOTH_ORDERS[-1]:
+                        order += 2  # the series needs more terms: the next order up
+                        forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, order - 1)
+                        th2, wh2, s_next, c_next, flag = taylor_smooth(
+                            order, U, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
+                    if flag != 0:
+                        nt = order
+                        n_low = n_low + 1 if flag == 2 else 0
+                        if n_low >= 16 and order > SMOOTH_ORDERS[0]:
+                            order -= 2  # a lower order has been enough for a while
+                            n_low = 0
+                        om2 = wh2 / h
+                    else:
+                        order += 2  # beyond the unrolled orders: the general loop
                 if nt == 0:
                     th2, om2, nt, s_next, c_next = _advance(
                         kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca,
@@ -743,6 +767,8 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         n_general = nt
                     if fixed and nt > 0:  # back to the unrolled steps when they suffice
                         order = max(FIXED_ORDERS[0], nt + (nt & 1))
+                    elif smooth and nt > 0:
+                        order = max(SMOOTH_ORDERS[0], nt + (nt & 1))
                 # sin and cos of the angle to the corner carry over only to an accepted step
                 sc_known = False
                 if omega * om2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI:

@@ -428,3 +428,38 @@ def test_forcing_series_of_smooth_pulses_matches_the_pulse(shape):
         series = np.polynomial.polynomial.polyval(x, U[:n])
         # the series to NMAX terms of an entire function over 1/8 of its period: rounding only
         np.testing.assert_allclose(series, pulse(t + x * h) / G, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("shape", ["sine", "ricker-sym", "ricker-anti"])
+def test_unrolled_smooth_pulse_steps_match_the_general_series(shape):
+    from rocking import engine
+    from rocking._taylor_fixed import SMOOTH_ORDERS, taylor_smooth
+
+    size = engine.NMAX + 3
+    cf, S, C, U = np.zeros(size), np.zeros(size), np.zeros(size), np.zeros(2 * size)
+    pulse = pulses.make_pulse(shape, 1.1 * G, 1.6, 0.3)
+    block = Block.from_tan_alpha(2.0, 0.3)
+    rng = np.random.default_rng(2)
+    checked = 0
+    for t in np.linspace(pulse.support[0], pulse.support[1], 9):
+        h = rng.uniform(0.02, 0.1)
+        theta, omega = 0.7 * block.alpha, -0.5 * block.p * block.alpha
+        nu, complete = engine.forcing_series(pulse.kind, pulse.ap / G, pulse.tp, pulse.t0,
+                                             np.zeros(0), 0, 0.0, 1.0, t, h, U, engine.NMAX + 1)
+        n, _, _ = engine.taylor_series(U, nu, complete, h, theta, omega, 1.0, block.p**2,
+                                       math.sin(block.alpha), math.cos(block.alpha), cf, S, C,
+                                       False, 0.0, 1.0)
+        want = engine.taylor_eval(cf, n, 1.0, h)
+        phi = block.alpha - theta
+        for order in SMOOTH_ORDERS:
+            th, wh, _, _, flag = taylor_smooth(order, U, (block.p * h) ** 2, theta, omega * h,
+                                               math.sin(phi), math.cos(phi), engine.TAYLOR_EPS,
+                                               cf)
+            if flag == 0:
+                continue  # the step says it needs more terms
+            checked += 1
+            # the same recurrences, both summed to 1e-15 of the leading terms
+            scale = abs(theta) + abs(omega * h)
+            assert th == pytest.approx(want[0], abs=1e-14 * scale)
+            assert wh == pytest.approx(want[1] * h, abs=1e-14 * scale)
+    assert checked > 20
