@@ -93,7 +93,10 @@ def _pool(tasks, jobs):
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     if ctx.get_start_method() == "forkserver":
-        ctx.set_forkserver_preload(["pipeline.batch", "pulses", "rocking"])
+        preload = ["pipeline.batch", "pulses", "rocking"]
+        if any(t.options.plots for t in tasks):
+            preload.append("pipeline.plots")  # matplotlib: ~0.2 s a worker otherwise
+        ctx.set_forkserver_preload(preload)
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
         futures = {pool.submit(process_record, t): t for t in tasks}
         try:
@@ -156,6 +159,13 @@ def execute(tasks, jobs: int | None = 1, dask: str | None = None):
     return _pool(tasks, min(jobs, len(tasks)))
 
 
+def _import_plots():
+    try:
+        import pipeline.plots  # noqa: F401
+    except Exception:  # pragma: no cover - reported when the summary plot is drawn
+        pass
+
+
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None) -> RunSummary:
@@ -186,6 +196,11 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
 
     results = [None] * len(tasks)
     plots_dir = out / "plots"
+    if options.plots and not dask and (jobs or 1) > 1 and len(tasks) > 1:
+        # the summary plot needs matplotlib here too: import it while the worker processes start
+        import threading
+
+        threading.Thread(target=_import_plots, daemon=True).start()
     try:
         for res in execute(tasks, jobs=jobs, dask=dask):
             results[res["index"]] = res

@@ -136,6 +136,64 @@ def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
     assert tree(out) == before
 
 
+#: plots on, two columns (two history panels), every shape (up to four pulses on the record panel)
+PLOT_ARGS = ["--block", "7.5x1.8", "--block", "6x1.2", "--quiet"]
+
+
+def test_plots_identical_whatever_jobs_and_on_rerun(tmp_path):
+    """With plots (one figure reused per worker process): --jobs 1, --jobs 2 and a re-run into the
+    same folder give the same bytes in every file, PNGs included."""
+    (tmp_path / "recs").mkdir()
+    recs = [str(write_good(tmp_path / "recs", k)) for k in range(6)]
+    one, two = tmp_path / "one", tmp_path / "two"
+    assert main(["run", *recs, *PLOT_ARGS, "--out", str(one), "--jobs", "1"]) == 0
+    assert main(["run", *recs, *PLOT_ARGS, "--out", str(two), "--jobs", "2"]) == 0
+    first = tree(one)
+    assert sum(n.endswith(".png") for n in first) == 6 + 1
+    assert tree(two) == first
+    assert main(["run", *recs[::-1], *PLOT_ARGS, "--out", str(two), "--jobs", "2"]) == 0
+    assert {n: b for n, b in tree(two).items() if n.endswith(".png") and "summary" not in n} == \
+        {n: b for n, b in first.items() if n.endswith(".png") and "summary" not in n}
+
+
+def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
+    """A record's PNG does not depend on what the reused figure drew before: drawn alone by a fresh
+    process, and drawn last after records of other lengths and verdicts (good09 overturns at 6 m);
+    in this process also with fewer pulses and curves than the figure drew before (hidden lines)."""
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    target = write_good(folder, 4)
+    others = [write_good(folder, k, duration=d) for k, d in [(0, 9.0), (9, 4.0), (6, 6.0)]]
+    alone = tmp_path / "alone"
+    proc = subprocess.run([sys.executable, "-m", "pipeline", "run", str(target), *PLOT_ARGS,
+                           "--out", str(alone)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    after = tmp_path / "after"
+    assert main(["run", *map(str, others), str(target), *PLOT_ARGS, "--out", str(after)]) == 0
+    name = f"plots/{target.stem}.png"
+    png = (alone / name).read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
+    assert (after / name).read_bytes() == png
+    # in this process: a fresh figure, then the same figure after the other records drew four
+    # pulses and two curves a panel; the target now has one pulse and one curve a panel
+    from pipeline import plots
+    from pipeline.batch import _process
+    from pipeline.runner import make_tasks
+
+    tasks = make_tasks([*map(str, others), str(target)], [Column(7.5, 1.8), Column(6.0, 1.2)], Options())
+    parts = [_process(t)[1] for t in tasks]
+    rec, fit, fitting, hist = parts[-1]
+    few = (rec, fit, fitting[:1], [(label, curves[1:]) for label, curves in hist])
+    plots._RECORD_FIGURES.clear()
+    fresh = plots.record_figure_png(tasks[-1].record_id, *parts[-1])
+    fresh_few = plots.record_figure_png(tasks[-1].record_id, *few)
+    for t, (r, f, fi, h) in zip(tasks, parts):
+        plots.record_figure_png(t.record_id, r, f, (fi + fi)[:4], h)
+    assert plots.record_figure_png(tasks[-1].record_id, *few) == fresh_few != fresh
+    assert plots.record_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
+    assert len(plots._RECORD_FIGURES) == 1  # the figure was indeed reused
+
+
 def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
     rec = write_good(tmp_path, 1)
     out = tmp_path / "out"
