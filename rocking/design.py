@@ -627,11 +627,12 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     lam : float
         The lambda of Eq. 20 for ``rule="eq20"``.
     n_scan, n_zone, rtol : int, int, float
-        ``rule="exact"``: uniform scan points up to the no-uplift width ``H peak/g`` (default
-        :data:`N_SCAN` for a pulse, :data:`REC_SCAN` for a record), points of the dense zone
-        just above the widest failing width (pulse: :data:`ZONE_POINTS` uniform; record:
-        :data:`REC_ZONE_POINTS` geometric, see :func:`_record_width`; 0 switches it off), and the
-        relative width of the final bracket.  For a record only the top transition is refined
+        ``rule="exact"``: scan points up to the no-uplift width ``H peak/g`` (pulse:
+        :data:`N_SCAN` uniform; record: :data:`REC_SCAN` geometric), points of the dense zone
+        just above the widest failing width (pulse: :data:`ZONE_POINTS` uniform, 0 switches it
+        off; record: an optional extra zone of ``n_zone`` geometric widths, off by default, next
+        to the fine zone of :data:`REC_FINE`, see :func:`_record_width`), and the relative width
+        of the final bracket.  For a record only the top transition is refined
         (its verdicts may change hundreds of times with the width) and the widths scanned are
         chosen adaptively; the answer holds at the resolution stated in :func:`_record_width`.
 
@@ -718,14 +719,24 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         runs=scan.runs, eta=eta)
 
 
-#: Verified width under a whole record (:func:`_record_width`): uniform scan points up to the
-#: no-uplift width, plus a geometric tail of ``REC_TAIL`` points towards zero.
-REC_SCAN = 64
+#: Verified width under a whole record (:func:`_record_width`): ``REC_SCAN`` widths geometric from
+#: ``top REC_LOW`` to the no-uplift width ``top`` (neighbours 3.3 % apart with the defaults), plus
+#: a tail of ``REC_TAIL`` widths halving towards zero.  ``REC_SPACING = "uniform"`` gives the former
+#: scan (``REC_SCAN`` uniform widths up to ``top``; kept to compare, see benchmarks/bench_design.py).
+REC_SCAN = 128
+REC_LOW = 1.0 / 64
 REC_TAIL = 4
-#: zone checked above each candidate answer ``w``: ``REC_ZONE_POINTS`` widths ``w (1 + d)`` with
-#: ``d`` geometric from ``REC_ZONE_FIRST`` to ``REC_ZONE_FRACTION`` (neighbours 30 % of ``d``
-#: apart with the defaults: 0.03 % of ``w`` next to it, 4.5 % at the far end).
-REC_ZONE_POINTS = 20
+REC_SPACING = "geometric"
+#: fine zone above each candidate answer ``w``: every width of the fixed grid
+#: ``top (1 + REC_FINE)^-k`` in ``(w, w (1 + REC_FINE_SPAN)]`` is run (0.05 % apart: failing
+#: slivers of real records are often thinner than 0.2 %, and lie up to ~25 % above the main
+#: transition; README "Design" has the measurements behind these numbers)
+REC_FINE = 5e-4
+REC_FINE_SPAN = 0.2
+#: optional extra zone (``n_zone`` of required_width; off by default, the fine zone covers it):
+#: ``n_zone`` widths ``w (1 + d)``, ``d`` geometric from ``REC_ZONE_FIRST`` to
+#: ``REC_ZONE_FRACTION``.  ``REC_ZONE_FIRST / 4`` is also the bisection tolerance of candidates.
+REC_ZONE_POINTS = 0
 REC_ZONE_FIRST = 1e-3
 REC_ZONE_FRACTION = 0.15
 #: above the candidate, every gap between scanned widths wider than ``REC_GAP`` (relative) is
@@ -734,7 +745,7 @@ REC_ZONE_FRACTION = 0.15
 REC_GAP = 0.01
 REC_NEAR = 0.6
 #: at most this many rounds (a failure found above the candidate moves it up: check again)
-REC_ROUNDS = 6
+REC_ROUNDS = 12
 
 
 def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone):
@@ -746,28 +757,37 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
     survives costs the whole record, and most runs here survive) while looking hardest where a
     failure is likely:
 
-    1. ``REC_TAIL`` widths towards zero and ``n_scan`` uniform widths up to the no-uplift width
-       ``top`` (known to survive), one batch;
+    1. ``REC_TAIL`` widths towards zero and ``n_scan`` widths geometric from ``top`` x
+       :data:`REC_LOW` to the no-uplift width ``top`` (known to survive), one batch;
     2. the bracket above the widest failing width is bisected (so the highest change is the one
        followed) to :data:`REC_ZONE_FIRST` / 4 relative: the candidate ``w``;
-    3. a zone above it: ``n_zone`` widths ``w (1 + d)``, ``d`` geometric from
+    3. (if ``n_zone``) a zone above it: ``n_zone`` widths ``w (1 + d)``, ``d`` geometric from
        :data:`REC_ZONE_FIRST` to :data:`REC_ZONE_FRACTION`;
-    4. above ``w``, every gap between scanned widths wider than :data:`REC_GAP` (relative) is
+    4. the fine zone: every width of the fixed grid ``top (1 + REC_FINE)^-k`` between ``w`` and
+       ``w (1 + REC_FINE_SPAN)`` not run yet (0.05 % apart, up to 20 % above ``w``);
+    5. above ``w``, every gap between scanned widths wider than :data:`REC_GAP` (relative) is
        halved, repeatedly, while either end reached ``max|theta|/alpha >= REC_NEAR``;
-    5. a failure found in 3 or 4 moves the candidate up (back to 2; at most
-       :data:`REC_ROUNDS` rounds); finally the top bracket is bisected to ``rtol`` relative.
+    6. a failure found in 3-5 moves the candidate up (back to 2; at most :data:`REC_ROUNDS`
+       rounds); finally the top bracket is bisected to ``rtol`` relative.
 
     Resolution (the caveat): a failing band is found if it is wider than the gap between the
-    scanned widths around it: 1 % or less wherever the block came near tipping (0.1-4.5 % of
-    ``w`` within 15 % above it from the zone alone), ``top / n_scan`` where it rocked little.
-    Bands narrower than that can be missed (so can they by any finite scan: slender columns
-    under real records have failing slivers far thinner than 0.1 %).  Islands of survival below
-    the widest failure never lower the answer; every verdict change among the scanned widths is
-    in ``transitions`` (the top one refined, the others at scan resolution).
+    scanned widths around it: 0.05 % of ``w`` up to 20 % above the answer, 1 % or less further
+    up wherever the block came near tipping, 3.3 % where it rocked little.  Bands narrower than
+    that can be missed, and so can they by any finite scan: slender columns under real records
+    have failing slivers thinner than 0.05 %, and on 30 real cases a uniform 1500-width scan
+    was itself up to 19 % below the highest failure a 6000-width scan found (README "Design"
+    has the table).  Islands of survival below the widest failure never lower the answer; every
+    verdict change among the scanned widths is in ``transitions`` (the top one refined, the
+    others at scan resolution).
     ``tests/test_design.py`` checks the answer against dense brute-force scans.
     """
-    tail = (1.0 / n_scan) * 2.0 ** -np.arange(REC_TAIL, 0, -1)
-    xs = top * np.concatenate([tail, np.arange(1, n_scan + 1) / n_scan])
+    if REC_SPACING == "geometric":
+        low = REC_LOW
+        xs = top * np.geomspace(low, 1.0, n_scan)
+    else:
+        low = 1.0 / n_scan
+        xs = top * np.arange(1, n_scan + 1) / n_scan
+    xs = np.concatenate([top * low * 2.0 ** -np.arange(REC_TAIL, 0, -1), xs])
     runs = calls = 0
     pts_x, pts_f, pts_r = [xs[-1:]], [np.zeros(1, dtype=bool)], [np.zeros(1)]  # top: no uplift
 
@@ -814,6 +834,8 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
         return 0.5 * (x[m] + x[m + 1])
 
     run(xs[:-1])
+    fine_done = np.zeros(0)
+    limited = False
     br = top_bracket()
     rounds = 0
     while br is not None and rounds < REC_ROUNDS:
@@ -824,6 +846,16 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
             z = hi * (1.0 + np.geomspace(REC_ZONE_FIRST, REC_ZONE_FRACTION, int(n_zone)))
             z = z[z < top]
             found = bool(z.size) and bool(run(z).any())
+        if not found and REC_FINE > 0:
+            # every width of the fixed fine grid top (1 + REC_FINE)^-k in (hi, hi (1 + REC_FINE_SPAN)]
+            # not run yet (a later round only adds the part above the previous one)
+            k_hi = math.floor(math.log(top / hi) / math.log1p(REC_FINE))
+            k_lo = max(math.ceil(math.log(top / (hi * (1.0 + REC_FINE_SPAN))) / math.log1p(REC_FINE)), 1)
+            z = top * (1.0 + REC_FINE) ** -np.arange(k_lo, k_hi + 1, dtype=float)
+            z = np.setdiff1d(z[(z > hi) & (z < top)], fine_done)
+            if z.size:
+                fine_done = np.union1d(fine_done, z)
+                found = bool(run(z).any())
         while not found:
             mids = near_gaps(hi)
             if not mids.size:
@@ -832,6 +864,8 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
         if not found:
             break
         br = top_bracket()
+    else:
+        limited = br is not None   # failures were still being found above the candidate
     width = 0.0
     if br is not None:
         width = bisect(*top_bracket(), rtol)[1]
@@ -842,7 +876,9 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
         width=float(width), height=height, rule="exact", iterations=calls,
         method=(f"verified width: scan of {xs.size} widths up to the no-uplift width {top:.4g} m, "
                 f"then {rounds} round(s) of bisection above the widest failure and checks above "
-                f"it (a zone of {int(n_zone)} widths up to {REC_ZONE_FRACTION:.0%} above, gaps "
-                f"halved to {REC_GAP:.0%} where the block nearly tipped); {runs} solver runs in "
-                f"{calls} batches"),
+                f"it (widths {REC_FINE:.2%} apart up to {REC_FINE_SPAN:.0%} above, "
+                + (f"a zone of {int(n_zone)} widths up to {REC_ZONE_FRACTION:.0%} above, " if n_zone else "")
+                + f"gaps halved to {REC_GAP:.0%} where the block nearly tipped"
+                + ("; round limit reached" if limited else "")
+                + f"); {runs} solver runs in {calls} batches"),
         criterion=criterion, transitions=transitions, runs=runs, eta=eta)
