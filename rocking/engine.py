@@ -523,6 +523,18 @@ def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
     return hi
 
 
+@njit(cache=True, inline="always")
+def _unrolled_step(fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q, theta, wh, s_phi,
+                   c_phi, cf):
+    """One unrolled Taylor step of ``order`` (:mod:`rocking._taylor_fixed`): forcing linear over
+    the step (``fixed``) or given by its series (smooth pulses, written into ``U``)."""
+    if fixed:
+        u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
+        return taylor_fixed(order, u0, u1, q, theta, wh, s_phi, c_phi, TAYLOR_EPS, cf)
+    forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, order - 1)
+    return taylor_smooth(order, U, q, theta, wh, s_phi, c_phi, TAYLOR_EPS, cf)
+
+
 @njit(cache=True)
 def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omega, s, sa, ca, p2,
             max_abs, sc_known, s_phi, c_phi, order, n_low, cf, record, hist_t, hist_theta,
@@ -624,7 +636,13 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     fixed = method == TAYLOR and not linear and (kind == NODAL or kind == RECT or kind == FREE)
     # smooth pulses: the same with the forcing's own series (unrolled up to SMOOTH_ORDERS[-1])
     smooth = method == TAYLOR and not linear and not fixed and kind != FREE
-    order, n_low = (FIXED_ORDERS[2], 0) if fixed else (SMOOTH_ORDERS[2], 0)
+    unrolled = fixed or smooth
+    if fixed:
+        lowest, highest, order = FIXED_ORDERS[0], FIXED_ORDERS[-1], FIXED_ORDERS[2]
+    else:
+        lowest, highest, order = SMOOTH_ORDERS[0], SMOOTH_ORDERS[-1], SMOOTH_ORDERS[2]
+    low_run = 64 if fixed else 16  # steps in a row a lower order must have sufficed
+    n_low = 0
     n_general = FIXED_ORDERS[-1]  # order of the last step of the general Taylor loop
     p2 = p * p
     if linear:
@@ -715,45 +733,23 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                 if pending:  # the step the tight loop took and stopped at
                     nt = n_pending
                     pending = False
-                elif fixed and order <= FIXED_ORDERS[-1]:
-                    if not sc_known:
-                        s_phi, c_phi = corner_sincos(theta, s, sa, ca)
-                        sc_known = True
-                    u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
-                    q = p2 * h * h
-                    th2, wh2, s_next, c_next, flag = taylor_fixed(
-                        order, u0, u1, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
-                    while flag == 0 and order < FIXED_ORDERS[-1]:
-                        order += 2  # the series needs more terms: the next order up
-                        th2, wh2, s_next, c_next, flag = taylor_fixed(
-                            order, u0, u1, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
-                    nt = 0
-                    if flag != 0:
-                        nt = order
-                        n_low = n_low + 1 if flag == 2 else 0
-                        if n_low >= 64 and order > FIXED_ORDERS[0]:
-                            order -= 2  # a lower order has been enough for a while
-                            n_low = 0
-                        om2 = wh2 / h
-                    else:
-                        order += 2  # beyond the unrolled orders: the general loop
-                elif smooth and order <= SMOOTH_ORDERS[-1]:
+                elif unrolled and order <= highest:
                     if not sc_known:
                         s_phi, c_phi = corner_sincos(theta, s, sa, ca)
                         sc_known = True
                     q = p2 * h * h
-                    forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, order - 1)
-                    th2, wh2, s_next, c_next, flag = taylor_smooth(
-                        order, U, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
-                    while flag == 0 and order < SMOOTH_ORDERS[-1]:
+                    th2, wh2, s_next, c_next, flag = _unrolled_step(
+                        fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q, theta,
+                        omega * h, s_phi, c_phi, cf)
+                    while flag == 0 and order < highest:
                         order += 2  # the series needs more terms: the next order up
-                        forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, order - 1)
-                        th2, wh2, s_next, c_next, flag = taylor_smooth(
-                            order, U, q, theta, omega * h, s_phi, c_phi, TAYLOR_EPS, cf)
+                        th2, wh2, s_next, c_next, flag = _unrolled_step(
+                            fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q, theta,
+                            omega * h, s_phi, c_phi, cf)
                     if flag != 0:
                         nt = order
                         n_low = n_low + 1 if flag == 2 else 0
-                        if n_low >= 16 and order > SMOOTH_ORDERS[0]:
+                        if n_low >= low_run and order > lowest:
                             order -= 2  # a lower order has been enough for a while
                             n_low = 0
                         om2 = wh2 / h
@@ -765,10 +761,8 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
                         linear, method, kt, kw, U, S, C, cf, sc_known, s_phi, c_phi, n_general)
                     if nt > 0:
                         n_general = nt
-                    if fixed and nt > 0:  # back to the unrolled steps when they suffice
-                        order = max(FIXED_ORDERS[0], nt + (nt & 1))
-                    elif smooth and nt > 0:
-                        order = max(SMOOTH_ORDERS[0], nt + (nt & 1))
+                        if unrolled:  # back to the unrolled steps when they suffice
+                            order = max(lowest, nt + (nt & 1))
                 # sin and cos of the angle to the corner carry over only to an accepted step
                 sc_known = False
                 if omega * om2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI:
