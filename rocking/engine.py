@@ -623,11 +623,33 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     -------
     status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted
     """
+    work = np.zeros(N_STAGES * 2 + 5 * (NMAX + 3))
+    out = run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, 0, n_int, n_sub, p, alpha,
+                   eta, theta0, omega0, -np.inf, linear, zeno_tol, stop_at_rest, hist_t,
+                   hist_theta, hist_omega, impacts, record, method, work)
+    return out[0], out[1], out[2], out[3], out[4], out[5], out[6], out[7]
+
+
+@njit(cache=True)
+def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_sub, p, alpha,
+             eta, theta0, omega0, rest_until0, linear, zeno_tol, stop_at_rest, hist_t, hist_theta,
+             hist_omega, impacts, record, method, work):
+    """:func:`run` from interval ``j0`` (its start time, state ``theta0``, ``omega0``; at rest
+    until ``rest_until0`` if that is later) to the end of interval ``n_end - 1``, with scratch
+    space ``work`` (``2 N_STAGES + 5 (NMAX + 3)`` floats) so that it allocates nothing (the
+    batch engine, :mod:`rocking.lanes`, calls it for single intervals where something happens).
+
+    Returns :func:`run`'s values and, last, the time until which the block is at rest after a
+    Zeno sequence (``-inf`` if none pending).
+    """
     tan_a = math.tan(alpha)
-    kt = np.empty(N_STAGES)
-    kw = np.empty(N_STAGES)
-    U, S, C, cf = (np.zeros(2 * (NMAX + 3)), np.zeros(NMAX + 3), np.zeros(NMAX + 3),
-                   np.zeros(NMAX + 3))
+    m = NMAX + 3
+    kt = work[:N_STAGES]
+    kw = work[N_STAGES:2 * N_STAGES]
+    U = work[2 * N_STAGES:2 * N_STAGES + 2 * m]
+    S = work[2 * N_STAGES + 2 * m:2 * N_STAGES + 3 * m]
+    C = work[2 * N_STAGES + 3 * m:2 * N_STAGES + 4 * m]
+    cf = work[2 * N_STAGES + 4 * m:2 * N_STAGES + 5 * m]
     sc_known, s_phi, c_phi = False, 0.0, 1.0  # sin, cos of s alpha - theta when known
     pending, th2, om2, s_next, c_next, nt, n_pending = False, 0.0, 0.0, 0.0, 1.0, 0, 0
     # forcing linear over each step: unrolled Taylor steps of a fixed order, adapted as we go
@@ -660,15 +682,16 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     uplifted = s != 0.0
     max_abs = abs(theta)
     n_imp = 0
-    rest_until = -np.inf
+    rest_until = rest_until0
     omega_zeno = zeno_tol * p * alpha
     status = ROCKING if s != 0.0 else REST
-    t = nodes[0] if not uniform else t_start
+    t = nodes[j0] if not uniform else t_start + j0 * h_uniform
+    n_int = n_end
     n_hist = 0
     if record:
         hist_t[0], hist_theta[0], hist_omega[0] = t, theta, omega
         n_hist = 1
-    j = 0
+    j = j0
     while j < n_int:
         if s == 0.0 and kind == NODAL and uniform and not stop_at_rest and rest_until <= t:
             # at rest: on to the first interval whose ends exceed the uplift threshold (the
@@ -894,7 +917,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
         j += 1
     if status == REST:
         theta, omega = 0.0, 0.0
-    return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted
+    return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted, rest_until
 
 
 @njit(cache=True)
