@@ -76,9 +76,109 @@ def _function(n: int, smooth: bool = False) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: latencies (cycles) of the scheduling model of :func:`_fixed_function`: a dependent add or
+#: multiply costs about the same on current x86 cores
+_LAT = 3
+
+
+class _Sched:
+    """Ready times of the values of one generated step, in a model where every add or multiply
+    waits for its operands (the steps are bound by latency, not throughput): sums are written
+    with the operands ready first added first, so that the chain after the last one is short."""
+
+    def __init__(self):
+        self.ready = {}
+
+    def product(self, a: str, b: str) -> tuple[int, str]:
+        t = max(self.ready.get(a, 0), self.ready.get(b, 0)) + _LAT
+        return t, f"{a} * {b}"
+
+    def sum(self, name: str, terms: list[tuple[int, str, int]]) -> str:
+        """``name = sum(sign * term)`` over ``(ready, text, sign)``, earliest first."""
+        terms = sorted(terms, key=lambda r: r[0])
+        t, text, sign = terms[0]
+        out = text if sign > 0 else f"-({text})"
+        for t_i, text_i, sign_i in terms[1:]:
+            out += (" + " if sign_i > 0 else " - ") + text_i
+            t = max(t, t_i) + _LAT
+        self.ready[name] = t
+        return f"    {name} = {out}"
+
+    def scaled(self, name: str, value: str, factor: str) -> str:
+        self.ready[name] = self.ready.get(value, 0) + _LAT
+        return f"    {name} = {value} * {factor}"
+
+
+def _fixed_function(n: int) -> str:
+    """The unrolled step of order ``n`` for forcing ``u0 + u1 x``, arranged for latency.
+
+    The same recurrences as :func:`rocking.engine.taylor_series`, with the factors that do not
+    depend on the step's own chain folded into coefficients computed up front: ``1/k`` of the two
+    newest terms of ``S_k``, ``C_k`` (``D_k / k = c_k``, ``D_1 / k = wh / k``), and
+    ``-q / ((k+1)(k+2))`` times 1, ``u0``, ``u1`` for ``c_{k+2}``; the end state sums the small
+    terms (in the order they become ready) before adding them to the large ones, as accurate as
+    summing from the smallest term."""
+    sc = _Sched()
+    L = [f"\n\n@njit(cache=True, fastmath={{'contract'}})\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf):",
+         "    S_0 = s0",
+         "    C_0 = c0",
+         "    D_1 = wh"]
+    for k in range(0, n - 1):  # c_{k+2} = Q_k S_k + A_k C_k + B_k C_{k-1}
+        r = -1.0 / ((k + 1) * (k + 2))
+        L.append(f"    Q_{k} = q * {r!r}")
+        L.append(f"    A_{k} = Q_{k} * u0")
+        if k > 0:
+            L.append(f"    B_{k} = Q_{k} * u1")
+    for k in range(2, n - 1):
+        L.append(f"    w_{k} = wh * {1.0 / k!r}")
+    sc.ready.update({"S_0": 0, "C_0": 0, "wh": 0})
+    for k in range(0, n - 1):
+        sc.ready[f"A_{k}"] = 2 * _LAT
+        sc.ready[f"B_{k}"] = 2 * _LAT
+    for k in range(2, n - 1):
+        sc.ready[f"w_{k}"] = _LAT
+    L.append(sc.sum("c_2", [(*sc.product("Q_0", "S_0"), 1), (*sc.product("A_0", "C_0"), 1)]))
+    L.append(sc.scaled("D_2", "c_2", "2.0"))
+    for k in range(1, n - 1):
+        for i in range(2, k):
+            L.append(sc.scaled(f"P_{i}_{k}", f"c_{i}", repr(i / k)))
+        for X, Y, sign in (("S", "C", -1), ("C", "S", 1)):
+            terms = []
+            w = "wh" if k == 1 else f"w_{k}"
+            terms.append((*sc.product(w, f"{Y}_{k - 1}"), sign))
+            if k > 1:
+                terms.append((*sc.product(f"c_{k}", f"{Y}_0"), sign))
+            for i in range(2, k):  # D_i Y_{k-i} / k = (c_i i / k) Y_{k-i}
+                terms.append((*sc.product(f"P_{i}_{k}", f"{Y}_{k - i}"), sign))
+            L.append(sc.sum(f"{X}_{k}", terms))
+        terms = [(*sc.product(f"Q_{k}", f"S_{k}"), 1), (*sc.product(f"A_{k}", f"C_{k}"), 1),
+                 (*sc.product(f"B_{k}", f"C_{k - 1}"), 1)]
+        L.append(sc.sum(f"c_{k + 2}", terms))
+        L.append(sc.scaled(f"D_{k + 2}", f"c_{k + 2}", f"{k + 2}.0"))
+    # end state: the tail (in the order its terms are ready), then the leading terms
+    def tail(name, first, lead, terms):
+        L.append(sc.sum(name, [(sc.ready[x], x, 1) for x in terms]))
+        return f"{lead} + ({first} + {name})"
+    th = tail("tc", "c_2", "theta + wh", [f"c_{k}" for k in range(3, n + 1)])
+    th = f"theta + (wh + (c_2 + tc))"
+    whn = tail("tD", "D_2", "wh", [f"D_{k}" for k in range(3, n + 1)])
+    s1 = tail("tS", "S_1", "S_0", [f"S_{k}" for k in range(2, n - 1)])
+    c1 = tail("tC", "C_1", "C_0", [f"C_{k}" for k in range(2, n - 1)])
+    L += [f"    cf[{k}] = c_{k}" for k in range(2, n + 1)]
+    L += ["    cf[0] = theta", "    cf[1] = wh",
+          "    tol = eps * (abs(theta) + abs(wh) + abs(c_2))",
+          "    flag = 1",
+          f"    if abs(D_{n}) > tol or abs(D_{n - 1}) > tol:",
+          "        flag = 0",
+          f"    elif abs(D_{n - 2}) <= tol and abs(D_{n - 3}) <= tol:",
+          "        flag = 2",
+          f"    return {th}, {whn}, {s1}, {c1}, flag"]
+    return "\n".join(L) + "\n"
+
+
 def source() -> str:
     """Text of the generated module."""
-    dispatch = ["\n\n@njit(cache=True)\ndef taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):",
+    dispatch = ["\n\n@njit(cache=True, inline='always')\ndef taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):",
                 '    """The step of :data:`ORDERS` order ``order`` (the highest for larger)."""']
     for n in ORDERS[:-1]:
         dispatch.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf)")
@@ -89,7 +189,7 @@ def source() -> str:
         dispatch.append(f"    if order <= {n}:\n        return taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf)")
     dispatch.append(f"    return taylor_smooth_{SMOOTH_ORDERS[-1]}(U, q, theta, wh, s0, c0, eps, cf)")
     return (HEADER + f"\nORDERS = {ORDERS!r}\nSMOOTH_ORDERS = {SMOOTH_ORDERS!r}\n"
-            + "".join(_function(n) for n in ORDERS)
+            + "".join(_fixed_function(n) for n in ORDERS)
             + "".join(_function(n, smooth=True) for n in SMOOTH_ORDERS)
             + "\n".join(dispatch) + "\n")
 
