@@ -24,6 +24,7 @@ from pulses import G, Pulse, Record
 
 from . import engine
 from .block import Block
+from .lanes import run_lanes
 
 #: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
 #: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  The Taylor
@@ -417,6 +418,36 @@ def _result(block, over, max_abs, impacts, n_imp, t, th, om, model, verdict_by, 
 
 
 # --------------------------------------------------------------------------- batch
+#: smaller batches run one by one (the engine's own loop over a single run is tighter)
+LANES_MIN_RUNS = 4
+
+
+def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, lanes=True):
+    """The engine over a batch: runs under a record with one Taylor step per sample go through the
+    batch engine (:mod:`rocking.lanes`, several runs per core at once), the rest run one by one
+    (:func:`rocking.engine.run_many`); the same model either way."""
+    args = (g.kind, amp, g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h, g.n_int)
+    if not (lanes and g.kind == engine.NODAL and g.nodes.size == 0 and not linear
+            and stepper == engine.TAYLOR and p.size >= LANES_MIN_RUNS):
+        return engine.run_many(*args, n_sub, p, alpha, eta, linear, ZENO_TOL, stepper)
+    one = n_sub == 1
+    if one.all():
+        return run_lanes(amp, g.uval, g.t_start, g.h, g.n_int, p, alpha, eta, ZENO_TOL,
+                         parallel=p.size >= engine.PARALLEL_MIN_RUNS)
+    out = tuple(np.empty(p.size, dtype=d) for d in (np.bool_, float, np.int64, np.bool_))
+    if one.any():
+        res = run_lanes(amp[one], g.uval, g.t_start, g.h, g.n_int, p[one], alpha[one], eta[one],
+                        ZENO_TOL, parallel=one.sum() >= engine.PARALLEL_MIN_RUNS)
+        for o, r in zip(out, res):
+            o[one] = r
+    rest = ~one
+    res = engine.run_many(g.kind, amp[rest], *args[2:], n_sub[rest], p[rest], alpha[rest],
+                          eta[rest], linear, ZENO_TOL, stepper)
+    for o, r in zip(out, res):
+        o[rest] = r
+    return out
+
+
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor") -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
@@ -468,9 +499,7 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     n_sub = _n_sub(h, p_eff, 0.05 if linear else ph_max)
     if linear and g.kind in (engine.NODAL, engine.RECT):
         n_sub[:] = 1
-    over, max_abs, n_imp, up = engine.run_many(g.kind, amp, g.tp, g.t0, g.uval, g.nodes,
-                                               g.t_start, g.h, g.n_int, n_sub, p, alpha, eta,
-                                               linear, ZENO_TOL, stepper)
+    over, max_abs, n_imp, up = _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper)
     ratio = max_abs / alpha
     return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
                        max_abs.reshape(shape), ratio.reshape(shape), n_imp.reshape(shape),
