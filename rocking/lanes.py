@@ -24,9 +24,11 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ._taylor_fixed import taylor_fixed
 from ._taylor_lanes import ORDERS, lanes_step
 from .engine import (HALF_PI, N_STAGES, NMAX, NODAL, OVERTURNED, REST, ROCKING, TAYLOR,
-                     TAYLOR_EPS, corner_sincos, energy_verdict, run_core)
+                     TAYLOR_EPS, _first_crossing, _hermite, _step_peak, corner_sincos,
+                     energy_verdict, run_core)
 
 #: runs stepped together at most (a chunk; the rocking ones are kept first, so that one loop over
 #: the first ``n_rocking`` lanes steps them all).  Measured per run and step at order 8: 45 ns for
@@ -55,20 +57,26 @@ def _swap(F, I, i, k):
 @njit(cache=True)
 def _partition(F, I, n_live):
     """Reorder lanes ``0 .. n_live-1``: rocking first, then at rest, then overturned; returns
-    ``(n_rocking, n_live)``."""
-    k = 0
-    for i in range(n_live):
-        if I[_STATUS, i] == ROCKING:
-            _swap(F, I, i, k)
-            k += 1
-    m = n_live
-    i = k
-    while i < m:
-        if I[_STATUS, i] == OVERTURNED:
-            m -= 1
-            _swap(F, I, i, m)
-        else:
+    ``(n_rocking, n_live)``.  Two-pointer partitions: only lanes out of place move (a few per
+    call: a lane changes state at an uplift, a return to rest or an overturning)."""
+    i, m = 0, n_live
+    while True:  # overturned lanes to the end
+        while i < m and I[_STATUS, i] != OVERTURNED:
             i += 1
+        while m > i and I[_STATUS, m - 1] == OVERTURNED:
+            m -= 1
+        if i >= m:
+            break
+        _swap(F, I, i, m - 1)
+    i, k = 0, m
+    while True:  # rocking lanes to the front
+        while i < k and I[_STATUS, i] == ROCKING:
+            i += 1
+        while k > i and I[_STATUS, k - 1] != ROCKING:
+            k -= 1
+        if i >= k:
+            break
+        _swap(F, I, i, k - 1)
     return k, m
 
 
@@ -82,10 +90,38 @@ def _wake(uval, j, n_int, a, tan_a):
 
 
 @njit(cache=True)
+def _turn(order, a, uval, j, ta, h, theta, omega, side, sa, ca, p, cf, kt, kw):
+    """A step of a rocking lane whose ``omega`` changes sign inside it (a turning point) but whose
+    ``theta`` keeps its side: as :func:`rocking.engine.run_core` takes it (the step's Taylor
+    polynomial; the peak located on it), unless the block may touch zero inside the step (then
+    ``ok`` is False and the engine takes the interval).  Returns ``(ok, theta, omega, sin, cos,
+    peak)`` at the end of the step."""
+    u0 = a * uval[j]
+    u1 = a * (uval[j + 1] - uval[j])
+    sn, cs = corner_sincos(theta, side, sa, ca)
+    th2, wh2, s1, c1, flag = taylor_fixed(order, u0, u1, (p * h) ** 2, theta, omega * h, sn, cs,
+                                          TAYLOR_EPS, cf)
+    om2 = wh2 / h
+    if flag == 0 or not (side * th2 > 0.0 and abs(th2) < HALF_PI):
+        return False, 0.0, 0.0, 0.0, 1.0, 0.0
+    c0, c1h, c2, c3 = _hermite(theta, omega, th2, om2, h)
+    lo, _, _ = _first_crossing(c0, c1h, c2, c3, side, 0.0)
+    if lo >= 0.0:
+        return False, 0.0, 0.0, 0.0, 1.0, 0.0
+    peak = _step_peak(NODAL, a, 1.0, 0.0, uval, j, ta, ta + h, ta, h, theta, omega, th2, om2,
+                      side, p, sa, ca, False, TAYLOR, kt, kw, h, cf, order)
+    return True, th2, om2, s1, c1, max(peak, abs(th2))
+
+
+@njit(cache=True)
 def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overturned, max_abs,
            n_impacts, uplifted, stats):
     """Runs ``i0 .. i1-1`` (at most :data:`LANES`) from rest over the whole record; results
-    (after the energy rule at the end of the record) written at their indices."""
+    (after the energy rule at the end of the record) written at their indices.
+
+    ``stats`` (4 integers) counts steps kept in lanes, turning points taken in lanes, and
+    intervals handed to the engine for rocking lanes and for lanes at rest.
+    """
     n = i1 - i0
     F = np.zeros((_NF, n))
     I = np.zeros((_NI, n), dtype=np.int64)
@@ -102,13 +138,12 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
         I[_STATUS, i] = REST
         I[_RUN, i] = k
     a, q, theta, omega = F[_A], F[_Q], F[_TH], F[_OM]
-    side, s_phi, c_phi = F[_SIDE], F[_SPHI], F[_CPHI]
-    th1 = np.zeros(n)
-    om1 = np.zeros(n)
-    s1 = np.zeros(n)
-    c1 = np.ones(n)
-    flag = np.zeros(n, dtype=np.int64)
+    side, s_phi, c_phi, peak = F[_SIDE], F[_SPHI], F[_CPHI], F[_MX]
+    bad = np.zeros(n, dtype=np.int64)
     work = np.zeros(2 * N_STAGES + 5 * (NMAX + 3))
+    kt = work[:N_STAGES]
+    kw = work[N_STAGES:2 * N_STAGES]
+    cf = np.zeros(NMAX + 3)
     empty = np.zeros(0)
     order = ORDERS[2]
     n_low = 0
@@ -119,86 +154,92 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
             break
         if n_rocking == 0 and j < next_wake:
             continue
+        ta = t_start + j * h
         tb = t_start + (j + 1) * h
-        stats[3] += 1
+        n_bad = 0
+        all_low = False
         if n_rocking > 0:
-            lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], a, q, h, theta, omega,
-                       s_phi, c_phi, TAYLOR_EPS, th1, om1, s1, c1, flag)
-        raise_order = False
-        all_low = n_rocking > 0
-        changed = False
+            n_bad, n_two = lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], a, q, h,
+                                      theta, omega, side, s_phi, c_phi, peak, TAYLOR_EPS, bad)
+            stats[0] += n_rocking - n_bad
+            all_low = n_two == n_rocking
         wake_all = j >= next_wake
-        if wake_all:
-            next_wake = n_int
-        for i in range(n_live):
-            st = I[_STATUS, i]
-            if st == ROCKING:
-                f = flag[i]
-                t2 = th1[i]
-                w2 = om1[i]
-                if f != 0 and omega[i] * w2 > 0.0 and side[i] * t2 > 0.0 and abs(t2) < HALF_PI:
-                    theta[i] = t2
-                    omega[i] = w2
-                    s_phi[i] = s1[i]
-                    c_phi[i] = c1[i]
-                    if abs(t2) > F[_MX, i]:
-                        F[_MX, i] = abs(t2)
-                    if f != 2:
-                        all_low = False
-                    stats[0] += 1
-                    continue
-                if f == 0:
-                    raise_order = True
-                all_low = False
-            else:  # at rest: the engine only where the block may uplift in this interval
-                if not wake_all:
-                    break  # lanes at rest come after the rocking ones
-                if I[_WAKE, i] > j:
-                    next_wake = min(next_wake, I[_WAKE, i])
-                    continue
-                if F[_REST, i] < tb:
+        if n_bad == 0 and not wake_all:
+            pass
+        else:
+            raise_order = False
+            changed = False
+            if wake_all:
+                next_wake = n_int
+            for i in range(n_rocking if not wake_all else n_live):
+                st = I[_STATUS, i]
+                if st == ROCKING:
+                    b = bad[i]
+                    if b == 0:
+                        continue
+                    if b == 2:
+                        raise_order = True
+                    elif omega[i] * side[i] > 0.0:
+                        # moving away from zero and turning back: the peak, in the lane
+                        ok, th, om, sn, cs, pk = _turn(order, a[i], uval, j, ta, h, theta[i],
+                                                      omega[i], side[i], F[_SA, i], F[_CA, i],
+                                                      F[_P, i], cf, kt, kw)
+                        if ok:
+                            theta[i], omega[i], s_phi[i], c_phi[i] = th, om, sn, cs
+                            if pk > peak[i]:
+                                peak[i] = pk
+                            stats[1] += 1
+                            continue
+                else:  # at rest: the engine only where the block may uplift in this interval
+                    if I[_WAKE, i] > j:
+                        next_wake = min(next_wake, I[_WAKE, i])
+                        continue
+                    if F[_REST, i] >= tb:  # at rest after a Zeno sequence until then
+                        next_wake = min(next_wake, j + 1)
+                        continue
                     w = _wake(uval, j, n_int, a[i], F[_TAN, i])
                     if w > j:
                         I[_WAKE, i] = w
                         next_wake = min(next_wake, w)
                         continue
-            # something happens in this interval: the engine takes this lane through it
-            stats[1 if st == ROCKING else 2] += 1
-            (st2, th, om, _, m, ni, _, u, r) = run_core(
-                NODAL, a[i], 1.0, 0.0, uval, empty, t_start, h, j, j + 1, 1, F[_P, i],
-                F[_ALPHA, i], F[_ETA, i], theta[i], omega[i], F[_REST, i], False, zeno_tol,
-                False, empty, empty, empty, empty, False, TAYLOR, work)
-            if m > F[_MX, i]:
-                F[_MX, i] = m
-            I[_NIMP, i] += ni
-            if u:
-                I[_UP, i] = 1
-            F[_REST, i] = r
-            I[_STATUS, i] = st2
-            changed = changed or st2 != st
-            if st2 == ROCKING:
-                theta[i] = th
-                omega[i] = om
-                if th != 0.0:
-                    side[i] = 1.0 if th > 0.0 else -1.0
+                # something happens in this interval: the engine takes this lane through it
+                stats[2 if st == ROCKING else 3] += 1
+                (st2, th, om, _, m, ni, _, u, r) = run_core(
+                    NODAL, a[i], 1.0, 0.0, uval, empty, t_start, h, j, j + 1, 1, F[_P, i],
+                    F[_ALPHA, i], F[_ETA, i], theta[i], omega[i], F[_REST, i], False, zeno_tol,
+                    False, empty, empty, empty, empty, False, TAYLOR, work)
+                if m > peak[i]:
+                    peak[i] = m
+                I[_NIMP, i] += ni
+                if u:
+                    I[_UP, i] = 1
+                F[_REST, i] = r
+                I[_STATUS, i] = st2
+                changed = changed or st2 != st
+                if st2 == ROCKING:
+                    theta[i] = th
+                    omega[i] = om
+                    if th != 0.0:
+                        side[i] = 1.0 if th > 0.0 else -1.0
+                    else:
+                        side[i] = 1.0 if om > 0.0 else -1.0
+                    s_phi[i], c_phi[i] = corner_sincos(th, side[i], F[_SA, i], F[_CA, i])
                 else:
-                    side[i] = 1.0 if om > 0.0 else -1.0
-                s_phi[i], c_phi[i] = corner_sincos(th, side[i], F[_SA, i], F[_CA, i])
-            else:
-                theta[i] = 0.0
-                omega[i] = 0.0
-                side[i] = 0.0
-                s_phi[i] = 0.0
-                c_phi[i] = 1.0
-                if st2 == REST:
-                    I[_WAKE, i] = j + 1
-                    next_wake = min(next_wake, j + 1)
-        if changed:
-            n_rocking, n_live = _partition(F, I, n_live)
-        if raise_order and order < ORDERS[-1]:
-            order += 2
-            n_low = 0
-        elif all_low:
+                    theta[i] = 0.0
+                    omega[i] = 0.0
+                    side[i] = 0.0
+                    s_phi[i] = 0.0
+                    c_phi[i] = 1.0
+                    if st2 == REST:
+                        I[_WAKE, i] = j + 1
+                        next_wake = min(next_wake, j + 1)
+            if changed:
+                n_rocking, n_live = _partition(F, I, n_live)
+            if raise_order and order < ORDERS[-1]:
+                order += 2
+                n_low = 0
+                continue
+        if all_low:
             n_low += 1
             if n_low >= LOW_RUN and order > ORDERS[0]:
                 order -= 2
@@ -209,14 +250,14 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
         k = I[_RUN, i]
         st = I[_STATUS, i]
         over = st == OVERTURNED
-        peak = F[_MX, i]
+        pk = peak[i]
         if st == ROCKING:
-            over, pk = energy_verdict(theta[i], omega[i], F[_P, i], F[_ALPHA, i], F[_ETA, i],
-                                      False)
-            if pk > peak:
-                peak = pk
+            over, pk2 = energy_verdict(theta[i], omega[i], F[_P, i], F[_ALPHA, i], F[_ETA, i],
+                                       False)
+            if pk2 > pk:
+                pk = pk2
         overturned[k] = over
-        max_abs[k] = HALF_PI if over else peak
+        max_abs[k] = HALF_PI if over else pk
         n_impacts[k] = I[_NIMP, i]
         uplifted[k] = I[_UP, i] != 0
 
