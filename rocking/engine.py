@@ -73,6 +73,10 @@ REST, ROCKING, OVERTURNED = 0, 1, 2
 
 _MAX_EVENTS_PER_STEP = 1_000_000
 
+#: steps in a row for which a lower order would have done before an unrolled step of forcing
+#: linear over the step (records) takes the next order down
+LOW_RUN_FIXED = 8
+
 
 # --------------------------------------------------------------------------- forcing
 @njit(cache=True, inline="always")
@@ -575,17 +579,13 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
             u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         else:
             u0, u1 = linear_forcing(kind, amp, uval, j, ta, tb, t, h)
-        while True:  # one call site: the unrolled orders are inlined once
-            th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, wh, s_phi,
-                                                          c_phi, TAYLOR_EPS, cf)
-            if flag != 0 or order >= FIXED_ORDERS[-1]:
-                break
-            order += 2  # the series needs more terms: the next order up
+        th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, wh, s_phi, c_phi,
+                                                      TAYLOR_EPS, cf)
         if flag == 0:
-            break
+            break  # the series needs more terms: run() raises the order (rare)
         n_used = order
         n_low = n_low + 1 if flag == 2 else 0
-        if n_low >= 64 and order > FIXED_ORDERS[0]:
+        if n_low >= LOW_RUN_FIXED and order > FIXED_ORDERS[0]:
             order -= 2  # a lower order has been enough for a while
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
@@ -670,7 +670,7 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
         lowest, highest, order = FIXED_ORDERS[0], FIXED_ORDERS[-1], FIXED_ORDERS[2]
     else:
         lowest, highest, order = SMOOTH_ORDERS[0], SMOOTH_ORDERS[-1], SMOOTH_ORDERS[2]
-    low_run = 64 if fixed else 16  # steps in a row a lower order must have sufficed
+    low_run = LOW_RUN_FIXED if fixed else 16  # steps in a row a lower order must have sufficed
     n_low = 0
     n_general = FIXED_ORDERS[-1]  # order of the last step of the general Taylor loop
     p2 = p * p
