@@ -79,6 +79,27 @@ LOW_RUN_FIXED = 8
 
 
 # --------------------------------------------------------------------------- forcing
+@njit(cache=True)
+def abs_max(a):
+    """``max|a|`` of a float array (as ``np.max(np.abs(a))`` for finite values), in one pass with
+    four running maxima (independent chains of compare and select)."""
+    m0 = m1 = m2 = m3 = 0.0
+    n = a.shape[0]
+    i = 0
+    while i + 4 <= n:
+        x0, x1, x2, x3 = abs(a[i]), abs(a[i + 1]), abs(a[i + 2]), abs(a[i + 3])
+        m0 = x0 if x0 > m0 else m0
+        m1 = x1 if x1 > m1 else m1
+        m2 = x2 if x2 > m2 else m2
+        m3 = x3 if x3 > m3 else m3
+        i += 4
+    while i < n:
+        x0 = abs(a[i])
+        m0 = x0 if x0 > m0 else m0
+        i += 1
+    return max(max(m0, m1), max(m2, m3))
+
+
 @njit(cache=True, inline="always")
 def forcing(kind, amp, tp, t0, uval, j, ta, tb, t):
     """Ground acceleration over g at time ``t`` inside interval ``j`` = ``[ta, tb]``.
@@ -380,6 +401,30 @@ def _first_crossing(c0, c1, c2, c3, s, level):
             return lo, hi, False
         lo = hi
     return -1.0, -1.0, False
+
+
+@njit(cache=True)
+def _cubic_root(c0, c1, c2, c3, s, lo, hi):
+    """The root of the cubic ``c0 + c1 x + c2 x^2 + c3 x^3`` in ``[lo, hi]``, where it is monotonic
+    with ``s H(lo) > 0 >= s H(hi)`` (a bracket from :func:`_first_crossing`), to rounding.
+
+    Newton from ``hi``, kept inside the bracket, which each evaluation narrows (a bisection when a
+    step would leave it): a few iterations where bisection to 1e-4 then Newton took ~20."""
+    x = hi
+    for _ in range(200):
+        f = _cubic(c0, c1, c2, c3, x)
+        if s * f > 0.0:
+            lo = x
+        else:
+            hi = x
+        d = c1 + x * (2.0 * c2 + 3.0 * c3 * x)
+        xn = x - f / d if d != 0.0 else 0.5 * (lo + hi)
+        if not (lo <= xn <= hi):
+            xn = 0.5 * (lo + hi)
+        if abs(xn - x) < 4e-16 or hi - lo < 4e-16:
+            return xn
+        x = xn
+    return x
 
 
 @njit(cache=True)
@@ -812,26 +857,11 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
                     if s * th_e > 0.0:
                         lo = -1.0
                 if lo >= 0.0 and (events < _MAX_EVENTS_PER_STEP):
-                    # bisection then Newton on the cubic (cheap), then Newton on the
-                    # re-integrated solution: its first iteration corrects the interpolation
-                    # error, the second confirms convergence to rounding
-                    for _ in range(60):
-                        mid = 0.5 * (lo + hi)
-                        if s * _cubic(c0, c1, c2, c3, mid) > 0.0:
-                            lo = mid
-                        else:
-                            hi = mid
-                        if hi - lo < 1e-4:
-                            break
-                    x = hi
-                    for _ in range(6):
-                        d = c1 + x * (2.0 * c2 + 3.0 * c3 * x)
-                        if d == 0.0:
-                            break
-                        xn = x - _cubic(c0, c1, c2, c3, x) / d
-                        if not (lo <= xn <= hi):
-                            break
-                        x = xn
+                    # the root of the cubic (cheap; one root in [lo, hi], where it is
+                    # monotonic), then Newton on the step's polynomial or the re-integrated
+                    # solution: its first iteration corrects the interpolation error, the second
+                    # confirms convergence to rounding
+                    x = _cubic_root(c0, c1, c2, c3, s, lo, hi)
                     converged = False
                     for _ in range(8):
                         th_x, om_x = _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, x, theta,
