@@ -117,12 +117,12 @@ def _fixed_function(n: int) -> str:
     newest terms of ``S_k``, ``C_k`` (``D_k / k = c_k``, ``D_1 / k = wh / k``), and
     ``-q / ((k+1)(k+2))`` times 1, ``u0``, ``u1`` for ``c_{k+2}``; the end state sums the small
     terms (in the order they become ready) before adding them to the large ones, as accurate as
-    summing from the smallest term."""
+    summing from the smallest term.  ``D_k = k c_k`` is not formed: ``omega h`` sums ``k c_k`` by
+    multiply-adds and the flags compare ``k |c_k|``."""
     sc = _Sched()
     L = [f"\n\n@njit(cache=True, fastmath={{'contract'}})\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf):",
          "    S_0 = s0",
-         "    C_0 = c0",
-         "    D_1 = wh"]
+         "    C_0 = c0"]
     for k in range(0, n - 1):  # c_{k+2} = Q_k S_k + A_k C_k + B_k C_{k-1}
         r = -1.0 / ((k + 1) * (k + 2))
         L.append(f"    Q_{k} = q * {r!r}")
@@ -138,7 +138,6 @@ def _fixed_function(n: int) -> str:
     for k in range(2, n - 1):
         sc.ready[f"w_{k}"] = _LAT
     L.append(sc.sum("c_2", [(*sc.product("Q_0", "S_0"), 1), (*sc.product("A_0", "C_0"), 1)]))
-    L.append(sc.scaled("D_2", "c_2", "2.0"))
     for k in range(1, n - 1):
         for i in range(2, k):
             L.append(sc.scaled(f"P_{i}_{k}", f"c_{i}", repr(i / k)))
@@ -154,23 +153,26 @@ def _fixed_function(n: int) -> str:
         terms = [(*sc.product(f"Q_{k}", f"S_{k}"), 1), (*sc.product(f"A_{k}", f"C_{k}"), 1),
                  (*sc.product(f"B_{k}", f"C_{k - 1}"), 1)]
         L.append(sc.sum(f"c_{k + 2}", terms))
-        L.append(sc.scaled(f"D_{k + 2}", f"c_{k + 2}", f"{k + 2}.0"))
     # end state: the tail (in the order its terms are ready), then the leading terms
     def tail(name, first, lead, terms):
         L.append(sc.sum(name, [(sc.ready[x], x, 1) for x in terms]))
         return f"{lead} + ({first} + {name})"
     th = tail("tc", "c_2", "theta + wh", [f"c_{k}" for k in range(3, n + 1)])
     th = f"theta + (wh + (c_2 + tc))"
-    whn = tail("tD", "D_2", "wh", [f"D_{k}" for k in range(3, n + 1)])
+    # omega h = sum k c_k: no D_k = k c_k kept (multiply-adds, and the flags below)
+    L.append(sc.sum("tD", [(sc.ready[f"c_{k}"] + _LAT, f"{k}.0 * c_{k}", 1) for k in range(3, n + 1)]))
+    whn = "wh + (2.0 * c_2 + tD)"
     s1 = tail("tS", "S_1", "S_0", [f"S_{k}" for k in range(2, n - 1)])
     c1 = tail("tC", "C_1", "C_0", [f"C_{k}" for k in range(2, n - 1)])
     L += [f"    cf[{k}] = c_{k}" for k in range(2, n + 1)]
     L += ["    cf[0] = theta", "    cf[1] = wh",
           "    tol = eps * (abs(theta) + abs(wh) + abs(c_2))",
-          "    flag = 1",
-          f"    if abs(D_{n}) > tol or abs(D_{n - 1}) > tol:",
+          "    flag = 1"]
+    D = {k: f"(abs(c_{k}) * {k}.0)" for k in range(2, n + 1)}  # |D_k|
+    D[1] = "abs(wh)"
+    L += [f"    if {D[n]} > tol or {D[n - 1]} > tol:",
           "        flag = 0",
-          f"    elif abs(D_{n - 2}) <= tol and abs(D_{n - 3}) <= tol:",
+          f"    elif {D[n - 2]} <= tol and {D[n - 3]} <= tol:",
           "        flag = 2",
           f"    return {th}, {whn}, {s1}, {c1}, flag"]
     return "\n".join(L) + "\n"

@@ -604,6 +604,36 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
     # from omega to omega h and back at every step, and two multiplications less on the chain
     # of dependent operations from one step to the next)
     wh = omega * h
+    if uniform and kind == NODAL and not record and j < n_int and t == t_start + j * h_uniform:
+        # records without history (the common case): the same loop, stripped to what changes
+        # from one interval to the next
+        if not sc_known:
+            s_phi, c_phi = corner_sincos(theta, s, sa, ca)
+            sc_known = True
+        while j < n_int:
+            u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+            th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, wh, s_phi,
+                                                          c_phi, TAYLOR_EPS, cf)
+            if flag == 0:
+                break  # the series needs more terms: run() raises the order (rare)
+            n_used = order
+            n_low = n_low + 1 if flag == 2 else 0
+            if n_low >= LOW_RUN_FIXED and order > FIXED_ORDERS[0]:
+                order -= 2  # a lower order has been enough for a while
+                n_low = 0
+            if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+                om2 = wh2 * inv_h
+                pending = True
+                break  # a turning point, an impact or overturning: the general way
+            if abs(th2) > max_abs:
+                max_abs = abs(th2)
+            theta, wh = th2, wh2
+            s_phi, c_phi = s_next, c_next
+            j += 1
+        t = t_start + j * h_uniform
+        omega = wh * inv_h
+        return (j, theta, omega, t, max_abs, sc_known, s_phi, c_phi, order, n_low, n_hist,
+                pending, th2, om2, s_next, c_next, n_used)
     while j < n_int:
         if uniform:
             ta = t_start + j * h_uniform
