@@ -9,16 +9,28 @@ import math
 import struct
 import threading
 import zlib
+from typing import ClassVar
 
-import numpy as np
 import matplotlib as mpl
+import numpy as np
+
 # imported here, not on first use: ``pipeline run`` preloads this module in the fork server (its
 # workers then start with matplotlib loaded) and in a thread of the main process (for the summary)
-from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
-from matplotlib.ft2font import RenderMode
+from matplotlib import cbook
+from matplotlib.artist import Artist
+from matplotlib.backends.backend_agg import (
+    FigureCanvasAgg,
+    RendererAgg,
+    get_hinting_flag,
+)
 from matplotlib.figure import Figure
+from matplotlib.font_manager import FontProperties
+from matplotlib.ft2font import RenderMode
 from matplotlib.lines import Line2D
 from matplotlib.markers import TICKDOWN, TICKLEFT
+from matplotlib.patches import FancyBboxPatch
+from matplotlib.ticker import AutoLocator, NullFormatter, NullLocator, ScalarFormatter
+from matplotlib.transforms import IdentityTransform
 
 #: at most this many points per curve (long records are thinned for drawing only)
 MAX_POINTS = 20000
@@ -33,44 +45,65 @@ class _TextRenderer(RendererAgg):
     autohinter on each draw, twice per string (metrics, then drawing): ~0.6 ms a string of 40
     characters, and half the cost of a record figure.  Here a string is laid out from per-character
     advances (hinted, whole pixels, as matplotlib's) plus per-pair kerning (what matplotlib's layout
-    gives for the pair), and glyphs are drawn from bitmaps rendered once per glyph, size, angle and
-    quarter-pixel position (matplotlib: 1/64 px; a quarter pixel is invisible at 80 dpi).  Every
-    cached value is a pure function of its key, so a figure's pixels do not depend on what the
-    process drew before.  Math text, font fallback (a character the font lacks), font features or
-    languages, and blank strings go through matplotlib's own path.
+    gives for the pair), and drawn as one bitmap composed from glyph bitmaps rendered once per
+    glyph, size, angle and quarter-pixel position (matplotlib: 1/64 px; a quarter pixel is
+    invisible at 80 dpi).  Every cached value is a pure function of its key, so a figure's pixels
+    do not depend on what the process drew before.  Math text, font fallback (a character the font
+    lacks), font features or languages, and blank strings go through matplotlib's own path.
+
+    Fonts are keyed by their properties (family, style, ..., size), not by the font file they
+    resolve to: the rcParams that resolve them are not changed while ``pipeline`` runs.
     """
 
-    #: (font file, size, dpi, flags, char) -> (glyph index, advance, ink x0, x1, y0, y1) in pixels
-    _chars: dict = {}
-    #: (font file, size, dpi, flags, char pair) -> kerning in pixels
-    _kerns: dict = {}
-    #: (font file, size, dpi, flags, string) -> (glyphs [(glyph index, x)], width, height, descent)
-    _strings: dict = {}
-    #: (font file, size, dpi, flags, glyph, angle, x quarter, y quarter, antialiased) -> bitmap
-    _glyphs: dict = {}
-    #: (font file, size, dpi, flags, string, angle, x quarter, y quarter, antialiased) -> bitmap
-    _bitmaps: dict = {}
-    #: font properties -> (ascent, descent, line gap) in pixels
-    _heights: dict = {}
-    #: caches are cleared past this many strings or glyphs (bounded memory in long runs)
+    #: (font key, char) -> (glyph index, advance, inked, ink x0, x1, y0, y1) in pixels
+    _chars: ClassVar[dict] = {}
+    #: (font key, char pair) -> kerning in pixels
+    _kerns: ClassVar[dict] = {}
+    #: (font key, string) -> (glyphs [(glyph index, x)], width, height, descent), None: fallback
+    _strings: ClassVar[dict] = {}
+    #: (font key, glyph, angle, x quarter, y quarter, antialiased) -> bitmap, left, top
+    _glyphs: ClassVar[dict] = {}
+    #: (font key, string, angle, x quarter, y quarter, antialiased) -> bitmap, left, top
+    _bitmaps: ClassVar[dict] = {}
+    #: font key -> (ascent, descent, line gap) in pixels
+    _heights: ClassVar[dict] = {}
+    #: caches are cleared past this many entries (bounded memory in long runs)
     MAX_ENTRIES = 20000
 
-    def _layout(self, s, prop, mtext):
-        """(font, size, flags, layout) for ``s``, or None for matplotlib's own path."""
-        if not s.strip() or (mtext is not None and (mtext.get_fontfeatures() is not None
-                                                    or mtext.get_language() is not None)):
-            return None
+    def _key(self, prop):
+        return (tuple(prop.get_family()), prop.get_style(), prop.get_variant(), prop.get_weight(),
+                prop.get_stretch(), prop.get_file(), prop.get_size_in_points(), self.dpi,
+                mpl.rcParams["text.hinting"])
+
+    def _font(self, key, prop):
+        """The FT2Font of ``prop`` at its size (``key``) and the hinting flags."""
         font = self._prepare_font(prop)
-        size = prop.get_size_in_points()
-        flags = get_hinting_flag()
-        base = (font.fname, size, self.dpi, flags)
-        key = (*base, s)
-        lay = self._strings.get(key)
-        if lay is not None:
-            return font, size, flags, lay
+        return font, key[6], get_hinting_flag()
+
+    @classmethod
+    def _store(cls, cache, key, value):
+        if len(cache) > cls.MAX_ENTRIES:
+            cache.clear()
+        cache[key] = value
+        return value
+
+    def _layout(self, s, prop, mtext=None):
+        """(font key, (glyphs, width, height, descent)) for ``s``, or None for matplotlib's path."""
+        if mtext is not None and (mtext.get_fontfeatures() is not None or mtext.get_language() is not None):
+            return None
+        key = self._key(prop)
+        lay = self._strings.get((key, s), False)
+        if lay is False:
+            lay = self._store(self._strings, (key, s), self._new_layout(key, prop, s))
+        return None if lay is None else (key, lay)
+
+    def _new_layout(self, key, prop, s):
+        if not s.strip():
+            return None
+        font, _, flags = self._font(key, prop)
         chars = []
         for c in s:
-            info = self._chars.get((*base, c))
+            info = self._chars.get((key, c))
             if info is None:
                 gi = font.get_char_index(ord(c))
                 if gi == 0:
@@ -78,21 +111,20 @@ class _TextRenderer(RendererAgg):
                 g = font.load_glyph(gi, flags)
                 x0 = g.horiBearingX / 64
                 y1 = g.horiBearingY / 64
-                ink = g.width > 0 and g.height > 0
-                info = self._chars[(*base, c)] = (gi, g.horiAdvance / 64, ink, x0, x0 + g.width / 64,
-                                                  y1 - g.height / 64, y1)
+                info = self._store(self._chars, (key, c), (
+                    gi, g.horiAdvance / 64, g.width > 0 and g.height > 0, x0, x0 + g.width / 64,
+                    y1 - g.height / 64, y1))
             chars.append(info)
         glyphs, x = [], 0.0
         xmin = ymin = math.inf
         xmax = ymax = -math.inf
         for i, (gi, adv, ink, x0, x1, y0, y1) in enumerate(chars):
             if i:
-                pair = s[i - 1:i + 1]
-                kern = self._kerns.get((*base, pair))
+                kern = self._kerns.get((key, s[i - 1:i + 1]))
                 if kern is None:
-                    items = font._layout(pair, flags=flags)
-                    kern = self._kerns[(*base, pair)] = (
-                        items[1].x - items[0].x - chars[i - 1][1] if len(items) == 2 else 0.0)
+                    items = font._layout(s[i - 1:i + 1], flags=flags)
+                    kern = self._store(self._kerns, (key, s[i - 1:i + 1]), (
+                        items[1].x - items[0].x - chars[i - 1][1] if len(items) == 2 else 0.0))
                 x += kern
             if ink:
                 glyphs.append((gi, x))
@@ -101,40 +133,33 @@ class _TextRenderer(RendererAgg):
             x += adv
         if not glyphs:
             return None
-        if len(self._strings) > self.MAX_ENTRIES:
-            self._strings.clear()
-        lay = self._strings[key] = (glyphs, xmax - xmin, ymax - ymin, -ymin)
-        return font, size, flags, lay
+        return glyphs, xmax - xmin, ymax - ymin, -ymin
 
     def get_text_width_height_descent(self, s, prop, ismath):
         if not ismath:
-            found = self._layout(s, prop, None)
+            found = self._layout(s, prop)
             if found is not None:
-                return found[3][1:]
+                return found[1][1:]
         return super().get_text_width_height_descent(s, prop, ismath)
 
-    def _glyph(self, font, size, flags, gi, angle, fx, fy, aa):
+    def _glyph(self, key, prop, gi, angle, fx, fy, aa):
         """(coverage bitmap, left, top) of a glyph with its pen at (fx, fy) quarter pixels, y up."""
-        key = (font.fname, size, self.dpi, flags, gi, angle, fx, fy, aa)
-        bitmap = self._glyphs.get(key)
+        bitmap = self._glyphs.get((key, gi, angle, fx, fy, aa))
         if bitmap is None:
-            if len(self._glyphs) > self.MAX_ENTRIES:
-                self._glyphs.clear()
+            font, _, flags = self._font(key, prop)
             cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
-            font.set_size(size, self.dpi)
             font._set_transform((0x10000 * np.array([[cos, -sin], [sin, cos]])).round().astype(int),
                                 [16 * fx, 16 * fy])
             g = font._render_glyph(gi, flags, RenderMode.NORMAL if aa else RenderMode.MONO)
             buf = np.array(g.buffer, dtype=np.uint8)
             if not aa:
                 buf *= 0xff
-            bitmap = self._glyphs[key] = (buf, g.left, g.top)
+            bitmap = self._store(self._glyphs, (key, gi, angle, fx, fy, aa), (buf, g.left, g.top))
         return bitmap
 
-    def _string_bitmap(self, font, size, flags, s, glyphs, angle, fx, fy, aa):
+    def _string_bitmap(self, key, prop, s, glyphs, angle, fx, fy, aa):
         """(coverage bitmap, left, top) of a string with its origin at (fx, fy) quarter pixels."""
-        key = (font.fname, size, self.dpi, flags, s, angle, fx, fy, aa)
-        found = self._bitmaps.get(key)
+        found = self._bitmaps.get((key, s, angle, fx, fy, aa))
         if found is not None:
             return found
         cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
@@ -142,7 +167,7 @@ class _TextRenderer(RendererAgg):
         for gi, dx in glyphs:
             ix, gx = divmod(fx + round(4 * dx * cos), 4)
             iy, gy = divmod(fy + round(4 * dx * sin), 4)
-            buf, left, top = self._glyph(font, size, flags, gi, angle, gx, gy, aa)
+            buf, left, top = self._glyph(key, prop, gi, angle, gx, gy, aa)
             if buf.size:
                 placed.append((buf, ix + left, iy + top))  # columns right, rows up
         if not placed:
@@ -159,20 +184,17 @@ class _TextRenderer(RendererAgg):
                 # coverage of two glyphs on a pixel as Agg blends them: a + b - a b
                 sub += buf - (sub * buf + 127) // 255
             found = (out.astype(np.uint8), x0, top)
-        if len(self._bitmaps) > self.MAX_ENTRIES:
-            self._bitmaps.clear()
-        self._bitmaps[key] = found
-        return found
+        return self._store(self._bitmaps, (key, s, angle, fx, fy, aa), found)
 
     def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
         found = None if ismath else self._layout(s, prop, mtext)
         if found is None:
             return super().draw_text(gc, x, y, s, prop, angle, ismath, mtext)
-        font, size, flags, (glyphs, *_) = found
+        key, (glyphs, *_) = found
         # origin in quarter pixels, y upwards (FreeType's)
         ix, fx = divmod(round(4 * x), 4)
         iy, fy = divmod(round(4 * (self.height - y)), 4)
-        buf, left, top = self._string_bitmap(font, size, flags, s, glyphs, angle, fx, fy,
+        buf, left, top = self._string_bitmap(key, prop, s, glyphs, angle, fx, fy,
                                              bool(gc.get_antialiased()))
         if buf.size:
             self._renderer.draw_text_image(buf, ix + left, int(self.height) - (iy + top) + buf.shape[0],
@@ -181,9 +203,7 @@ class _TextRenderer(RendererAgg):
     def _get_font_height_metrics(self, prop):
         """Ascent, descent and line gap of the font (what ``Text._get_layout`` reads from the font's
         tables on every draw), cached."""
-        size = prop.get_size_in_points()
-        key = (tuple(prop.get_family()), prop.get_style(), prop.get_variant(), prop.get_weight(),
-               prop.get_stretch(), prop.get_file(), size, self.dpi)
+        key = self._key(prop)
         found = self._heights.get(key)
         if found is None:
             from matplotlib.font_manager import fontManager, get_font
@@ -194,7 +214,7 @@ class _TextRenderer(RendererAgg):
                                                 ("hhea", "lineGap", "ascent", "descent")]:
                 t = font.get_sfnt_table(table)
                 if t is not None:
-                    scale = size * self.dpi / 72 / font.get_sfnt_table("head")["unitsPerEm"]
+                    scale = key[6] * self.dpi / 72 / font.get_sfnt_table("head")["unitsPerEm"]
                     found = (t[ascent] * scale, -t[descent] * scale, t[gap] * scale)
                     break
             self._heights[key] = found
@@ -260,6 +280,100 @@ MAX_CURVES = 2
 _PULSE_STYLES = ["-", "--", "-.", ":"]
 
 
+class _Labels(Artist):
+    """Strings drawn straight by the renderer at positions given in pixels (one artist for all the
+    tick labels of an axes, or all the texts of a legend): what a ``Text`` per string costs is
+    its layout machinery (~0.2 ms), here positions are computed once by :meth:`place`."""
+
+    def __init__(self, size, zorder):
+        super().__init__()
+        self.prop = FontProperties(size=size)
+        self.items = []  # (x, y of the baseline, from the bottom, in pixels; string; math)
+        self.set_zorder(zorder)
+
+    def metrics(self, renderer, s):
+        """(width, ascent, descent) as matplotlib's ``Text`` lays out one line ('normal' spacing)."""
+        math_ = cbook.is_math_text(s)
+        w, h, d = renderer.get_text_width_height_descent(s, self.prop, math_)
+        ascent, descent, _ = renderer._get_font_height_metrics(self.prop)
+        if ascent is None:
+            return w, h - d, d
+        return w, max(h - d, ascent), max(d, descent)
+
+    def place(self, renderer, items):
+        """``items``: ``[(x, y, string, ha, va)]`` in pixels; ha left/center/right, va
+        top/baseline/center_baseline (matplotlib's meanings)."""
+        self.items = []
+        for x, y, s, ha, va in items:
+            w, a, _ = self.metrics(renderer, s)
+            x -= {"left": 0.0, "center": w / 2, "right": w}[ha]
+            y -= {"top": a, "baseline": 0.0, "center_baseline": a / 2}[va]
+            self.items.append((x, y, s, cbook.is_math_text(s)))
+        self.stale = True
+
+    def draw(self, renderer):
+        if not self.get_visible() or not self.items:
+            return
+        gc = renderer.new_gc()
+        gc.set_foreground(mpl.rcParams["text.color"])
+        gc.set_antialiased(mpl.rcParams["text.antialiased"])
+        for x, y, s, math_ in self.items:
+            renderer.draw_text(gc, x, renderer.height - y, s, self.prop, 0.0, ismath=math_)
+        gc.restore()
+        self.stale = False
+
+
+class _Legend:
+    """A legend (upper right of an axes) laid out as matplotlib's with its default settings, from
+    a frame, one handle line per entry and one :class:`_Labels`: a ``Legend`` lays out through
+    nested packers on every draw (~2 ms)."""
+
+    FONTSIZE = 7
+    #: matplotlib's legend defaults, in font sizes
+    BORDERPAD, LABELSPACING, HANDLELENGTH, HANDLETEXTPAD, BORDERAXESPAD = 0.4, 0.5, 2.0, 0.8, 0.5
+
+    def __init__(self, ax, lines):
+        self.ax = ax
+        self.frame = FancyBboxPatch((0, 0), 1, 1, boxstyle="round,pad=0,rounding_size=0.2",
+                                    facecolor=mpl.rcParams["axes.facecolor"],
+                                    edgecolor=mpl.rcParams["legend.edgecolor"], alpha=0.8, snap=True,
+                                    transform=IdentityTransform(), clip_on=False, zorder=5)
+        self.handles = []
+        for line in lines:
+            h = Line2D([], [], transform=IdentityTransform(), clip_on=False, zorder=5.01)
+            h.update_from(line)
+            h.set_transform(IdentityTransform())
+            h.set_visible(True)
+            self.handles.append(h)
+        self.labels = _Labels(self.FONTSIZE, zorder=5.02)
+        for a in (self.frame, *self.handles, self.labels):
+            ax.add_artist(a)
+            a.set_clip_on(False)
+
+    def show(self, renderer, texts):
+        fs = renderer.points_to_pixels(self.FONTSIZE)
+        metrics = [self.labels.metrics(renderer, s) for s in texts]
+        row = max(a for _, a, _ in metrics) + max(d for *_, d in metrics)
+        width = ((2 * self.BORDERPAD + self.HANDLELENGTH + self.HANDLETEXTPAD) * fs
+                 + max(w for w, *_ in metrics))
+        height = 2 * self.BORDERPAD * fs + len(texts) * row + (len(texts) - 1) * self.LABELSPACING * fs
+        bbox = self.ax.bbox
+        x1, y1 = bbox.x1 - self.BORDERAXESPAD * fs, bbox.y1 - self.BORDERAXESPAD * fs
+        x0 = x1 - width
+        self.frame.set_bounds(x0, y1 - height, width, height)
+        self.frame.set_mutation_scale(fs)
+        items = []
+        for i, h in enumerate(self.handles):
+            h.set_visible(i < len(texts))
+            if i < len(texts):
+                base = y1 - self.BORDERPAD * fs - i * (row + self.LABELSPACING * fs) - metrics[i][1]
+                hx = x0 + self.BORDERPAD * fs
+                h.set_data([hx, hx + self.HANDLELENGTH * fs], [base + 0.35 * fs] * 2)
+                items.append((hx + (self.HANDLELENGTH + self.HANDLETEXTPAD) * fs, base, texts[i],
+                              "left", "baseline"))
+        self.labels.place(renderer, items)
+
+
 class _RecordFigure:
     """One reusable record figure with ``n_hist`` history panels (a process draws many records).
 
@@ -269,11 +383,14 @@ class _RecordFigure:
     record: explicit colours, no colour cycle, no ``ax.plot``), so a record's PNG bytes do not
     depend on what the figure drew before (``tests/test_pipeline_run.py`` checks it).
 
-    Drawing costs per artist, so the figure has few: the grid and the tick marks of an axes are one
-    line each (matplotlib: two lines per tick, ~120 a figure), a legend per number of entries is
-    made once and only its texts change, y limits are computed here (no ``relim``), the y labels
-    sit at a fixed place (no measuring of the tick labels to place them).
+    Drawing costs per artist, so the figure has few: matplotlib's axes draw two lines and a text
+    per tick (~120 lines a figure, each with its machinery), here the grid, the tick marks and the
+    tick labels of an axes are one artist each, placed as matplotlib's (its locators and
+    formatters give the ticks and their labels); legends are :class:`_Legend`; y limits are
+    computed here (no ``relim``); the axis labels sit at fixed places.
     """
+
+    TICK_LABEL_SIZE = 10
 
     def __init__(self, n_hist):
         height = 2.4 + 2.0 * n_hist
@@ -296,39 +413,47 @@ class _RecordFigure:
             ax.axhline(-1.0, color="k", lw=0.5, ls=":")
             ax.set_ylabel("theta / alpha")
         axes[-1].set_xlabel("time (s)")
-        self.decor = []
-        for k, ax in enumerate(axes):
-            # every panel spans the same time: x tick labels only at the bottom
-            ax.tick_params(bottom=False, left=False, labelbottom=k == len(axes) - 1)
-            # left of the widest usual tick labels ("-0.75"), the same place on every panel
-            ax.yaxis.set_label_coords(-0.078, 0.5)
-            grid = dict(color=mpl.rcParams["grid.color"], lw=mpl.rcParams["grid.linewidth"], alpha=0.3,
-                        zorder=1.5)
-            tick = dict(ls="none", color=mpl.rcParams["xtick.color"], ms=mpl.rcParams["xtick.major.size"],
-                        mew=mpl.rcParams["xtick.major.width"], clip_on=False, zorder=2.6)
+        renderer = fig.canvas.get_renderer()
+        pt = renderer.points_to_pixels(1.0)
+        # tick labels: (tick size + pad) from the axes, as matplotlib's
+        self.tick_pad = (mpl.rcParams["xtick.major.size"] + mpl.rcParams["xtick.major.pad"]) * pt
+        self.decor, self.locators, self.legends = [], [], []
+        grid = {"color": mpl.rcParams["grid.color"], "lw": mpl.rcParams["grid.linewidth"], "alpha": 0.3,
+                "zorder": 1.5}
+        tick = {"ls": "none", "color": mpl.rcParams["xtick.color"], "ms": mpl.rcParams["xtick.major.size"],
+                "mew": mpl.rcParams["xtick.major.width"], "clip_on": False, "zorder": 2.6}
+        for k, (ax, lines) in enumerate(zip(axes, [[self.record_line] + self.pulse_lines] + self.hist_lines)):
+            # ticks chosen by matplotlib's own locators and formatters, drawn here
+            locators = []
+            for axis in (ax.xaxis, ax.yaxis):
+                loc, fmt = AutoLocator(), ScalarFormatter()
+                loc.set_axis(axis)
+                fmt.set_axis(axis)
+                locators.append((loc, fmt))
+                axis.set_major_locator(NullLocator())
+                axis.set_minor_locator(NullLocator())
+                axis.set_major_formatter(NullFormatter())
+            self.locators.append(locators)
             artists = (Line2D([], [], transform=ax.get_xaxis_transform(), **grid),
                        Line2D([], [], transform=ax.get_yaxis_transform(), **grid),
                        Line2D([], [], transform=ax.get_xaxis_transform(), marker=TICKDOWN, **tick),
-                       Line2D([], [], transform=ax.get_yaxis_transform(), marker=TICKLEFT, **tick))
+                       Line2D([], [], transform=ax.get_yaxis_transform(), marker=TICKLEFT, **tick),
+                       _Labels(self.TICK_LABEL_SIZE, zorder=2.6))
             for a in artists:
                 ax.add_artist(a)
+            artists[-1].set_clip_on(False)
             self.decor.append(artists)
-        # one legend per panel and number of entries, made now (its handles copy the lines' styles)
-        self.legends = []
-        for ax, lines in zip(axes, [[self.record_line] + self.pulse_lines] + self.hist_lines):
-            self.legends.append([ax.legend(lines[:n], ["_"] * n, fontsize=7, loc="upper right")
-                                 for n in range(1, len(lines) + 1)])
-        for ax in axes:
-            ax.legend_ = None
-
-    @staticmethod
-    def _ticks(axis, lo, hi):
-        span = hi - lo
-        return np.array([v for v in axis.get_major_locator()() if lo - 1e-9 * span <= v <= hi + 1e-9 * span])
+            self.legends.append(_Legend(ax, lines))
+            # left of the widest usual tick labels ("-0.75"), the same place on every panel
+            ax.yaxis.set_label_coords(-0.078, 0.5)
+        # x label below the tick labels (matplotlib: tick labels' extent + labelpad)
+        _, a, d = self.decor[-1][-1].metrics(renderer, "0123456789")
+        below = self.tick_pad + a + d + mpl.rcParams["axes.labelpad"] * pt
+        axes[-1].xaxis.set_label_coords(0.5, -below / axes[-1].bbox.height)
 
     def _show(self, k, lines, data, xlim, ylim_with=()):
         """Panel ``k``'s lines get ``data`` (``[(t, y, label), ...]``, the rest hidden), legend,
-        limits (y: the data and ``ylim_with``, 5 % margins as matplotlib's autoscale), grid, ticks."""
+        limits (y: the data and ``ylim_with``, 5 % margins as matplotlib's autoscale), ticks."""
         ax = self.axes[k]
         if len(data) > len(lines):
             raise ValueError(f"at most {len(lines)} curves per panel, got {len(data)}")
@@ -348,23 +473,47 @@ class _RecordFigure:
             lo, hi = min(lo, v), max(hi, v)
         if not math.isfinite(lo):
             lo, hi = -1.0, 1.0
-        lo, hi = ax.yaxis.get_major_locator().nonsingular(float(lo), float(hi))
+        yloc = self.locators[k][1][0]
+        lo, hi = yloc.nonsingular(float(lo), float(hi))
         margin = ax.margins()[1] * (hi - lo)
         ax.set_ylim(lo - margin, hi + margin)
         ax.set_xlim(*xlim)
-        legend = self.legends[k][len(data) - 1]
-        for text, d in zip(legend.texts, data):
-            text.set_text(d[2])
-        ax.legend_ = legend
-        xgrid, ygrid, xtick, ytick = self.decor[k]
-        xs = self._ticks(ax.xaxis, *ax.get_xlim())
-        ys = self._ticks(ax.yaxis, *ax.get_ylim())
+        renderer = self.fig.canvas.get_renderer()
+        self.legends[k].show(renderer, [d[2] for d in data])
+        self._ticks(k, renderer, bottom_labels=k == len(self.axes) - 1)
+
+    def _ticks(self, k, renderer, bottom_labels):
+        ax = self.axes[k]
+        xgrid, ygrid, xtick, ytick, labels = self.decor[k]
+        (xloc, xfmt), (yloc, yfmt) = self.locators[k]
+        ticks = []
+        for axis, loc, fmt in ((ax.xaxis, xloc, xfmt), (ax.yaxis, yloc, yfmt)):
+            lo, hi = sorted(axis.get_view_interval())
+            locs = np.asarray(loc())
+            texts = fmt.format_ticks(locs)  # all the locator's ticks, as matplotlib's axis does
+            tol = 1e-9 * (hi - lo)
+            keep = (locs >= lo - tol) & (locs <= hi + tol)
+            ticks.append((locs[keep], [t for t, kp in zip(texts, keep) if kp], fmt.get_offset()))
+        (xs, xtexts, xoff), (ys, ytexts, yoff) = ticks
         nan = np.full(len(xs), np.nan)
         xgrid.set_data(np.column_stack([xs, xs, nan]).ravel(), np.tile([0.0, 1.0, np.nan], len(xs)))
         nan = np.full(len(ys), np.nan)
         ygrid.set_data(np.tile([0.0, 1.0, np.nan], len(ys)), np.column_stack([ys, ys, nan]).ravel())
         xtick.set_data(xs, np.zeros(len(xs)))
         ytick.set_data(np.zeros(len(ys)), ys)
+        bbox = ax.bbox
+        items = []
+        if bottom_labels:
+            px = ax.transData.transform(np.column_stack([xs, np.zeros(len(xs))]))[:, 0]
+            items += [(x, bbox.y0 - self.tick_pad, s, "center", "top") for x, s in zip(px, xtexts)]
+            if xoff:  # matplotlib: at the right end, below the tick labels
+                _, a, d = labels.metrics(renderer, "0")
+                items.append((bbox.x1, bbox.y0 - self.tick_pad - a - d, xoff, "right", "top"))
+        py = ax.transData.transform(np.column_stack([np.zeros(len(ys)), ys]))[:, 1]
+        items += [(bbox.x0 - self.tick_pad, y, s, "right", "center_baseline") for y, s in zip(py, ytexts)]
+        if yoff:  # matplotlib: above the top left corner
+            items.append((bbox.x0, bbox.y1 + self.tick_pad, yoff, "left", "baseline"))
+        labels.place(renderer, items)
 
     def draw(self, record_id, record, fitting, histories) -> bytes:
         from pulses import G

@@ -192,6 +192,11 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     assert plots.record_figure_png(tasks[-1].record_id, *few) == fresh_few != fresh
     assert plots.record_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
     assert len(plots._RECORD_FIGURES) == 1  # the figure was indeed reused
+    # the text caches (strings, glyph bitmaps) hold pure functions of their keys: emptied, same bytes
+    for cache in (plots._TextRenderer._chars, plots._TextRenderer._kerns, plots._TextRenderer._strings,
+                  plots._TextRenderer._glyphs, plots._TextRenderer._bitmaps, plots._TextRenderer._heights):
+        cache.clear()
+    assert plots.record_figure_png(tasks[-1].record_id, *parts[-1]) == png
 
 
 def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
