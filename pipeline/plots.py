@@ -257,10 +257,10 @@ def _png(fig) -> bytes:
     pixels = rgba[:, :, :3] if opaque else rgba
     rows = np.empty((h, 1 + pixels.shape[2] * w), np.uint8)
     rows[:, 0] = 0  # filter type None
-    rows[:, 1:] = pixels.reshape(h, -1)
+    rows[:, 1:].reshape(pixels.shape)[...] = pixels
     header = struct.pack(">IIBBBBB", w, h, 8, 2 if opaque else 6, 0, 0, 0)
     return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", header)
-            + _png_chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)) + _png_chunk(b"IEND", b""))
+            + _png_chunk(b"IDAT", zlib.compress(rows, 1)) + _png_chunk(b"IEND", b""))
 
 
 def _thin(t, y):
@@ -351,6 +351,12 @@ class _Legend:
             a.set_clip_on(False)
 
     def show(self, renderer, texts):
+        self.frame.set_visible(bool(texts))
+        if not texts:  # no entry: no legend
+            for h in self.handles:
+                h.set_visible(False)
+            self.labels.place(renderer, [])
+            return
         fs = renderer.points_to_pixels(self.FONTSIZE)
         metrics = [self.labels.metrics(renderer, s) for s in texts]
         row = max(a for _, a, _ in metrics) + max(d for *_, d in metrics)
@@ -457,8 +463,6 @@ class _RecordFigure:
         ax = self.axes[k]
         if len(data) > len(lines):
             raise ValueError(f"at most {len(lines)} curves per panel, got {len(data)}")
-        if not data:
-            raise ValueError("no curve to draw")
         lo, hi = math.inf, -math.inf
         for line, d in zip(lines, data + [None] * (len(lines) - len(data))):
             if d is None:
