@@ -118,7 +118,9 @@ def _fixed_function(n: int) -> str:
     ``-q / ((k+1)(k+2))`` times 1, ``u0``, ``u1`` for ``c_{k+2}``; the end state sums the small
     terms (in the order they become ready) before adding them to the large ones, as accurate as
     summing from the smallest term.  ``D_k = k c_k`` is not formed: ``omega h`` sums ``k c_k`` by
-    multiply-adds and the flags compare ``k |c_k|``."""
+    multiply-adds and the flags compare ``k |c_k|``.  The ready times of the model (one unit per
+    add or multiply) order the sums; the compiler may fuse a multiply into the add that follows
+    (``fastmath='contract'``), never reorder."""
     sc = _Sched()
     L = [f"\n\n@njit(cache=True, fastmath={{'contract'}})\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf):",
          "    S_0 = s0",
@@ -153,17 +155,18 @@ def _fixed_function(n: int) -> str:
         terms = [(*sc.product(f"Q_{k}", f"S_{k}"), 1), (*sc.product(f"A_{k}", f"C_{k}"), 1),
                  (*sc.product(f"B_{k}", f"C_{k - 1}"), 1)]
         L.append(sc.sum(f"c_{k + 2}", terms))
-    # end state: the tail (in the order its terms are ready), then the leading terms
-    def tail(name, first, lead, terms):
-        L.append(sc.sum(name, [(sc.ready[x], x, 1) for x in terms]))
-        return f"{lead} + ({first} + {name})"
-    th = tail("tc", "c_2", "theta + wh", [f"c_{k}" for k in range(3, n + 1)])
-    th = f"theta + (wh + (c_2 + tc))"
-    # omega h = sum k c_k: no D_k = k c_k kept (multiply-adds, and the flags below)
-    L.append(sc.sum("tD", [(sc.ready[f"c_{k}"] + _LAT, f"{k}.0 * c_{k}", 1) for k in range(3, n + 1)]))
-    whn = "wh + (2.0 * c_2 + tD)"
-    s1 = tail("tS", "S_1", "S_0", [f"S_{k}" for k in range(2, n - 1)])
-    c1 = tail("tC", "C_1", "C_0", [f"C_{k}" for k in range(2, n - 1)])
+    # end state: the terms after the leading one added in the order they become ready (the
+    # largest first, but all far below the leading term), then the leading term, whose addition
+    # is the one rounding at the result's own level; omega h sums k c_k by multiply-adds (no
+    # D_k = k c_k is formed: the flags below compare k |c_k|)
+    def tail(name, terms):
+        L.append(sc.sum(name, [(sc.ready.get(x, 0), x, 1) for x in terms]))
+    tail("tc", [f"c_{k}" for k in range(2, n + 1)])
+    L.append(sc.sum("tD", [(sc.ready[f"c_{k}"] + _LAT, f"{k}.0 * c_{k}", 1)
+                           for k in range(2, n + 1)]))
+    tail("tS", [f"S_{k}" for k in range(1, n - 1)])
+    tail("tC", [f"C_{k}" for k in range(1, n - 1)])
+    th, whn, s1, c1 = "theta + (wh + tc)", "wh + tD", "S_0 + tS", "C_0 + tC"
     L += [f"    cf[{k}] = c_{k}" for k in range(2, n + 1)]
     L += ["    cf[0] = theta", "    cf[1] = wh",
           "    tol = eps * (abs(theta) + abs(wh) + abs(c_2))",

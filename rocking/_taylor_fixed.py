@@ -36,10 +36,10 @@ def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_2 = -(w_2 * C_1) - c_2 * C_0
     C_2 = w_2 * S_1 + c_2 * S_0
     c_4 = B_2 * C_1 + Q_2 * S_2 + A_2 * C_2
-    tc = c_3 + c_4
-    tD = 3.0 * c_3 + 4.0 * c_4
-    tS = S_2
-    tC = C_2
+    tc = c_2 + c_3 + c_4
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4
+    tS = S_1 + S_2
+    tC = C_1 + C_2
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -51,7 +51,7 @@ def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_2) * 2.0) <= tol and abs(wh) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -91,10 +91,10 @@ def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_4 = -(P_2_4 * C_2) - P_3_4 * C_1 - w_4 * C_3 - c_4 * C_0
     C_4 = P_2_4 * S_2 + P_3_4 * S_1 + w_4 * S_3 + c_4 * S_0
     c_6 = B_4 * C_3 + Q_4 * S_4 + A_4 * C_4
-    tc = c_3 + c_4 + c_5 + c_6
-    tD = 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6
-    tS = S_2 + S_3 + S_4
-    tC = C_2 + C_3 + C_4
+    tc = c_2 + c_3 + c_4 + c_5 + c_6
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6
+    tS = S_1 + S_2 + S_3 + S_4
+    tC = C_1 + C_2 + C_3 + C_4
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -108,7 +108,7 @@ def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_4) * 4.0) <= tol and (abs(c_3) * 3.0) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -169,10 +169,10 @@ def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_6 = -(P_3_6 * C_3) - P_4_6 * C_2 - P_2_6 * C_4 - P_5_6 * C_1 - w_6 * C_5 - c_6 * C_0
     C_6 = P_3_6 * S_3 + P_4_6 * S_2 + P_2_6 * S_4 + P_5_6 * S_1 + w_6 * S_5 + c_6 * S_0
     c_8 = B_6 * C_5 + Q_6 * S_6 + A_6 * C_6
-    tc = c_3 + c_4 + c_5 + c_6 + c_7 + c_8
-    tD = 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8
-    tS = S_2 + S_3 + S_4 + S_5 + S_6
-    tC = C_2 + C_3 + C_4 + C_5 + C_6
+    tc = c_2 + c_3 + c_4 + c_5 + c_6 + c_7 + c_8
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8
+    tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6
+    tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -188,7 +188,7 @@ def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_6) * 6.0) <= tol and (abs(c_5) * 5.0) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -274,10 +274,10 @@ def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_8 = -(P_4_8 * C_4) - P_5_8 * C_3 - P_3_8 * C_5 - P_6_8 * C_2 - P_2_8 * C_6 - P_7_8 * C_1 - w_8 * C_7 - c_8 * C_0
     C_8 = P_4_8 * S_4 + P_5_8 * S_3 + P_3_8 * S_5 + P_6_8 * S_2 + P_2_8 * S_6 + P_7_8 * S_1 + w_8 * S_7 + c_8 * S_0
     c_10 = B_8 * C_7 + Q_8 * S_8 + A_8 * C_8
-    tc = c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10
-    tD = 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10
-    tS = S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8
-    tC = C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8
+    tc = c_2 + c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10
+    tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8
+    tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -295,7 +295,7 @@ def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_8) * 8.0) <= tol and (abs(c_7) * 7.0) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -410,10 +410,10 @@ def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_10 = -(P_5_10 * C_5) - P_6_10 * C_4 - P_4_10 * C_6 - P_7_10 * C_3 - P_3_10 * C_7 - P_8_10 * C_2 - P_2_10 * C_8 - P_9_10 * C_1 - w_10 * C_9 - c_10 * C_0
     C_10 = P_5_10 * S_5 + P_6_10 * S_4 + P_4_10 * S_6 + P_7_10 * S_3 + P_3_10 * S_7 + P_8_10 * S_2 + P_2_10 * S_8 + P_9_10 * S_1 + w_10 * S_9 + c_10 * S_0
     c_12 = B_10 * C_9 + Q_10 * S_10 + A_10 * C_10
-    tc = c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10 + c_11 + c_12
-    tD = 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12
-    tS = S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10
-    tC = C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10
+    tc = c_2 + c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10 + c_11 + c_12
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12
+    tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10
+    tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -433,7 +433,7 @@ def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_10) * 10.0) <= tol and (abs(c_9) * 9.0) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -581,10 +581,10 @@ def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_12 = -(P_6_12 * C_6) - P_7_12 * C_5 - P_5_12 * C_7 - P_8_12 * C_4 - P_4_12 * C_8 - P_9_12 * C_3 - P_3_12 * C_9 - P_10_12 * C_2 - P_2_12 * C_10 - P_11_12 * C_1 - w_12 * C_11 - c_12 * C_0
     C_12 = P_6_12 * S_6 + P_7_12 * S_5 + P_5_12 * S_7 + P_8_12 * S_4 + P_4_12 * S_8 + P_9_12 * S_3 + P_3_12 * S_9 + P_10_12 * S_2 + P_2_12 * S_10 + P_11_12 * S_1 + w_12 * S_11 + c_12 * S_0
     c_14 = B_12 * C_11 + Q_12 * S_12 + A_12 * C_12
-    tc = c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10 + c_11 + c_12 + c_13 + c_14
-    tD = 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12 + 13.0 * c_13 + 14.0 * c_14
-    tS = S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10 + S_11 + S_12
-    tC = C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10 + C_11 + C_12
+    tc = c_2 + c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10 + c_11 + c_12 + c_13 + c_14
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12 + 13.0 * c_13 + 14.0 * c_14
+    tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10 + S_11 + S_12
+    tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10 + C_11 + C_12
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -606,7 +606,7 @@ def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_12) * 12.0) <= tol and (abs(c_11) * 11.0) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -791,10 +791,10 @@ def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf):
     S_14 = -(P_7_14 * C_7) - P_8_14 * C_6 - P_6_14 * C_8 - P_9_14 * C_5 - P_5_14 * C_9 - P_10_14 * C_4 - P_4_14 * C_10 - P_11_14 * C_3 - P_3_14 * C_11 - P_12_14 * C_2 - P_2_14 * C_12 - P_13_14 * C_1 - w_14 * C_13 - c_14 * C_0
     C_14 = P_7_14 * S_7 + P_8_14 * S_6 + P_6_14 * S_8 + P_9_14 * S_5 + P_5_14 * S_9 + P_10_14 * S_4 + P_4_14 * S_10 + P_11_14 * S_3 + P_3_14 * S_11 + P_12_14 * S_2 + P_2_14 * S_12 + P_13_14 * S_1 + w_14 * S_13 + c_14 * S_0
     c_16 = B_14 * C_13 + Q_14 * S_14 + A_14 * C_14
-    tc = c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10 + c_11 + c_12 + c_13 + c_14 + c_15 + c_16
-    tD = 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12 + 13.0 * c_13 + 14.0 * c_14 + 15.0 * c_15 + 16.0 * c_16
-    tS = S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10 + S_11 + S_12 + S_13 + S_14
-    tC = C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10 + C_11 + C_12 + C_13 + C_14
+    tc = c_2 + c_3 + c_4 + c_5 + c_6 + c_7 + c_8 + c_9 + c_10 + c_11 + c_12 + c_13 + c_14 + c_15 + c_16
+    tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12 + 13.0 * c_13 + 14.0 * c_14 + 15.0 * c_15 + 16.0 * c_16
+    tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10 + S_11 + S_12 + S_13 + S_14
+    tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10 + C_11 + C_12 + C_13 + C_14
     cf[2] = c_2
     cf[3] = c_3
     cf[4] = c_4
@@ -818,7 +818,7 @@ def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf):
         flag = 0
     elif (abs(c_14) * 14.0) <= tol and (abs(c_13) * 13.0) <= tol:
         flag = 2
-    return theta + (wh + (c_2 + tc)), wh + (2.0 * c_2 + tD), S_0 + (S_1 + tS), C_0 + (C_1 + tC), flag
+    return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
 @njit(cache=True)
