@@ -354,7 +354,7 @@ def _cubic(c0, c1, c2, c3, x):
     return c0 + x * (c1 + x * (c2 + x * c3))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _stationary(c1, c2, c3):
     """Roots of the derivative ``c1 + 2 c2 x + 3 c3 x^2`` inside (0, 1), sorted (nan if none)."""
     r1, r2 = np.nan, np.nan
@@ -379,7 +379,7 @@ def _stationary(c1, c2, c3):
     return r1, r2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _first_crossing(c0, c1, c2, c3, s, level):
     """First x in (0, 1] where ``s*H(x) - level`` turns non-positive, given it starts >= 0.
 
@@ -461,7 +461,7 @@ def _advance(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, c
     return th, om, 0, 0.0, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
                s, p, sa, ca, linear, method, kt, kw, h_step, cf, n):
     """Largest ``|theta|`` at a turning point strictly inside ``[t, t + h]`` (0 if none).
@@ -584,7 +584,7 @@ def _unrolled_step(fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q,
     return taylor_smooth(order, U, q, theta, wh, s_phi, c_phi, TAYLOR_EPS, cf)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omega, s, sa, ca, p2,
             max_abs, sc_known, s_phi, c_phi, order, n_low, cf, record, hist_t, hist_theta,
             hist_omega, n_hist):
