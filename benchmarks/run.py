@@ -605,6 +605,20 @@ def headline(quick):
         t_many.append(timed(lambda: rocking.simulate_many([blk] * 200, exc))[1] / 200)
         t_many_rk8.append(timed(lambda: rocking.simulate_many([blk] * 200, exc, method="rk8"))[1] / 200)
         t_usual.append(timed(lambda: simulate_usual(blk, exc, **USUAL_DEFAULT))[1])
+    # batch engine (rocking.lanes) against the same runs one by one, one core (< 256 runs: no
+    # threads): 200 widths of the column up to 20 % wider, as a verified-width search runs them
+    from rocking import solver
+
+    wide = [rocking.Block.from_dimensions(7.5, 1.8 * (1.0 + 0.2 * k / 199)) for k in range(200)]
+    t_lanes, t_one = [], []
+    saved = solver.LANES_MIN_RUNS
+    for _ in range(max(2, n_round // 2)):
+        t_lanes.append(timed(lambda: rocking.simulate_many(wide, exc))[1] / 200)
+        solver.LANES_MIN_RUNS = 10 ** 9
+        try:
+            t_one.append(timed(lambda: rocking.simulate_many(wide, exc))[1] / 200)
+        finally:
+            solver.LANES_MIN_RUNS = saved
     ratios = [u / f for u, f in zip(t_usual, t_fast)]
     ratios_rk8 = [u / f for u, f in zip(t_usual, t_rk8)]
     e_fast = abs(fast.max_rotation_ratio - ref.max_rotation_ratio)
@@ -617,6 +631,8 @@ def headline(quick):
                 t_fast=statistics.median(t_fast), t_fast_best=min(t.best for t in t_fast),
                 t_usual_best=min(t_usual), t_fast_hist=statistics.median(t_fast_hist),
                 t_many=statistics.median(t_many), t_usual=statistics.median(t_usual),
+                t_lanes=statistics.median(t_lanes), t_one=statistics.median(t_one),
+                lanes_ratio=statistics.median(t_usual) / statistics.median(t_lanes),
                 speed_ratio=statistics.median(ratios), speed_ratio_min=min(ratios),
                 e_fast=e_fast, e_usual=e_usual,
                 acc_ratio=(e_usual / e_fast) if e_fast > 0 else math.inf, n_round=n_round,
@@ -740,6 +756,9 @@ def section_solver(md, out, quick, records, rec_notes):
     md.append(f"| fast engine, `method=\"{m}\"`, `simulate(...)` with history | {fmt_t(h['t_fast_hist'])} | same as above | |")
     md.append(f"| fast engine in a batch (`simulate_many`, 200 blocks, 2 threads), per run, `method=\"{m}\"` / "
               f"`\"rk8\"` | {fmt_t(h['t_many'])} / {fmt_t(h['t_many_rk8'])} | same as above | |")
+    md.append(f"| batch engine (`rocking.lanes`, runs stepped together), one core: 200 widths 1.8-2.16 m "
+              f"(`simulate_many`), per run | {fmt_t(h['t_lanes'])} (the same runs one by one: "
+              f"{fmt_t(h['t_one'])}) | same as above | {h['lanes_ratio']:.0f}x |")
     md.append(f"| usual approach (RK45 default) | {fmt_t(h['t_usual'])} (best {fmt_t(h['t_usual_best'])}) | "
               f"{fmt_e(h['e_usual'])} | 1 |")
     acc = "infinite (fast error is 0)" if math.isinf(h["acc_ratio"]) else f"{h['acc_ratio']:.2g}x"
