@@ -7,6 +7,7 @@ coefficient in registers and run about three times faster than the general loop.
 """
 from __future__ import annotations
 
+import math
 import pathlib
 
 #: orders generated (even); higher orders use the general loop of rocking.engine
@@ -24,7 +25,9 @@ of the step, with ``flag`` 0 if the last two terms of the series are above
 terms before them already were below (a lower order would do), else 1.  The coefficients of
 ``theta`` in powers of ``x`` are written into ``cf[0 .. N]`` (the step's polynomial, for events).
 ``taylor_smooth_N(U, q, theta, wh, s0, c0, eps)`` is the same for forcing given by its series
-``U[0 .. N - 2]`` in powers of ``x`` (smooth pulses).
+``U[0 .. N - 2]`` in powers of ``x`` (smooth pulses).  ``fixed_run_N`` loops ``taylor_N`` over the
+intervals of a record while nothing happens (one loop per order: a loop holding all the orders
+cost ~4 ns a step), ``fixed_run`` picks the one of an order.
 """
 from numba import njit
 '''
@@ -181,6 +184,36 @@ def _fixed_function(n: int) -> str:
     return "\n".join(L) + "\n"
 
 
+RUN_TEMPLATE = '''
+
+@njit(cache=True)
+def fixed_run_{n}(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_{n} over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+'''
+
+
 def source() -> str:
     """Text of the generated module."""
     dispatch = ["\n\n@njit(cache=True, inline='always')\ndef taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):",
@@ -188,13 +221,22 @@ def source() -> str:
     for n in ORDERS[:-1]:
         dispatch.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf)")
     dispatch.append(f"    return taylor_{ORDERS[-1]}(u0, u1, q, theta, wh, s0, c0, eps, cf)")
+    args = "uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low"
+    dispatch.append("\n\n@njit(cache=True)\ndef fixed_run(order, " + args + ", low_run, eps, cf):")
+    dispatch.append('    """fixed_run_N of :data:`ORDERS` order ``order`` (the highest for larger)."""')
+    for i, n in enumerate(ORDERS):
+        lower = "False" if i == 0 else "True"
+        call = f"fixed_run_{n}({args}, {lower}, low_run, eps, cf)"
+        dispatch.append(f"    if order <= {n}:\n        return {call}" if i < len(ORDERS) - 1
+                        else f"    return {call}")
     dispatch.append("\n\n@njit(cache=True)\ndef taylor_smooth(order, U, q, theta, wh, s0, c0, eps, cf):")
     dispatch.append('    """The step of :data:`SMOOTH_ORDERS` order ``order`` (the highest for larger)."""')
     for n in SMOOTH_ORDERS[:-1]:
         dispatch.append(f"    if order <= {n}:\n        return taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf)")
     dispatch.append(f"    return taylor_smooth_{SMOOTH_ORDERS[-1]}(U, q, theta, wh, s0, c0, eps, cf)")
-    return (HEADER + f"\nORDERS = {ORDERS!r}\nSMOOTH_ORDERS = {SMOOTH_ORDERS!r}\n"
+    return (HEADER + f"\nORDERS = {ORDERS!r}\nSMOOTH_ORDERS = {SMOOTH_ORDERS!r}\nHALF_PI = {math.pi / 2!r}\n"
             + "".join(_fixed_function(n) for n in ORDERS)
+            + "".join(RUN_TEMPLATE.format(n=n) for n in ORDERS)
             + "".join(_function(n, smooth=True) for n in SMOOTH_ORDERS)
             + "\n".join(dispatch) + "\n")
 

@@ -8,12 +8,15 @@ of the step, with ``flag`` 0 if the last two terms of the series are above
 terms before them already were below (a lower order would do), else 1.  The coefficients of
 ``theta`` in powers of ``x`` are written into ``cf[0 .. N]`` (the step's polynomial, for events).
 ``taylor_smooth_N(U, q, theta, wh, s0, c0, eps)`` is the same for forcing given by its series
-``U[0 .. N - 2]`` in powers of ``x`` (smooth pulses).
+``U[0 .. N - 2]`` in powers of ``x`` (smooth pulses).  ``fixed_run_N`` loops ``taylor_N`` over the
+intervals of a record while nothing happens (one loop per order: a loop holding all the orders
+cost ~4 ns a step), ``fixed_run`` picks the one of an order.
 """
 from numba import njit
 
 ORDERS = (4, 6, 8, 10, 12, 14, 16)
 SMOOTH_ORDERS = (8, 10, 12, 14, 16, 18, 20, 22, 24)
+HALF_PI = 1.5707963267948966
 
 
 @njit(cache=True, fastmath={'contract'})
@@ -819,6 +822,195 @@ def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf):
     elif (abs(c_14) * 14.0) <= tol and (abs(c_13) * 13.0) <= tol:
         flag = 2
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
+
+
+@njit(cache=True)
+def fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_4 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+
+
+@njit(cache=True)
+def fixed_run_6(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_6 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+
+
+@njit(cache=True)
+def fixed_run_8(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_8 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+
+
+@njit(cache=True)
+def fixed_run_10(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_10 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+
+
+@njit(cache=True)
+def fixed_run_12(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_12 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+
+
+@njit(cache=True)
+def fixed_run_14(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_14 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+
+
+@njit(cache=True)
+def fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
+                low_run, eps, cf):
+    """taylor_16 over intervals j, j + 1, ... of a record (forcing amp * uval, linear between
+    samples) while nothing happens: rocking.engine._cruise's loop at one order."""
+    th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
+    while j < n_int:
+        u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
+        th2, wh2, s_next, c_next, flag = taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        if flag == 0:
+            return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
+        n_low = n_low + 1 if flag == 2 else 0
+        lower = n_low >= low_run and can_lower
+        if lower:
+            n_low = 0
+        if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
+        if abs(th2) > max_abs:
+            max_abs = abs(th2)
+        theta, wh = th2, wh2
+        s_phi, c_phi = s_next, c_next
+        j += 1
+        if lower:
+            return 2, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, True
+    return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
 
 
 @njit(cache=True)
@@ -1773,6 +1965,24 @@ def taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):
     if order <= 14:
         return taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf)
     return taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf)
+
+
+@njit(cache=True)
+def fixed_run(order, uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, low_run, eps, cf):
+    """fixed_run_N of :data:`ORDERS` order ``order`` (the highest for larger)."""
+    if order <= 4:
+        return fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, False, low_run, eps, cf)
+    if order <= 6:
+        return fixed_run_6(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
+    if order <= 8:
+        return fixed_run_8(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
+    if order <= 10:
+        return fixed_run_10(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
+    if order <= 12:
+        return fixed_run_12(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
+    if order <= 14:
+        return fixed_run_14(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
+    return fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
 
 
 @njit(cache=True)
