@@ -125,7 +125,7 @@ def _fixed_function(n: int) -> str:
     add or multiply) order the sums; the compiler may fuse a multiply into the add that follows
     (``fastmath='contract'``), never reorder."""
     sc = _Sched()
-    L = [f"\n\n@njit(cache=True, fastmath={{'contract'}})\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf):",
+    L = [f"\n\n@njit(cache=True, fastmath={{'contract'}})\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):",
          "    S_0 = s0",
          "    C_0 = c0"]
     for k in range(0, n - 1):  # c_{k+2} = Q_k S_k + A_k C_k + B_k C_{k-1}
@@ -170,8 +170,8 @@ def _fixed_function(n: int) -> str:
     tail("tS", [f"S_{k}" for k in range(1, n - 1)])
     tail("tC", [f"C_{k}" for k in range(1, n - 1)])
     th, whn, s1, c1 = "theta + (wh + tc)", "wh + tD", "S_0 + tS", "C_0 + tC"
-    L += [f"    cf[{k}] = c_{k}" for k in range(2, n + 1)]
-    L += ["    cf[0] = theta", "    cf[1] = wh",
+    L += ["    if store:"] + [f"        cf[{k}] = c_{k}" for k in range(2, n + 1)]
+    L += ["        cf[0] = theta", "        cf[1] = wh",
           "    tol = eps * (abs(theta) + abs(wh) + abs(c_2))",
           "    flag = 1"]
     D = {k: f"(abs(c_{k}) * {k}.0)" for k in range(2, n + 1)}  # |D_k|
@@ -194,7 +194,8 @@ def fixed_run_{n}(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -202,6 +203,7 @@ def fixed_run_{n}(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)

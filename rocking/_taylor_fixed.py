@@ -20,7 +20,7 @@ HALF_PI = 1.5707963267948966
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -43,11 +43,12 @@ def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4
     tS = S_1 + S_2
     tC = C_1 + C_2
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_4) * 4.0) > tol or (abs(c_3) * 3.0) > tol:
@@ -58,7 +59,7 @@ def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf):
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -98,13 +99,14 @@ def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6
     tS = S_1 + S_2 + S_3 + S_4
     tC = C_1 + C_2 + C_3 + C_4
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[5] = c_5
-    cf[6] = c_6
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[5] = c_5
+        cf[6] = c_6
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_6) * 6.0) > tol or (abs(c_5) * 5.0) > tol:
@@ -115,7 +117,7 @@ def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf):
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -176,15 +178,16 @@ def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8
     tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6
     tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[5] = c_5
-    cf[6] = c_6
-    cf[7] = c_7
-    cf[8] = c_8
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[5] = c_5
+        cf[6] = c_6
+        cf[7] = c_7
+        cf[8] = c_8
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_8) * 8.0) > tol or (abs(c_7) * 7.0) > tol:
@@ -195,7 +198,7 @@ def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf):
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -281,17 +284,18 @@ def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10
     tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8
     tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[5] = c_5
-    cf[6] = c_6
-    cf[7] = c_7
-    cf[8] = c_8
-    cf[9] = c_9
-    cf[10] = c_10
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[5] = c_5
+        cf[6] = c_6
+        cf[7] = c_7
+        cf[8] = c_8
+        cf[9] = c_9
+        cf[10] = c_10
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_10) * 10.0) > tol or (abs(c_9) * 9.0) > tol:
@@ -302,7 +306,7 @@ def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf):
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -417,19 +421,20 @@ def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12
     tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10
     tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[5] = c_5
-    cf[6] = c_6
-    cf[7] = c_7
-    cf[8] = c_8
-    cf[9] = c_9
-    cf[10] = c_10
-    cf[11] = c_11
-    cf[12] = c_12
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[5] = c_5
+        cf[6] = c_6
+        cf[7] = c_7
+        cf[8] = c_8
+        cf[9] = c_9
+        cf[10] = c_10
+        cf[11] = c_11
+        cf[12] = c_12
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_12) * 12.0) > tol or (abs(c_11) * 11.0) > tol:
@@ -440,7 +445,7 @@ def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf):
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -588,21 +593,22 @@ def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12 + 13.0 * c_13 + 14.0 * c_14
     tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10 + S_11 + S_12
     tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10 + C_11 + C_12
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[5] = c_5
-    cf[6] = c_6
-    cf[7] = c_7
-    cf[8] = c_8
-    cf[9] = c_9
-    cf[10] = c_10
-    cf[11] = c_11
-    cf[12] = c_12
-    cf[13] = c_13
-    cf[14] = c_14
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[5] = c_5
+        cf[6] = c_6
+        cf[7] = c_7
+        cf[8] = c_8
+        cf[9] = c_9
+        cf[10] = c_10
+        cf[11] = c_11
+        cf[12] = c_12
+        cf[13] = c_13
+        cf[14] = c_14
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_14) * 14.0) > tol or (abs(c_13) * 13.0) > tol:
@@ -613,7 +619,7 @@ def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf):
 
 
 @njit(cache=True, fastmath={'contract'})
-def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf):
+def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -798,23 +804,24 @@ def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf):
     tD = 2.0 * c_2 + 3.0 * c_3 + 4.0 * c_4 + 5.0 * c_5 + 6.0 * c_6 + 7.0 * c_7 + 8.0 * c_8 + 9.0 * c_9 + 10.0 * c_10 + 11.0 * c_11 + 12.0 * c_12 + 13.0 * c_13 + 14.0 * c_14 + 15.0 * c_15 + 16.0 * c_16
     tS = S_1 + S_2 + S_3 + S_4 + S_5 + S_6 + S_7 + S_8 + S_9 + S_10 + S_11 + S_12 + S_13 + S_14
     tC = C_1 + C_2 + C_3 + C_4 + C_5 + C_6 + C_7 + C_8 + C_9 + C_10 + C_11 + C_12 + C_13 + C_14
-    cf[2] = c_2
-    cf[3] = c_3
-    cf[4] = c_4
-    cf[5] = c_5
-    cf[6] = c_6
-    cf[7] = c_7
-    cf[8] = c_8
-    cf[9] = c_9
-    cf[10] = c_10
-    cf[11] = c_11
-    cf[12] = c_12
-    cf[13] = c_13
-    cf[14] = c_14
-    cf[15] = c_15
-    cf[16] = c_16
-    cf[0] = theta
-    cf[1] = wh
+    if store:
+        cf[2] = c_2
+        cf[3] = c_3
+        cf[4] = c_4
+        cf[5] = c_5
+        cf[6] = c_6
+        cf[7] = c_7
+        cf[8] = c_8
+        cf[9] = c_9
+        cf[10] = c_10
+        cf[11] = c_11
+        cf[12] = c_12
+        cf[13] = c_13
+        cf[14] = c_14
+        cf[15] = c_15
+        cf[16] = c_16
+        cf[0] = theta
+        cf[1] = wh
     tol = eps * (abs(theta) + abs(wh) + abs(c_2))
     flag = 1
     if (abs(c_16) * 16.0) > tol or (abs(c_15) * 15.0) > tol:
@@ -832,7 +839,8 @@ def fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -840,6 +848,7 @@ def fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -859,7 +868,8 @@ def fixed_run_6(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -867,6 +877,7 @@ def fixed_run_6(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -886,7 +897,8 @@ def fixed_run_8(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -894,6 +906,7 @@ def fixed_run_8(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -913,7 +926,8 @@ def fixed_run_10(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -921,6 +935,7 @@ def fixed_run_10(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -940,7 +955,8 @@ def fixed_run_12(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -948,6 +964,7 @@ def fixed_run_12(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -967,7 +984,8 @@ def fixed_run_14(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -975,6 +993,7 @@ def fixed_run_14(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -994,7 +1013,8 @@ def fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     th2, wh2, s_next, c_next = 0.0, 0.0, 0.0, 1.0
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
-        th2, wh2, s_next, c_next, flag = taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf)
+        th2, wh2, s_next, c_next, flag = taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
+                                                   False)
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -1002,6 +1022,7 @@ def fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
+            taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
