@@ -409,8 +409,19 @@ def _cubic_root(c0, c1, c2, c3, s, lo, hi):
     with ``s H(lo) > 0 >= s H(hi)`` (a bracket from :func:`_first_crossing`), to rounding.
 
     Newton from ``hi``, kept inside the bracket, which each evaluation narrows (a bisection when a
-    step would leave it): a few iterations where bisection to 1e-4 then Newton took ~20."""
+    step would leave it): a few iterations where bisection to 1e-4 then Newton took ~20.  A step
+    that starts at ``theta = 0`` (just after an impact: ``c0 = 0``) starts from the root of
+    ``c1 + c2 x + c3 x^2`` in the bracket (small hops, whose root is close to the top of the hop,
+    took Newton from ``hi`` ~11 iterations)."""
     x = hi
+    if c0 == 0.0:
+        disc = c2 * c2 - 4.0 * c3 * c1
+        if disc >= 0.0 and (c2 != 0.0 or c3 != 0.0):
+            qq = -0.5 * (c2 + math.copysign(math.sqrt(disc), c2))
+            for r in (qq / c3 if c3 != 0.0 else np.nan, c1 / qq if qq != 0.0 else np.nan):
+                if lo <= r <= hi:
+                    x = r
+                    break
     for _ in range(200):
         f = _cubic(c0, c1, c2, c3, x)
         if s * f > 0.0:
