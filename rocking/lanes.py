@@ -164,9 +164,7 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
             stats[0] += n_rocking - n_bad
             all_low = n_two == n_rocking
         wake_all = j >= next_wake
-        if n_bad == 0 and not wake_all:
-            pass
-        else:
+        if n_bad > 0 or wake_all:  # lanes that need attention in this interval
             raise_order = False
             changed = False
             if wake_all:

@@ -431,25 +431,26 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, lanes=True):
     """The engine over a batch: runs under a record with one Taylor step per sample go through the
     batch engine (:mod:`rocking.lanes`, several runs per core at once), the rest run one by one
     (:func:`rocking.engine.run_many`); the same model either way."""
-    args = (g.kind, amp, g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h, g.n_int)
-    if not (lanes and g.kind == engine.NODAL and g.nodes.size == 0 and not linear
+    def one_by_one(m):
+        return engine.run_many(g.kind, amp[m], g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h,
+                               g.n_int, n_sub[m], p[m], alpha[m], eta[m], linear, ZENO_TOL, stepper)
+
+    def in_lanes(m):
+        return run_lanes(amp[m], g.uval, g.t_start, g.h, g.n_int, p[m], alpha[m], eta[m], ZENO_TOL,
+                         parallel=p[m].size >= engine.PARALLEL_MIN_RUNS)
+
+    use = np.zeros(p.size, dtype=bool)
+    if (lanes and g.kind == engine.NODAL and g.nodes.size == 0 and not linear
             and stepper == engine.TAYLOR and p.size >= LANES_MIN_RUNS):
-        return engine.run_many(*args, n_sub, p, alpha, eta, linear, ZENO_TOL, stepper)
-    one = n_sub == 1
-    if one.all():
-        return run_lanes(amp, g.uval, g.t_start, g.h, g.n_int, p, alpha, eta, ZENO_TOL,
-                         parallel=p.size >= engine.PARALLEL_MIN_RUNS)
+        use = n_sub == 1
+    if not use.any():
+        return one_by_one(slice(None))
+    if use.all():
+        return in_lanes(slice(None))
     out = tuple(np.empty(p.size, dtype=d) for d in (np.bool_, float, np.int64, np.bool_))
-    if one.any():
-        res = run_lanes(amp[one], g.uval, g.t_start, g.h, g.n_int, p[one], alpha[one], eta[one],
-                        ZENO_TOL, parallel=one.sum() >= engine.PARALLEL_MIN_RUNS)
-        for o, r in zip(out, res):
-            o[one] = r
-    rest = ~one
-    res = engine.run_many(g.kind, amp[rest], *args[2:], n_sub[rest], p[rest], alpha[rest],
-                          eta[rest], linear, ZENO_TOL, stepper)
-    for o, r in zip(out, res):
-        o[rest] = r
+    for m, fn in ((use, in_lanes), (~use, one_by_one)):
+        for o, r in zip(out, fn(m)):
+            o[m] = r
     return out
 
 
