@@ -746,6 +746,9 @@ REC_GAP = 0.01
 REC_NEAR = 0.6
 #: at most this many rounds (a failure found above the candidate moves it up: check again)
 REC_ROUNDS = 12
+#: the fine zone is run from its widest width down in batches of this many (one batch of the
+#: batch engine's lanes per core), and stops at the first batch with a failure
+REC_CHUNK = 32
 
 
 def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone):
@@ -807,6 +810,16 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
         order = np.argsort(x, kind="stable")
         return x[order], f[order], r[order]
 
+    def run_down(widths):
+        """Run ``widths`` from the widest down, :data:`REC_CHUNK` at a time, stopping after the
+        first chunk with a failure: narrower widths cannot change the answer (it lies above the
+        widest failure), so they are not run.  Returns whether any failed."""
+        widths = np.sort(np.asarray(widths, dtype=float))[::-1]
+        for k in range(0, widths.size, REC_CHUNK):
+            if run(widths[k:k + REC_CHUNK]).any():
+                return True
+        return False
+
     def top_bracket():
         x, f, _ = scanned()
         if not f.any():
@@ -855,7 +868,7 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
             z = np.setdiff1d(z[(z > hi) & (z < top)], fine_done)
             if z.size:
                 fine_done = np.union1d(fine_done, z)
-                found = bool(run(z).any())
+                found = run_down(z)
         while not found:
             mids = near_gaps(hi)
             if not mids.size:

@@ -20,7 +20,9 @@ breakpoints and extrema subdivided into equal steps) and handles everything betw
 * **Zeno sequences**: once the post-impact velocity falls below ``zeno_tol * p * alpha`` while
   both sides are restoring, the remaining geometric series of hops is summed in closed form and
   the block is put at rest at the accumulation time (no threshold on the *result*: the hops
-  left out are ``(zeno_tol * alpha)^2`` small);
+  left out are ``(zeno_tol * alpha)^2`` small); when the forcing is at or past the uplift
+  threshold on one side the block is put at rest at once, and the rest rule uplifts it (hopping
+  on would take ever shorter hops down to rounding, millions of them);
 * **peaks**: ``max|theta|`` includes the extremum of the Hermite interpolant inside each step;
 * **overturning**: ``|theta|`` reaching ``pi/2``;
 * **end of the excitation**: the energy rule of SPEC section 2 decides overturning exactly and
@@ -928,7 +930,7 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
                                           omega, s, p, sa, ca, linear, method, kt, kw, cf, nt)
                     t_imp = t + x * h
                     if t_imp <= t:
-                        t_imp = t + 1e-16 * max(abs(t), 1.0)
+                        t_imp = t + 4.5e-16 * max(abs(t), 1.0)  # at least one ulp of t
                     # peak between t and the impact (none above max_abs if the polynomial's
                     # bound says so: the small hops of a block coming to rest)
                     pk = 0.0
@@ -957,9 +959,15 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
                         if a_new > 0.0 and a_old > 0.0:
                             t_z = 2.0 * abs(omega) / (1.0 - eta * eta) * (1.0 / a_new + eta / a_old)
                             rest_until = t + t_z
-                            s = 0.0
-                            omega = 0.0
-                            status = REST
+                        else:
+                            # the forcing is at or past the uplift threshold on one side: at
+                            # rest now, to uplift as the rest rule says (what is left out is
+                            # again hops of height ~(zeno_tol alpha)^2; hopping on would take
+                            # ever shorter hops, millions of them, down to rounding)
+                            rest_until = t
+                        s = 0.0
+                        omega = 0.0
+                        status = REST
                     continue
                 if lo >= 0.0:  # too many events in one step: settle (never loops forever)
                     s = 0.0

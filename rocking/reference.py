@@ -159,10 +159,13 @@ def _advance(state: _State, ta: float, tb: float, u, stop_at_rest: bool = False)
                 uu = u(t)
                 a_new = p * p * (math.sin(alpha) + state.s * uu * math.cos(alpha))
                 a_old = p * p * (math.sin(alpha) - state.s * uu * math.cos(alpha))
+                # at rest (after the hops' accumulation time when both sides hold the block;
+                # now when the forcing is at or past the uplift threshold on one side)
+                tz = 0.0
                 if a_new > 0 and a_old > 0:
                     tz = 2 * abs(state.omega) / (1 - eta**2) * (1 / a_new + eta / a_old)
-                    state.rest_until = t + tz
-                    state.s, state.omega = 0.0, 0.0
+                state.rest_until = t + tz
+                state.s, state.omega = 0.0, 0.0
             continue
         state.theta, state.omega = float(sol.y[0, -1]), float(sol.y[1, -1])
         t = tb

@@ -337,6 +337,12 @@ def test_record_width_search_matches_brute_force_synthetic(height):
     assert abs(fast.width - brute) <= step
     # 132 scanned widths, ~365 of the fine zone (0.05 % apart over 20 %), ~25 bisection steps
     assert fast.runs < 600
+    # the fine zone run from its top down, stopping at the first batch with a failure, answers as
+    # the whole zone run at once (widths below the widest failure cannot move the answer)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(rocking.design, "REC_CHUNK", 10**9)
+        whole = rocking.required_width(height, rec, rule="exact")
+    assert whole.width == fast.width and whole.runs >= fast.runs
     # and it is a transition: fails just below, survives just above (fast solver and reference)
     for f, expect in [(1 + 1e-6, False), (1 - 1e-6, True)]:
         blk = Block.from_dimensions(height, fast.width * f)

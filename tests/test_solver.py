@@ -148,6 +148,24 @@ def test_zeno_under_ground_motion_then_uplift_again_independent_of_threshold():
     assert a.max_rotation == pytest.approx(b.max_rotation, abs=1e-9)
 
 
+def test_uplift_at_the_threshold_takes_no_vanishing_hops():
+    # three samples of a synthetic record where the forcing crosses g tan(alpha) (the middle
+    # sample is 0.999 of it, the last 1.044): the block grazes theta = 0 at the uplift; the engine
+    # once hopped there with ever smaller hops at a standstill in time (999,999 impacts, stopped by
+    # the guard) instead of resting until the forcing passes the threshold (SPEC: "never loop
+    # forever or take vanishing steps")
+    rec = Record(np.array([-0.5472045440000001, -0.775768, -0.825751232]), 0.01, t_start=2.19)
+    block = Block.from_dimensions(7.5, 0.5930384878284735)
+    fast = simulate(block, rec)
+    ref = simulate(block, rec, model="reference")
+    assert fast.n_impacts <= 2 and ref.n_impacts <= 2
+    assert fast.uplifted and not fast.overturned
+    # the same motion as the reference (theta ~ 2e-7 rad at the end; 1e-6 relative is far above
+    # the integrators' error and far below a difference in the hops' treatment)
+    assert fast.max_rotation == pytest.approx(ref.max_rotation, rel=1e-6)
+    np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-12)
+
+
 def test_plastic_impact_block_stops_at_first_impact():
     # alpha = asin(sqrt(2/3)) = 54.7 deg: eta = 0, the first impact ends the motion
     block = Block(2.0, rocking.ALPHA_PLASTIC)
