@@ -83,6 +83,13 @@ def init_worker() -> None:
         pass
 
 
+def _size(task) -> int:
+    try:
+        return os.path.getsize(task.path)
+    except OSError:
+        return 0
+
+
 def _pool(tasks, jobs):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -98,7 +105,10 @@ def _pool(tasks, jobs):
             preload.append("pipeline.plots")  # matplotlib: ~0.2 s a worker otherwise
         ctx.set_forkserver_preload(preload)
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
-        futures = {pool.submit(process_record, t): t for t in tasks}
+        # the largest files first (longer records take longer), so that no long record is left
+        # alone at the end while the other workers idle; results are placed by index, so the
+        # reports do not depend on this order
+        futures = {pool.submit(process_record, t): t for t in sorted(tasks, key=_size, reverse=True)}
         try:
             for fut in as_completed(futures):
                 try:
