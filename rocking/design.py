@@ -767,7 +767,9 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
     3. (if ``n_zone``) a zone above it: ``n_zone`` widths ``w (1 + d)``, ``d`` geometric from
        :data:`REC_ZONE_FIRST` to :data:`REC_ZONE_FRACTION`;
     4. the fine zone: every width of the fixed grid ``top (1 + REC_FINE)^-k`` between ``w`` and
-       ``w (1 + REC_FINE_SPAN)`` not run yet (0.05 % apart, up to 20 % above ``w``);
+       ``w (1 + REC_FINE_SPAN)`` not run yet (0.05 % apart, up to 20 % above ``w``), run from
+       the widest down :data:`REC_CHUNK` at a time and stopped at the first batch with a
+       failure (the widths below it cannot move the answer);
     5. above ``w``, every gap between scanned widths wider than :data:`REC_GAP` (relative) is
        halved, repeatedly, while either end reached ``max|theta|/alpha >= REC_NEAR``;
     6. a failure found in 3-5 moves the candidate up (back to 2; at most :data:`REC_ROUNDS`
