@@ -301,7 +301,6 @@ def settings(kind: str):
 
     out = []
     default_n, default_ph = solver.STEPS_PER_TP, solver.PH_MAX
-    rk4_ph = getattr(solver, "PH_MAX_RK4", None)
 
     def dflt(value, default):
         return " (default)" if value == default else ""
@@ -320,12 +319,12 @@ def settings(kind: str):
     for method, family in FAST_FAMILIES:
         name = _method_label(method)
         ress, phs, ph_steps = plan[method]
-        ph_default = rk4_ph if method == "rk4" else default_ph
+        ph_default = solver._default_ph_max(method)
         for n in ress:
             if kind == "pulse":
                 label = f"{name}, {n} steps/Tp{dflt(n, default_n)}"
             else:
-                label = f"{name}, {n} sub-step/sample" + (" (default)" if n == 1 else "")
+                label = f"{name}, {n} sub-step/sample{dflt(n, 1)}"
             out.append(Setting(label, family, "fast", res=n, method=method))
         for ph in phs:
             at = f" at {ph_steps} steps/Tp{dflt(ph_steps, default_n)}" if kind == "pulse" else ""
@@ -780,7 +779,7 @@ def section_solver(md, out, quick, records, rec_notes):
               "Dormand-Prince, the previous default; `rk4`: classical RK4) against steps per Tp "
               f"(`rocking.solver.STEPS_PER_TP`, default {solver.STEPS_PER_TP}) and `ph_max` (default "
               f"{solver.PH_MAX:g}"
-              + (f", {solver.PH_MAX_RK4:g} for rk4" if hasattr(solver, "PH_MAX_RK4") else "") +
+              + f", {solver.PH_MAX_RK4:g} for rk4" +
               "; the cap on p_eff h, which binds for the longer pulses), the `ph_max` sweeps at the steps per "
               "Tp their label says.\n")
     md += wp_table(pres, pref_t)

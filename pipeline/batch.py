@@ -113,7 +113,7 @@ def _sim(block, record, history):
 def process_record(task: Task) -> dict:
     """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot", "seconds"}``.
 
-    ``seconds`` maps each stage (``"verify:verified_width"``, ...) to the time it took; it is for
+    ``seconds`` maps each stage (``"verify:required_width"``, ...) to the time it took; it is for
     benchmarks and never written to the reports (which must not depend on timing).
     """
     _local.timings = {}
@@ -305,11 +305,8 @@ def _process(task: Task):
             histories.append((col.label, curves))
 
         # -- verified width: smallest width surviving the full record (islands respected) ---------
-        def verified_width():
-            return rocking.required_width(H, record, rule="exact")
-
         if H not in verified_cache:
-            verified_cache[H] = _stage("verify", verified_width)
+            verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact")
         ver = verified_cache[H]
         row.update({"verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / H})
         if col.width is not None:

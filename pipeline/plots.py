@@ -75,10 +75,9 @@ class _TextRenderer(RendererAgg):
                 prop.get_stretch(), prop.get_file(), prop.get_size_in_points(), self.dpi,
                 mpl.rcParams["text.hinting"])
 
-    def _font(self, key, prop):
-        """The FT2Font of ``prop`` at its size (``key``) and the hinting flags."""
-        font = self._prepare_font(prop)
-        return font, key[6], get_hinting_flag()
+    def _font(self, prop):
+        """The FT2Font of ``prop`` at its size and the hinting flags."""
+        return self._prepare_font(prop), get_hinting_flag()
 
     @classmethod
     def _store(cls, cache, key, value):
@@ -100,7 +99,7 @@ class _TextRenderer(RendererAgg):
     def _new_layout(self, key, prop, s):
         if not s.strip():
             return None
-        font, _, flags = self._font(key, prop)
+        font, flags = self._font(prop)
         chars = []
         for c in s:
             info = self._chars.get((key, c))
@@ -146,7 +145,7 @@ class _TextRenderer(RendererAgg):
         """(coverage bitmap, left, top) of a glyph with its pen at (fx, fy) quarter pixels, y up."""
         bitmap = self._glyphs.get((key, gi, angle, fx, fy, aa))
         if bitmap is None:
-            font, _, flags = self._font(key, prop)
+            font, flags = self._font(prop)
             cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
             font._set_transform((0x10000 * np.array([[cos, -sin], [sin, cos]])).round().astype(int),
                                 [16 * fx, 16 * fy])
@@ -217,7 +216,7 @@ class _TextRenderer(RendererAgg):
                     scale = key[6] * self.dpi / 72 / font.get_sfnt_table("head")["unitsPerEm"]
                     found = (t[ascent] * scale, -t[descent] * scale, t[gap] * scale)
                     break
-            self._heights[key] = found
+            self._store(self._heights, key, found)
         return found
 
 

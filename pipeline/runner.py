@@ -99,6 +99,7 @@ def _pool(tasks, jobs):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    plots = any(t.options.plots for t in tasks)
     # Not plain fork: the parent may already run OpenMP threads (numba's parallel solver), and
     # forking such a process is unsafe.  The fork server starts clean, imports the package once
     # and forks the workers from there (cheap, and compilation caches are loaded only once).
@@ -106,9 +107,14 @@ def _pool(tasks, jobs):
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     if ctx.get_start_method() == "forkserver":
         preload = ["pipeline.batch", "pulses", "rocking"]
-        if any(t.options.plots for t in tasks):
+        if plots:
             preload.append("pipeline.plots")  # matplotlib: ~0.2 s a worker otherwise
         ctx.set_forkserver_preload(preload)
+    if plots:
+        # the summary plot needs matplotlib here too: import it while the workers start
+        import threading
+
+        threading.Thread(target=_import_plots, daemon=True).start()
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
         # the largest files first (longer records take longer), so that no long record is left
         # alone at the end while the other workers idle; results are placed by index, so the
@@ -211,11 +217,6 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
 
     results = [None] * len(tasks)
     plots_dir = out / "plots"
-    if options.plots and not dask and (jobs or 1) > 1 and len(tasks) > 1:
-        # the summary plot needs matplotlib here too: import it while the worker processes start
-        import threading
-
-        threading.Thread(target=_import_plots, daemon=True).start()
     try:
         for res in execute(tasks, jobs=jobs, dask=dask):
             results[res["index"]] = res

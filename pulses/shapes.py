@@ -147,7 +147,16 @@ class OneSine(Pulse):
         return (self.t0, self.t0 + self.tp)
 
 
-class SymmetricRicker(Pulse):
+class _Ricker(Pulse):
+    """The Ricker wavelets' common part: a support of :data:`RICKER_HALF_SUPPORT` periods each side."""
+
+    @property
+    def support(self):
+        half = RICKER_HALF_SUPPORT[self.shape] * self.tp
+        return (self.t0 - half, self.t0 + half)
+
+
+class SymmetricRicker(_Ricker):
     """Symmetric Ricker wavelet, Eq. 7: ``ap (1 - 2 pi^2 tau^2) exp(-pi^2 tau^2)``, ``tau = (t-t0)/tp``.
 
     The second derivative of a Gaussian (PyWavelets' ``mexh``); its Fourier amplitude peaks at
@@ -162,16 +171,11 @@ class SymmetricRicker(Pulse):
         return (1.0 - 2.0 * x2) * np.exp(-x2)
 
     @property
-    def support(self):
-        half = RICKER_HALF_SUPPORT[self.shape] * self.tp
-        return (self.t0 - half, self.t0 + half)
-
-    @property
     def breakpoints(self):
         return self.support
 
 
-class AntisymmetricRicker(Pulse):
+class AntisymmetricRicker(_Ricker):
     """Antisymmetric Ricker wavelet, Eq. 8: ``(ap/beta) (x^2 - 3) x exp(-x^2/2)``.
 
     ``x = 2 pi (t - t0) / (sqrt(3) tp)``; ``beta`` (:data:`BETA`) makes the peak equal ``ap``.
@@ -185,11 +189,6 @@ class AntisymmetricRicker(Pulse):
     def _unit(self, tau):
         x = 2.0 * np.pi * tau / np.sqrt(3.0)
         return (x * x - 3.0) * x * np.exp(-0.5 * x * x) / BETA
-
-    @property
-    def support(self):
-        half = RICKER_HALF_SUPPORT[self.shape] * self.tp
-        return (self.t0 - half, self.t0 + half)
 
 
 #: shape name -> class

@@ -685,15 +685,17 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
     if top <= 0:
         return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion)
 
+    def runs(widths):
+        return _batch([Block.from_dimensions(height, float(b), eta) for b in widths], excitation,
+                      None, model=model)
+
     def evaluate(idx, widths):
-        blocks = [Block.from_dimensions(height, float(b), eta) for b in widths]
-        return _failed(_batch(blocks, excitation, None, model=model), criterion)
+        return _failed(runs(widths), criterion)
 
     is_pulse = getattr(excitation, "shape", "record") in ("rect", "sine", "ricker-sym", "ricker-anti")
     if not is_pulse:
         def evaluate_record(widths):
-            blocks = [Block.from_dimensions(height, float(b), eta) for b in widths]
-            res = _batch(blocks, excitation, None, model=model)
+            res = runs(widths)
             return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
 
         return _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
@@ -839,7 +841,7 @@ def _record_width(height, top, evaluate, *, criterion, eta, n_scan, rtol, n_zone
         return lo, hi
 
     def near_gaps(w):
-        """Midpoints of the gaps above ``w`` to halve (step 4)."""
+        """Midpoints of the gaps above ``w`` to halve (step 5)."""
         x, f, r = scanned()
         sel = x >= w
         x, r = x[sel], r[sel]

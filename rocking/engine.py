@@ -64,6 +64,8 @@ METHODS = {"taylor": TAYLOR, "rk8": RK8, "rk4": RK4}
 #: highest order of a Taylor step (steps are kept short enough, ``p h <= PH_MAX``, that the series
 #: reaches rounding level far below it)
 NMAX = 40
+#: floats of the scratch space of :func:`run_core` (stages, forcing and sin/cos series, coefficients)
+WORK_SIZE = 2 * N_STAGES + 5 * (NMAX + 3)
 #: a Taylor series is cut once two consecutive terms of theta and of ``h * omega`` fall below
 #: ``TAYLOR_EPS`` times the size of the step's leading terms
 TAYLOR_EPS = 1e-15
@@ -246,14 +248,14 @@ def forcing_series(kind, amp, tp, t0, uval, j, ta, tb, t, h, U, n_terms):
         y0 = math.pi * (t - t0) / tp
         dy = math.pi * h / tp
         g1, g2 = -2.0 * y0 * dy, -dy * dy
-        e_prev, e = 0.0, math.exp(-y0 * y0)
+        e = math.exp(-y0 * y0)
         p0, p1, p2, p3 = 1.0 - 2.0 * y0 * y0, -4.0 * y0 * dy, -2.0 * dy * dy, 0.0
         scale = amp
     else:
         y0 = TWO_PI * (t - t0) / (tp * SQRT3)
         dy = TWO_PI * h / (tp * SQRT3)
         g1, g2 = -y0 * dy, -0.5 * dy * dy
-        e_prev, e = 0.0, math.exp(-0.5 * y0 * y0)
+        e = math.exp(-0.5 * y0 * y0)
         p0, p1, p2, p3 = y0 * (y0 * y0 - 3.0), 3.0 * (y0 * y0 - 1.0) * dy, 3.0 * y0 * dy * dy, dy ** 3
         scale = amp / BETA
     # E_k = (g1 E_{k-1} + 2 g2 E_{k-2}) / k;  U_k = sum_i P_i E_{k-i}
@@ -725,7 +727,7 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     -------
     status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted
     """
-    work = np.zeros(N_STAGES * 2 + 5 * (NMAX + 3))
+    work = np.zeros(WORK_SIZE)
     out = run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, 0, n_int, n_sub, p, alpha,
                    eta, theta0, omega0, -np.inf, linear, zeno_tol, stop_at_rest, hist_t,
                    hist_theta, hist_omega, impacts, record, method, work)
@@ -738,7 +740,7 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
              hist_omega, impacts, record, method, work):
     """:func:`run` from interval ``j0`` (its start time, state ``theta0``, ``omega0``; at rest
     until ``rest_until0`` if that is later) to the end of interval ``n_end - 1``, with scratch
-    space ``work`` (``2 N_STAGES + 5 (NMAX + 3)`` floats) so that it allocates nothing (the
+    space ``work`` (:data:`WORK_SIZE` floats) so that it allocates nothing (the
     batch engine, :mod:`rocking.lanes`, calls it for single intervals where something happens).
 
     Returns :func:`run`'s values and, last, the time until which the block is at rest after a
@@ -759,8 +761,7 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
     # a lower one would have done); any other step takes the general loop
     fixed = method == TAYLOR and not linear and (kind == NODAL or kind == RECT or kind == FREE)
     # smooth pulses: the same with the forcing's own series (unrolled up to SMOOTH_ORDERS[-1])
-    smooth = method == TAYLOR and not linear and not fixed and kind != FREE
-    unrolled = fixed or smooth
+    unrolled = method == TAYLOR and not linear
     if fixed:
         lowest, highest, order = FIXED_ORDERS[0], FIXED_ORDERS[-1], FIXED_ORDERS[2]
     else:

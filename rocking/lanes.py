@@ -14,8 +14,9 @@ order, overturning) is handed for that one interval and that one lane to the eng
 operations, at the same or a higher order).
 
 For records (forcing linear between samples) on a uniform grid with one Taylor step per sample
-(``p dt`` within :data:`rocking.solver.PH_MAX`); :func:`rocking.engine.run_many` uses it for those
-and the per-run engine for everything else.
+(``p dt`` within :data:`rocking.solver.PH_MAX`); :func:`rocking.simulate_many` uses it for those
+(``rocking.solver._run_batch``) and the per-run engine, :func:`rocking.engine.run_many`, for
+everything else.
 """
 from __future__ import annotations
 
@@ -27,8 +28,8 @@ from numba import njit, prange
 from ._taylor_fixed import taylor_fixed
 from ._taylor_lanes import ORDERS, lanes_step
 from .engine import (HALF_PI, N_STAGES, NMAX, NODAL, OVERTURNED, REST, ROCKING, TAYLOR,
-                     TAYLOR_EPS, _first_crossing, _hermite, _step_peak, corner_sincos,
-                     energy_verdict, run_core)
+                     TAYLOR_EPS, WORK_SIZE, _first_crossing, _hermite, _step_peak,
+                     corner_sincos, energy_verdict, run_core)
 
 #: runs stepped together at most (a chunk; the rocking ones are kept first, so that one loop over
 #: the first ``n_rocking`` lanes steps them all).  Measured per run and step at order 8: 45 ns for
@@ -140,7 +141,7 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
     a, q, theta, omega = F[_A], F[_Q], F[_TH], F[_OM]
     side, s_phi, c_phi, peak = F[_SIDE], F[_SPHI], F[_CPHI], F[_MX]
     bad = np.zeros(n, dtype=np.int64)
-    work = np.zeros(2 * N_STAGES + 5 * (NMAX + 3))
+    work = np.zeros(WORK_SIZE)
     kt = work[:N_STAGES]
     kw = work[N_STAGES:2 * N_STAGES]
     cf = np.zeros(NMAX + 3)

@@ -427,7 +427,7 @@ def _result(block, over, max_abs, impacts, n_imp, t, th, om, model, verdict_by, 
 LANES_MIN_RUNS = 4
 
 
-def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, lanes=True):
+def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper):
     """The engine over a batch: runs under a record with one Taylor step per sample go through the
     batch engine (:mod:`rocking.lanes`, several runs per core at once), the rest run one by one
     (:func:`rocking.engine.run_many`); the same model either way."""
@@ -440,7 +440,7 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, lanes=True):
                          parallel=p[m].size >= engine.PARALLEL_MIN_RUNS)
 
     use = np.zeros(p.size, dtype=bool)
-    if (lanes and g.kind == engine.NODAL and g.nodes.size == 0 and not linear
+    if (g.kind == engine.NODAL and g.nodes.size == 0 and not linear
             and stepper == engine.TAYLOR and p.size >= LANES_MIN_RUNS):
         use = n_sub == 1
     if not use.any():
