@@ -41,24 +41,19 @@ def _chain_sum(k: int, other: str) -> str:
     return " + ".join(f"D_{i} * {other}_{k - i}" for i in terms)
 
 
-def _function(n: int, smooth: bool = False) -> str:
-    if smooth:  # forcing series U_0 .. U_{n-2} from an array
-        lines = [f"\n\n@njit(cache=True)\ndef taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf):"]
-        lines += [f"    U_{i} = U[{i}]" for i in range(n - 1)]
-    else:  # forcing u0 + u1 x
-        lines = [f"\n\n@njit(cache=True)\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf):"]
+def _smooth_function(n: int) -> str:
+    """The step of order ``n`` for forcing given by its series ``U[0 .. n - 2]`` (smooth pulses)."""
+    lines = [f"\n\n@njit(cache=True)\ndef taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf):"]
+    lines += [f"    U_{i} = U[{i}]" for i in range(n - 1)]
     lines += ["    S_0 = s0",
               "    C_0 = c0",
               "    D_1 = wh",
-              f"    c_2 = -0.5 * q * (S_0 + {'U_0' if smooth else 'u0'} * C_0)",
+              "    c_2 = -0.5 * q * (S_0 + U_0 * C_0)",
               "    D_2 = 2.0 * c_2"]
     for k in range(1, n - 1):
         sk = _chain_sum(k, "C")
         ck = _chain_sum(k, "S")
-        if smooth:
-            uc = " + ".join(f"U_{i} * C_{k - i}" for i in range(k, -1, -1))
-        else:
-            uc = f"u0 * C_{k} + u1 * C_{k - 1}"
+        uc = " + ".join(f"U_{i} * C_{k - i}" for i in range(k, -1, -1))
         lines += [f"    S_{k} = -({sk}) * {1.0 / k!r}",
                   f"    C_{k} = ({ck}) * {1.0 / k!r}",
                   f"    c_{k + 2} = -q * (S_{k} + {uc}) * {1.0 / ((k + 1) * (k + 2))!r}",
@@ -239,7 +234,7 @@ def source() -> str:
     return (HEADER + f"\nORDERS = {ORDERS!r}\nSMOOTH_ORDERS = {SMOOTH_ORDERS!r}\nHALF_PI = {math.pi / 2!r}\n"
             + "".join(_fixed_function(n) for n in ORDERS)
             + "".join(RUN_TEMPLATE.format(n=n) for n in ORDERS)
-            + "".join(_function(n, smooth=True) for n in SMOOTH_ORDERS)
+            + "".join(_smooth_function(n) for n in SMOOTH_ORDERS)
             + "\n".join(dispatch) + "\n")
 
 
