@@ -7,8 +7,8 @@ The verified width (``rocking.required_width(..., rule="exact")`` on a record) r
 per column), and that is most of what ``pipeline run`` costs.  A cheaper search would run a
 coarser grid (every ``k``-th width) and fill in only the gaps next to a width that came near to
 tipping (``max|theta|/alpha >= R``).  This script runs the whole fine zone at once on real records
-(../shared/records, heights 3, 6, 7.5 and 12 m) and on the benchmark's synthetic ones, and for
-every zone with a failure reports, per stride ``k``, the larger ``max|theta|/alpha`` of the two
+(../shared/records/raw or $ROCKING_RECORDS, heights 3, 6, 7.5 and 12 m) and on the benchmark's
+synthetic ones, and for every zone with a failure reports, per stride ``k``, the larger ``max|theta|/alpha`` of the two
 coarse widths around its widest failing width: a refinement rule with ``R`` above that value
 misses the failure (and answers narrower, unconservatively).  It also reports what share of the
 zone such a rule would still run.
@@ -23,7 +23,6 @@ import time
 
 import numpy as np
 
-SHARED = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "records" / "raw"
 STRIDES = (4, 8, 16)
 NEAR = (0.3, 0.5, 0.7)
 
@@ -115,14 +114,15 @@ def cases():
 
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
     from bench_pipeline import make_records
+    from run import RECORDS_DIR
 
     out = []
-    if SHARED.is_dir():
-        for path in sorted(SHARED.rglob("*.AT2")):
+    if RECORDS_DIR.is_dir():
+        for path in sorted(RECORDS_DIR.rglob("*.AT2")):
             rec = pulses.read_record(path)
             out += [(path.stem, rec, h) for h in (3.0, 6.0, 7.5, 12.0)]
     else:
-        print(f"({SHARED} not found: synthetic records only)")
+        print(f"({RECORDS_DIR} not found: synthetic records only)")
     with tempfile.TemporaryDirectory() as tmp:
         for path in make_records(tmp, 20, durations=[20.0, 25.0, 30.0, 35.0, 40.0]):
             rec = pulses.read_record(path)

@@ -336,11 +336,11 @@ class _Legend:
         self.frame = FancyBboxPatch((0, 0), 1, 1, boxstyle="round,pad=0,rounding_size=0.2",
                                     facecolor=mpl.rcParams["axes.facecolor"],
                                     edgecolor=mpl.rcParams["legend.edgecolor"], alpha=0.8, snap=True,
-                                    transform=IdentityTransform(), clip_on=False, zorder=5)
+                                    transform=IdentityTransform(), zorder=5)
         self.handles = []
         for line in lines:
-            h = Line2D([], [], transform=IdentityTransform(), clip_on=False, zorder=5.01)
-            h.update_from(line)
+            h = Line2D([], [], zorder=5.01)
+            h.update_from(line)  # copies transform, clipping and visibility too: set below
             h.set_transform(IdentityTransform())
             h.set_visible(True)
             self.handles.append(h)
@@ -408,7 +408,7 @@ class _RecordFigure:
         ax = axes[0]
         self.record_line, = ax.plot([], [], color="0.55", lw=0.6)
         self.pulse_lines = [ax.plot([], [], color=f"C{i}", lw=1.6 if i == 0 else 1.1,
-                                    ls=_PULSE_STYLES[i % 4])[0] for i in range(MAX_PULSES)]
+                                    ls=_PULSE_STYLES[i])[0] for i in range(MAX_PULSES)]
         ax.set_ylabel("ground acc. (g)")
         self.hist_lines = []
         for ax in axes[1:]:

@@ -170,10 +170,6 @@ class SymmetricRicker(_Ricker):
         x2 = (np.pi * tau) ** 2
         return (1.0 - 2.0 * x2) * np.exp(-x2)
 
-    @property
-    def breakpoints(self):
-        return self.support
-
 
 class AntisymmetricRicker(_Ricker):
     """Antisymmetric Ricker wavelet, Eq. 8: ``(ap/beta) (x^2 - 3) x exp(-x^2/2)``.

@@ -195,8 +195,8 @@ def _scan_refine(evaluate, x, known=None, rtol=RTOL, zone=True, refine="all", n_
     then cut in :data:`KSECTION` parts per step, all together, until narrower than ``rtol``
     relative; where a step reveals more than one change inside a bracket the highest is followed
     (so the top fail-to-survive transition is always the highest one found).  ``refine="top"``
-    refines only each problem's top fail-to-survive bracket (records, whose verdicts can change
-    hundreds of times); the other changes are then reported at scan resolution.  ``ksection=2``
+    refines only each problem's top fail-to-survive bracket (``pipeline run``, which needs only
+    the answer); the other changes are then reported at scan resolution.  ``ksection=2``
     (bisection) needs about half the runs of the default in twice as many batch calls: cheaper
     when only a few problems are refined at once.
     """

@@ -164,6 +164,10 @@ def _pulse_grid(pulse: Pulse, h_max: float, t_end: float | None = None) -> np.nd
 
 
 def _n_sub(h: float, p_eff: np.ndarray | float, ph_max: float) -> np.ndarray | int:
+    """Sub-steps per interval of length ``h`` so that ``p_eff h / n_sub <= ph_max`` (a float
+    ``p_eff`` takes scalar arithmetic, without numpy's overhead: the same numbers)."""
+    if isinstance(p_eff, float):
+        return max(1, math.ceil(h * p_eff / ph_max - 1e-9))
     return np.maximum(1, np.ceil(h * np.asarray(p_eff) / ph_max - 1e-9)).astype(np.int64)
 
 
@@ -314,9 +318,7 @@ def _never_uplifts(block, excitation, duration, history):
 def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_tol,
               stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX):
     h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
-    # _n_sub's arithmetic on a scalar, without numpy's overhead
-    n_sub = max(1, math.ceil(h * (block.p * math.sqrt(1.0 + grid.u_peak))
-                             / (0.05 if linear else ph_max) - 1e-9))
+    n_sub = _n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else ph_max)
     if linear and grid.kind in (engine.NODAL, engine.RECT, engine.FREE):
         n_sub = 1  # exact for forcing linear on each interval
     size = grid.n_int + 1 if history else 0
