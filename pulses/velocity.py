@@ -188,7 +188,8 @@ def _cwt_at(x: np.ndarray, scale: float, start: int, stop: int) -> np.ndarray:
     if lo < 0 or hi > x.size:
         seg = np.concatenate([np.zeros(max(-lo, 0)), seg, np.zeros(max(hi - x.size, 0))])
     if stop - start == 1:
-        return np.array([-math.sqrt(scale) * float(np.dot(seg[::-1], g))])
+        # einsum, not a BLAS dot: a multithreaded BLAS dot on long vectors stalls on a busy machine
+        return np.array([-math.sqrt(scale) * float(np.einsum("i,i->", seg[::-1], g))])
     if (stop - start) * g.size < 100_000:  # direct: cheaper than FFTs for few outputs
         return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
     # circular convolution of size >= len(seg) is exact on the 'valid' part
@@ -236,13 +237,13 @@ def dwt_energy(v) -> float:
     """Energy measure of ``analyze_record.m``: the sum of squares of MATLAB's one-output
     ``dwt(v, 'db4')`` (level-1 approximation coefficients, symmetric half-point extension)."""
     approx = pywt.dwt(np.asarray(v, dtype=float), WAVELET, mode="symmetric")[0]
-    return float(np.dot(approx, approx))
+    return float(np.einsum("i,i->", approx, approx))
 
 
 def integral_energy(v) -> float:
     """The simpler energy measure: sum of ``v^2`` (proportional to the integral of v^2 dt)."""
     v = np.asarray(v, dtype=float)
-    return float(np.dot(v, v))
+    return float(np.einsum("i,i->", v, v))
 
 
 def pulse_indicator(pgv_ratio: float, energy_ratio: float, pgv_cm_s: float) -> float:

@@ -251,3 +251,40 @@ def test_pair_files_from_names_and_headers():
 def test_pair_files_ambiguous_group_stays_single():
     found = pair_files(["RSN5_A000.AT2", "RSN5_A090.AT2", "RSN5_B000.AT2"])
     assert found.pairs == [] and len(found.singles) == 3 and found.notes
+
+
+# -- command line ----------------------------------------------------------------------------
+
+def test_pipeline_classify_command(tmp_path, capsys):
+    from pipeline.cli import main
+    from pipeline.cmd_classify import COLUMNS, RUN_COLUMNS, classify_fields
+
+    one = shared_record("shahi_baker_examples/example1.AT2")
+    two = shared_record("shahi_baker_examples/example2.AT2")
+    csv_path, plots = tmp_path / "rows.csv", tmp_path / "plots"
+    missing = tmp_path / "missing.AT2"
+    code = main(["classify", str(one), str(two), str(missing), "--csv", str(csv_path), "--plot", str(plots)])
+    assert code == 1  # the missing file is reported, the pair still classified
+    assert "missing.AT2" in capsys.readouterr().err
+    with open(csv_path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 1 and list(rows[0]) == COLUMNS
+    assert rows[0]["file2"].endswith("example2.AT2")  # paired from the headers' station and event
+    assert rows[0]["pulse_like"] == "True" and float(rows[0]["velocity_tp_s"]) == pytest.approx(4.79, rel=0.005)
+    png = sorted(plots.glob("*.png"))
+    assert len(png) == 1
+    first_bytes = png[0].read_bytes()
+    assert main(["classify", "--pair", str(one), str(two), "--pairs", "none", "--plot", str(plots)]) == 0
+    assert png[0].read_bytes() == first_bytes  # deterministic file
+    fields = classify_fields(pulses.read_record(one), pulses.read_record(two))
+    assert list(fields) == RUN_COLUMNS and fields["pulse_like"] is True
+
+
+def test_pipeline_classify_refuses_an_explicit_bad_pair(capsys):
+    from pipeline.cli import main
+
+    a = shared_record("RSN6_IMPVALL.I_I-ELC180.AT2")
+    b = shared_record("haselREC_NGA-West2-Reduced/RSN6_2.AT2")
+    assert main(["classify", "--pair", str(a), str(b)]) == 1
+    err = capsys.readouterr().err
+    assert "RSN6_IMPVALL.I_I-ELC180.AT2" in err and "RSN6_2.AT2" in err and "26 samples" in err
