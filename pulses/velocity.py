@@ -431,6 +431,26 @@ def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
     return out
 
 
+def _transform_piece(piece: np.ndarray, at: int, scale: float, start: int, stop: int) -> np.ndarray:
+    """Transform over samples ``start..stop-1`` of a signal that is ``piece`` from sample ``at``
+    on and zero elsewhere (``_cwt_at`` without building the whole signal)."""
+    g = difference_filter(scale)
+    lo = start + _offset(scale) - (g.size - 1)  # first sample the outputs see
+    length = stop - start + g.size - 1
+    a, b = max(at, lo), min(at + piece.size, lo + length)
+    if b <= a:
+        return np.zeros(stop - start)
+    if (stop - start) * g.size < 100_000:
+        seg = np.zeros(length)
+        seg[a - lo:b - lo] = piece[a - at:b - at]
+        return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
+    size = sfft.next_fast_len(length, real=True)
+    seg = np.zeros(size)
+    seg[a - lo:b - lo] = piece[a - at:b - at]
+    y = sfft.irfft(sfft.rfft(seg) * _window_spectrum(scale, size), size)
+    return y[g.size - 1:g.size - 1 + stop - start]
+
+
 def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarray, energy) -> dict:
     """``analyze_record.m`` for one candidate; ``signal`` in cm/s.
 
@@ -472,10 +492,8 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
             break
         if a == start and b == start + shape.size:  # wholly inside: the shifted kernel
             window -= amp * kernel[lo - at + span:hi - at + span]
-        else:
-            cut = np.zeros(n)
-            cut[a:b] = amp * shape[a - start:b - start]
-            window -= _cwt_at(cut, scale, lo, hi)
+        else:  # cut by the record's ends: the transform of the samples kept
+            window -= _transform_piece(amp * shape[a - start:b - start], a, scale, lo, hi)
     resid = signal - pulse
     e_signal = np.cumsum(signal * signal)
     e_pulse = np.cumsum(pulse * pulse)
