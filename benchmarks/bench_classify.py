@@ -12,6 +12,8 @@ CPU time is the fairer number).
 from __future__ import annotations
 
 import argparse
+import math
+import os
 import statistics
 import time
 
@@ -37,6 +39,22 @@ def make_pair(seed: int = 2007) -> tuple[Record, Record]:
     return comps[0], comps[1]
 
 
+def calibration() -> float:
+    """The workload ``benchmarks/run.py`` calibrates with: a 20,000-step Python loop (s, best of 5)."""
+    def loop():
+        s = 0.0
+        for i in range(20000):
+            s += math.sin(i)
+        return s
+
+    best = math.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        loop()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=21, help="timed calls after the first (default 21)")
@@ -51,6 +69,8 @@ def main(argv=None) -> None:
         classify_pulse(first, second)
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
+    print(f"load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}; calibration "
+          f"(20,000-step Python loop, as benchmarks/run.py): {1e3 * calibration():.2f} ms")
     print(f"pair of {DURATION:g} s records at {1 / DT:g} Hz ({first.npts} samples each): "
           f"pulse-like {result.is_pulse}, Tp {result.tp:.2f} s, orientation {result.orientation:.1f} deg")
     print(f"first call: {1e3 * cold_wall:.1f} ms wall, {1e3 * cold_cpu:.1f} ms CPU")

@@ -127,7 +127,7 @@ def db4_cwt_direct(x, scales) -> np.ndarray:
     return out
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=16)
 def _filter_spectra(scales: tuple, size: int) -> np.ndarray:
     spectra = np.empty((len(scales), size // 2 + 1), dtype=complex)
     for i, a in enumerate(scales):
@@ -463,21 +463,20 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
     z = np.abs(_cwt_point(signal, refined, col))
     scale = int(refined[int(np.argmax(z))])
     half = math.ceil(scale * WINDOW)
+    # every window searched lies within 2 half of the candidate's time: one transform covers all
+    reach_lo, reach_hi = max(0, col - 2 * half), min(n, col + 2 * half + 1)
+    around = _cwt_at(signal, scale, reach_lo, reach_hi)
     lo, hi = max(0, col - half), min(n, col + half + 1)
-    c = _cwt_at(signal, scale, lo, hi)
-    k = int(np.argmax(np.abs(c)))
-    at0, coef = lo + k, c[k]
+    k = int(np.argmax(np.abs(around[lo - reach_lo:hi - reach_lo])))
+    at0 = lo + k
+    coef = around[at0 - reach_lo]
     # later wavelets are sought within `half` samples of the first one
     lo, hi = max(0, at0 - half), min(n, at0 + half + 1)
-    window = _cwt_at(signal, scale, lo, hi)
-    # the unit wavelet's samples (centred on sample `centre` of `shape`) and its transform at
-    # lags -2 half .. 2 half from its centre
+    window = around[lo - reach_lo:hi - reach_lo].copy()
     first, shape = _unit_wavelet(scale)
     centre = -first
     span = 2 * half
-    pad = np.zeros(shape.size + 2 * span)
-    pad[span:span + shape.size] = shape
-    kernel = _cwt_at(pad, scale, span + centre - span, span + centre + span + 1)  # index: lag + span
+    kernel = None  # transform of the unit wavelet at lags -span..span, when first needed
     pulse = np.zeros(n)
     at = at0
     for i in range(N_WAVELETS):
@@ -491,6 +490,8 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
         if i == N_WAVELETS - 1:
             break
         if a == start and b == start + shape.size:  # wholly inside: the shifted kernel
+            if kernel is None:
+                kernel = _transform_piece(shape, span, scale, centre, centre + 2 * span + 1)
             window -= amp * kernel[lo - at + span:hi - at + span]
         else:  # cut by the record's ends: the transform of the samples kept
             window -= _transform_piece(amp * shape[a - start:b - start], a, scale, lo, hi)
