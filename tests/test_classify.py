@@ -286,6 +286,8 @@ def test_pair_files_from_names_and_headers():
 def test_pair_files_ambiguous_group_stays_single():
     found = pair_files(["RSN5_A000.AT2", "RSN5_A090.AT2", "RSN5_B000.AT2"])
     assert found.pairs == [] and len(found.singles) == 3 and found.notes
+    # trailing numbers that are not orthogonal azimuths are not a pair
+    assert pair_files(["run001.AT2", "run002.AT2"]).pairs == []
 
 
 # -- command line ----------------------------------------------------------------------------
