@@ -185,8 +185,8 @@ class Pairing:
 
 
 def _is_vertical(path, meta) -> bool:
-    if meta and meta.get("vertical"):
-        return True
+    if meta and meta.get("vertical") is not None:  # the reader's reading of the header comes first
+        return bool(meta["vertical"])
     stem = os.path.splitext(os.path.basename(str(path)))[0]
     if _RSN.match(stem) and re.fullmatch(r"RSN\d+_3", stem, re.IGNORECASE):
         return True

@@ -286,6 +286,10 @@ def test_pair_files_from_names_and_headers():
 def test_pair_files_ambiguous_group_stays_single():
     found = pair_files(["RSN5_A000.AT2", "RSN5_A090.AT2", "RSN5_B000.AT2"])
     assert found.pairs == [] and len(found.singles) == 3 and found.notes
+    # the header's word comes before the name's: a stated horizontal named _3, a stated vertical
+    found = pair_files(["s_1.AT2", "s_3.AT2", "t_1.AT2", "t_2.AT2"],
+                       metadata={"s_3.AT2": {"vertical": False}, "t_2.AT2": {"vertical": True}})
+    assert found.pairs == [("s_1.AT2", "s_3.AT2")] and found.verticals == ["t_2.AT2"]
     # trailing numbers that are not orthogonal azimuths are not a pair
     assert pair_files(["run001.AT2", "run002.AT2"]).pairs == []
 
