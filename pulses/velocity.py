@@ -82,16 +82,22 @@ def _integrated_wavelet():
     return int_psi, float(x[1] - x[0]), float(x[-1] - x[0])
 
 
-@lru_cache(maxsize=4096)
-def difference_filter(scale: float) -> np.ndarray:
-    """Filter ``g`` with ``conv(x, g) = diff`` of the convolution with the integrated wavelet
-    resampled at ``scale`` (MATLAB legacy ``cwt``: ``f = fliplr(intpsi(j))``); read-only."""
+def resampled_integral(scale: float) -> np.ndarray:
+    """The integrated wavelet resampled at ``scale`` and reversed, as MATLAB's legacy ``cwt``:
+    ``j = 1 + floor((0:a*xmax) / (a*step))``, ``f = fliplr(intpsi(j))``."""
     int_psi, step, xmax = _integrated_wavelet()
     j = (np.arange(int(math.floor(scale * xmax)) + 1) / (scale * step)).astype(int)
     j = j[j < int_psi.size]
     if j.size == 1:
         j = np.array([j[0], j[0]])
-    f = int_psi[j][::-1]
+    return int_psi[j][::-1]
+
+
+@lru_cache(maxsize=4096)
+def difference_filter(scale: float) -> np.ndarray:
+    """Filter ``g`` with ``conv(x, g) = diff(conv(x, f))``, ``f`` the :func:`resampled_integral`
+    (``g = [f0, f1 - f0, ..., -f_last]``); read-only."""
+    f = resampled_integral(scale)
     g = np.empty(f.size + 1)
     g[0] = f[0]
     g[1:-1] = np.diff(f)
@@ -116,12 +122,7 @@ def db4_cwt_direct(x, scales) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     out = np.empty((len(scales), x.size))
     for i, a in enumerate(scales):
-        int_psi, step, xmax = _integrated_wavelet()
-        j = (np.arange(int(math.floor(a * xmax)) + 1) / (a * step)).astype(int)
-        j = j[j < int_psi.size]
-        if j.size == 1:
-            j = np.array([j[0], j[0]])
-        y = np.diff(np.convolve(x, int_psi[j][::-1]))
+        y = np.diff(np.convolve(x, resampled_integral(a)))
         start = (y.size - x.size) // 2
         out[i] = -math.sqrt(a) * y[start:start + x.size]
     return out
