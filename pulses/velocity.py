@@ -555,8 +555,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
         raise RecordError(f"{record.name}: time step {dt:g} s is too long for pulses of "
                           f"{TP_MIN:g} s (at most {TP_MIN * FC:g} s)")
     if v2 is None:
-        c1 = db4_cwt(v1, scales)
-        c2 = np.zeros_like(c1)
+        c1, c2 = db4_cwt(v1, scales), None
         power = c1 * c1
     else:
         c1, c2 = db4_cwt(np.stack([v1, v2]), scales)
@@ -564,7 +563,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     candidates = []
     for _ in range(N_CANDIDATES):
         row, col = np.unravel_index(int(np.argmax(power)), power.shape)
-        a, b = c1[row, col], c2[row, col]
+        a, b = c1[row, col], (c2[row, col] if c2 is not None else 0.0)
         theta = math.atan(b / a) if a != 0.0 else (math.pi / 2 if b != 0.0 else 0.0)
         signal = v1 * math.cos(theta) + v2 * math.sin(theta) if v2 is not None else v1
         d = _analyze(signal, dt, int(col), int(row), scales, energy)
@@ -575,8 +574,8 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
             time=record.t_start + int(col) * dt, velocity=d["velocity"], pulse=d["pulse"]))
         reach = WINDOW * scales[row]  # clear samples strictly within `reach` of the maximum
         power[:, max(0, math.floor(col - reach) + 1):max(0, math.ceil(col + reach))] = 0.0
-    pulses = [i for i, c in enumerate(candidates) if c.is_pulse]
-    chosen = pulses[0] if pulses else int(np.argmax([c.indicator for c in candidates]))
+    pulse_like = [i for i, c in enumerate(candidates) if c.is_pulse]
+    chosen = pulse_like[0] if pulse_like else int(np.argmax([c.indicator for c in candidates]))
     c = candidates[chosen]
     if other is not None:
         azimuth = rotated_azimuth(record, other, c.orientation)
@@ -584,7 +583,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
         azimuth = _azimuth(record)
     name = record.name if other is None else f"{record.name}+{other.name}"
     return PulseClassification(
-        name=name, is_pulse=bool(pulses), indicator=c.indicator, tp=c.tp, pgv=c.pgv,
+        name=name, is_pulse=bool(pulse_like), indicator=c.indicator, tp=c.tp, pgv=c.pgv,
         pgv_ratio=c.pgv_ratio, energy_ratio=c.energy_ratio, late=c.late, arrival=c.arrival,
         orientation=c.orientation, azimuth=None if azimuth is None else azimuth % 180.0,
         candidates=tuple(candidates), chosen=chosen, t_start=record.t_start, dt=dt)
