@@ -59,7 +59,8 @@ def add_parser(subparsers) -> None:
                     "(Shahi & Baker 2014): pulse indicator, Tp, PGV and orientation of the "
                     "strongest velocity pulse. Exit status 0 when every file was classified, 1 "
                     "when some could not be read or paired, 2 for bad arguments.")
-    p.add_argument("files", nargs="*", metavar="FILE", help="record files (AT2, SAC, MiniSEED, K-NET, text ...)")
+    p.add_argument("files", nargs="*", metavar="FILE",
+                   help="record files (AT2, SAC, MiniSEED, K-NET, text ...) or folders of them")
     p.add_argument("--pair", nargs=2, action="append", default=[], metavar=("A", "B"),
                    help="classify A and B as the two horizontal components of one station "
                         "(orientation measured from A towards B); repeatable")
@@ -82,11 +83,14 @@ def _message(path, exc) -> str:
 def main(args) -> int:
     import pulses
 
+    from .runner import expand_inputs
+
     if not args.files and not args.pair:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
     opts = record_options(args)
+    files = expand_inputs(args.files)
     records, failures = {}, 0
-    for path in list(args.files) + [p for pair in args.pair for p in pair]:
+    for path in files + [p for pair in args.pair for p in pair]:
         if path in records:
             continue
         try:
@@ -100,7 +104,7 @@ def main(args) -> int:
     for a, b in args.pair:
         jobs.append((a, b, True))
         paired.update((a, b))
-    rest = [p for p in dict.fromkeys(args.files) if p not in paired and records.get(p) is not None]
+    rest = [p for p in files if p not in paired and records.get(p) is not None]
     if args.pairs == "auto":
         found = pulses.pair_files(rest, metadata={p: records[p].metadata for p in rest})
         for note in found.notes:
