@@ -14,11 +14,12 @@ from .shapes import (
     Rectangular,
     SymmetricRicker,
     make_pulse,
+    shape_class,
 )
 
 __all__ = [
     "G", "Record", "BETA", "SHAPES", "Pulse", "Rectangular", "OneSine", "SymmetricRicker",
-    "AntisymmetricRicker", "make_pulse",
+    "AntisymmetricRicker", "make_pulse", "shape_class",
     "RecordError", "read_record", "write_sac", "fit_pulse", "PulseFit", "Candidate",
     "design_pulse", "pulse_period", "VP_TO_AP",
 ]
