@@ -58,6 +58,11 @@ TP_LEASH = 1.5
 FIT_MARGIN = 1.0
 
 
+class FitError(ValueError):
+    """Input the pulse fit cannot use: a record with nothing to fit, or a period range that is
+    not one.  The message is one line that says what is wrong."""
+
+
 # -- sampled unit pulses ---------------------------------------------------------------------
 def unit_samples(shape: str, tp: float, t0: float, t, dt: float) -> np.ndarray:
     """Unit-amplitude pulse at sample times ``t`` (s): point samples, cell averages for ``rect``."""
@@ -221,7 +226,7 @@ def default_tp_range(record: Record) -> tuple[float, float]:
     tp_min = max(0.2, 10.0 * record.dt)
     tp_max = min(10.0, 0.25 * record.duration)
     if tp_max <= tp_min:
-        raise ValueError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
+        raise FitError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
                          f"at least {tp_min:g} s")
     return tp_min, tp_max
 
@@ -250,9 +255,9 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     for s in shapes:
         shape_class(s)  # an unknown name fails here, before any work
     if not shapes:
-        raise ValueError("no pulse shape to fit")
-    tp_min, tp_max = tp_range if tp_range is not None else default_tp_range(record)
-    x = record.acc
+        raise FitError("no pulse shape to fit")
+    tp_min, tp_max = default_tp_range(record) if tp_range is None else _checked_tp_range(tp_range, record)
+    x, amplitude = _normalised(record)
     dt = record.dt
     t = np.arange(x.size) * dt  # time from the first sample; record.t_start is added at the end
     matcher = Matcher(x, dt, tp_min, tp_max)
@@ -276,14 +281,48 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         corr = _dot(xw, pw) / denom if denom > 0 else 0.0
         t0_abs = t0 + record.t_start
         window = None if idx is None else (record.t_start + idx.start * dt, record.t_start + (idx.stop - 1) * dt)
+        ap *= amplitude
         candidates.append(Candidate(shape, ap, tp, t0_abs, score, corr, make_pulse(shape, ap, tp, t0_abs),
                                     fit_window=window))
     order = sorted(range(len(candidates)), key=lambda i: -candidates[i].score)
     ranked = [candidates[i] for i in order]
     for k, c in enumerate(ranked, start=1):
         c.rank = k
-    return PulseFit(record.name, ranked, record.pga, _pgv(x, dt), record.duration,
-                    significant_duration(x, dt))
+    return PulseFit(record.name, ranked, record.pga, _pgv(record.acc, dt), record.duration,
+                    significant_duration(record.acc, dt))
+
+
+def _checked_tp_range(tp_range, record: Record) -> tuple[float, float]:
+    """``(tp_min, tp_max)`` as floats; FitError unless ``2 dt < tp_min <= tp_max <= duration``."""
+    try:
+        tp_min, tp_max = (float(v) for v in tp_range)
+    except (TypeError, ValueError):
+        raise FitError(f"tp_range must be two periods in s, got {tp_range!r}") from None
+    if not (math.isfinite(tp_min) and math.isfinite(tp_max) and 0.0 < tp_min <= tp_max):
+        raise FitError(f"tp_range must be two finite periods with 0 < shortest <= longest, got {tp_range!r} s")
+    if tp_min <= 2.0 * record.dt:
+        raise FitError(f"tp_range: the shortest period {tp_min:g} s must span more than two samples "
+                       f"(2 dt = {2.0 * record.dt:g} s)")
+    if tp_max > record.duration:
+        raise FitError(f"tp_range: the longest period {tp_max:g} s exceeds the duration of record "
+                       f"{record.name!r} ({record.duration:g} s)")
+    return tp_min, tp_max
+
+
+def _normalised(record: Record) -> tuple[np.ndarray, float]:
+    """The samples divided by a power of two near their peak, and that power (m/s^2).
+
+    A power of two scales every floating-point operation exactly, so the fit of the normalised
+    samples is the fit of the record, without overflow in its sums of squares of sums of squares.
+    """
+    peak = float(np.max(np.abs(record.acc)))
+    if peak == 0.0:
+        raise FitError(f"record {record.name!r} is zero everywhere: there is no pulse to fit")
+    if not math.isfinite(float(np.dot(record.acc / peak, record.acc / peak)) * peak * peak):
+        raise FitError(f"record {record.name!r}: samples up to {peak:.3g} m/s^2 are too large for their "
+                       "energy (sum of squares) to be a number; check the units")
+    amplitude = math.ldexp(1.0, math.frexp(peak)[1])
+    return record.acc / amplitude, amplitude
 
 
 def _coarse(matcher: Matcher, shape: str, tps, t_end: float):

@@ -377,3 +377,30 @@ def test_a_new_shape_is_one_class(monkeypatch):
     assert c.shape == "gauss-test" and isinstance(c.pulse, _Gaussian)
     assert (c.ap, c.tp, c.t0) == pytest.approx((-3.0, 1.3, 8.2), rel=1e-4)
     assert c.arrival == pytest.approx(8.2 - 0.65)
+
+
+# -- bad input ----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("tp_range,words", [((0, 0), "0 < shortest <= longest"), ((-1, 5), "0 < shortest"),
+                                            ((5, 1), "shortest <= longest"), ((float("nan"), 2), "finite"),
+                                            ((0.005, 2), "more than two samples"), ((0.5, 1e9), "exceeds"),
+                                            (3.0, "two periods")])
+def test_bad_tp_range_is_a_one_line_value_error(tp_range, words):
+    rec = synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, DT)
+    with pytest.raises(pulses.FitError, match=words) as err:
+        fit_pulse(rec, tp_range=tp_range)
+    assert isinstance(err.value, ValueError) and "\n" not in str(err.value)
+
+
+def test_records_with_nothing_to_fit_or_too_large_are_refused():
+    rec = synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, DT, noise=0.15, seed=1)
+    for bad, words in ((Record(np.zeros(4001), DT), "zero everywhere"), (rec.scaled(1e300), "too large")):
+        with pytest.raises(pulses.FitError, match=words) as err:
+            fit_pulse(bad)
+        assert isinstance(err.value, ValueError) and "\n" not in str(err.value)
+    # the fit is linear in the record: scaled by 2^500 or 2^-900 (exact in binary floating point,
+    # far beyond where sums of squares would overflow or underflow) it is the same fit, scaled
+    base = fit_pulse(rec).best
+    for k in (500, -900):
+        c = fit_pulse(rec.scaled(2.0**k)).best
+        assert (c.shape, c.tp, c.t0, c.score) == (base.shape, base.tp, base.t0, base.score)
+        assert c.ap == base.ap * 2.0**k
