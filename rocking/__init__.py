@@ -15,3 +15,6 @@ __all__ += [
 from .solver import BatchResult, RockingResult, linear_error_estimate, simulate, simulate_many
 
 __all__ += ["BatchResult", "RockingResult", "linear_error_estimate", "simulate", "simulate_many"]
+from .frame import equivalent_size, eta_frame, frame_p
+
+__all__ += ["equivalent_size", "eta_frame", "frame_p"]
