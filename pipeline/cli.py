@@ -12,7 +12,7 @@ import sys
 from .args import ArgumentError
 
 #: sub-command modules, in the order ``pipeline --help`` lists them
-COMMANDS = ["simulate", "fit", "convert", "design", "spectrum", "chart", "run", "demo"]
+COMMANDS = ["simulate", "fit", "convert", "design", "spectrum", "chart", "run", "demo", "classify"]
 
 
 class _Parser(argparse.ArgumentParser):

@@ -23,3 +23,9 @@ __all__ = [
     "RecordError", "read_record", "write_sac", "fit_pulse", "FitError", "PulseFit", "Candidate",
     "design_pulse", "pulse_period", "VP_TO_AP",
 ]
+
+from .velocity import PulseCandidate, PulseClassification, classify_pulse
+from .pairs import Pairing, check_pair, component, pair_files, read_pair, rotate_pair
+
+__all__ += ["classify_pulse", "PulseClassification", "PulseCandidate", "read_pair", "check_pair",
+            "component", "rotate_pair", "pair_files", "Pairing"]

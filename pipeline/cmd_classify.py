@@ -1,0 +1,166 @@
+"""``pipeline classify FILES...``: is each record (or pair of components) pulse-like?
+
+Shahi & Baker's (2014) velocity-pulse classification (:func:`pulses.classify_pulse`): one row per
+pair of horizontal components or per single component, with the pulse indicator, the pulse
+period Tp, the peak velocity and the orientation of the strongest pulse.  Files are paired from
+what they say (``--pairs auto``, the default: NGA-West2 names, ``_1``/``_2``, the header's
+station and event; verticals are left out) or as named with ``--pair A B``.
+
+:func:`classify_fields` gives the columns ``pipeline run`` adds to its reports, from the same
+place as this command's rows.
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+from .args import ArgumentError
+
+#: columns of one row, in order (units in the names)
+COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
+           "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio"]
+#: the subset ``pipeline run`` reports
+RUN_COLUMNS = ["pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "orientation_deg", "azimuth_deg"]
+
+try:  # shared record-reading options (consolidated in args.py where that has them)
+    from .args import add_record_arguments, record_options
+except ImportError:
+    from .cmd_fit import add_record_arguments, record_options
+
+
+def result_row(result, file="", file2="") -> dict:
+    """One report row of a :class:`pulses.PulseClassification` (see :data:`COLUMNS`)."""
+    return {"file": str(file), "file2": str(file2) if file2 else "", "pulse_like": bool(result.is_pulse),
+            "velocity_pulse_indicator": float(result.indicator), "velocity_tp_s": float(result.tp),
+            "pgv_m_s": float(result.pgv), "orientation_deg": float(result.orientation),
+            "azimuth_deg": None if result.azimuth is None else float(result.azimuth),
+            "arrival_s": float(result.arrival), "late": bool(result.late),
+            "pgv_ratio": float(result.pgv_ratio), "energy_ratio": float(result.energy_ratio)}
+
+
+def classify_fields(record, other=None) -> dict:
+    """The velocity-pulse columns of ``pipeline run`` for one record or pair.
+
+    Returns ``pulse_like`` (bool), ``velocity_pulse_indicator`` (Shahi & Baker's PI),
+    ``velocity_tp_s`` (s), ``orientation_deg`` (from the first component towards the second; 0
+    for one component) and ``azimuth_deg`` (clockwise from north, 0..180, or None).  Raises
+    :class:`pulses.RecordError` for a pair that cannot be used.
+    """
+    from pulses import classify_pulse
+
+    row = result_row(classify_pulse(record, other))
+    return {k: row[k] for k in RUN_COLUMNS}
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser(
+        "classify", help="is the record pulse-like? velocity pulses (Shahi & Baker 2014)",
+        description="Classify records, or pairs of horizontal components, as pulse-like or not "
+                    "(Shahi & Baker 2014): pulse indicator, Tp, PGV and orientation of the "
+                    "strongest velocity pulse. Exit status 0 when every file was classified, 1 "
+                    "when some could not be read or paired, 2 for bad arguments.")
+    p.add_argument("files", nargs="*", metavar="FILE", help="record files (AT2, SAC, MiniSEED, K-NET, text ...)")
+    p.add_argument("--pair", nargs=2, action="append", default=[], metavar=("A", "B"),
+                   help="classify A and B as the two horizontal components of one station "
+                        "(orientation measured from A towards B); repeatable")
+    p.add_argument("--pairs", choices=["auto", "none"], default="auto",
+                   help="auto (default): pair the other files from their names and headers and "
+                        "leave verticals out; none: classify every file as one component")
+    add_record_arguments(p)
+    p.add_argument("--csv", metavar="FILE", help="write one row per pair or component to this CSV file")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON instead of a table")
+    p.add_argument("--plot", metavar="DIR", help="draw each classification into DIR/<name>.png")
+    p.set_defaults(func=main)
+
+
+def _message(path, exc) -> str:
+    text = str(exc).strip().splitlines()
+    text = text[0] if text else type(exc).__name__
+    return text if text.startswith(str(path)) else f"{path}: {text}"
+
+
+def main(args) -> int:
+    import pulses
+
+    if not args.files and not args.pair:
+        raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
+    opts = record_options(args)
+    records, failures = {}, 0
+    for path in list(args.files) + [p for pair in args.pair for p in pair]:
+        if path in records:
+            continue
+        try:
+            records[path] = pulses.read_record(path, **opts)
+        except (pulses.RecordError, ValueError, OSError) as exc:
+            print(f"pipeline classify: {_message(path, exc)}", file=sys.stderr)
+            records[path] = None
+            failures += 1
+    jobs = []  # (first, second or None, named with --pair), in order
+    paired = set()
+    for a, b in args.pair:
+        jobs.append((a, b, True))
+        paired.update((a, b))
+    rest = [p for p in dict.fromkeys(args.files) if p not in paired and records.get(p) is not None]
+    if args.pairs == "auto":
+        found = pulses.pair_files(rest, metadata={p: records[p].metadata for p in rest})
+        for note in found.notes:
+            print(f"pipeline classify: note: {note}", file=sys.stderr)
+        for v in found.verticals:
+            print(f"pipeline classify: note: {v}: vertical component, left out", file=sys.stderr)
+        order = {p: i for i, p in enumerate(rest)}
+        found_jobs = [(order[a], a, b) for a, b in found.pairs] + [(order[s], s, None) for s in found.singles]
+        jobs += [(a, b, False) for _, a, b in sorted(found_jobs, key=lambda u: u[0])]
+    else:
+        jobs += [(p, None, False) for p in rest]
+
+    rows, results = [], []
+    for a, b, explicit in jobs:
+        first, second = records.get(a), records.get(b) if b is not None else None
+        if first is None or (b is not None and second is None):
+            continue  # already reported as unreadable
+        units = [(a, b)]
+        if second is not None:
+            try:
+                pulses.check_pair(first, second)
+            except pulses.RecordError as exc:
+                print(f"pipeline classify: {exc}", file=sys.stderr)
+                if explicit:
+                    failures += 1
+                    continue
+                print(f"pipeline classify: note: classifying {a} and {b} one by one", file=sys.stderr)
+                units = [(a, None), (b, None)]
+        for x, y in units:
+            try:
+                result = pulses.classify_pulse(records[x], records[y] if y is not None else None)
+            except (pulses.RecordError, ValueError) as exc:
+                print(f"pipeline classify: {_message(x, exc)}", file=sys.stderr)
+                failures += 1
+                continue
+            rows.append(result_row(result, x, y or ""))
+            results.append((result, x, y))
+            if args.plot:
+                from .plot_classify import plot_classification
+
+                plot_classification(result, args.plot, records[x], records[y] if y is not None else None)
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    elif rows:
+        print(format_rows(rows))
+    if args.csv and rows:
+        import pandas as pd
+
+        pd.DataFrame(rows, columns=COLUMNS).to_csv(args.csv, index=False, float_format="%.6g")
+    return 1 if failures else 0
+
+
+def format_rows(rows) -> str:
+    """A plain-text table of the rows."""
+    lines = ["pulse  PI      Tp (s)  PGV (m/s)  orient.  azimuth  arrival (s)  late  PGVr   Er     file(s)"]
+    for r in rows:
+        az = "   -   " if r["azimuth_deg"] is None else f"{r['azimuth_deg']:6.1f} "
+        files = r["file"] + (f" + {r['file2']}" if r["file2"] else "")
+        lines.append(f"{'yes' if r['pulse_like'] else 'no ':<5}  {r['velocity_pulse_indicator']:+6.2f}  "
+                     f"{r['velocity_tp_s']:6.2f}  {r['pgv_m_s']:9.3f}  {r['orientation_deg']:+7.1f}  {az}  "
+                     f"{r['arrival_s']:11.2f}  {'yes' if r['late'] else 'no ':<4}  {r['pgv_ratio']:5.3f}  "
+                     f"{r['energy_ratio']:5.3f}  {files}")
+    return "\n".join(lines)
