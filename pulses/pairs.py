@@ -185,8 +185,8 @@ class Pairing:
 
 
 def _is_vertical(path, meta) -> bool:
-    if meta and meta.get("vertical"):
-        return True
+    if meta and meta.get("vertical") is not None:  # the reader's reading of the header comes first
+        return bool(meta["vertical"])
     stem = os.path.splitext(os.path.basename(str(path)))[0]
     if _RSN.match(stem) and re.fullmatch(r"RSN\d+_3", stem, re.IGNORECASE):
         return True
@@ -213,11 +213,20 @@ def _group_key(path, meta):
         return ("name", folder, m.group(1).lower())
     m = _AZIMUTH_CODE.match(stem)
     if m:
-        return ("name", folder, m.group(1).lower())
+        return ("azimuth", folder, m.group(1).lower())
     station, event = (meta or {}).get("station"), (meta or {}).get("event")
     if station and event:
         return ("header", folder, str(station).strip().casefold(), str(event).strip().casefold())
     return None
+
+
+def _codes_orthogonal(path1, path2) -> bool:
+    """Whether the trailing three-digit codes of two names read as orthogonal azimuths."""
+    codes = [int(_AZIMUTH_CODE.match(os.path.splitext(os.path.basename(str(p)))[0]).group(2))
+             for p in (path1, path2)]
+    if max(codes) > 360:
+        return False
+    return abs((codes[1] - codes[0]) % 180 - 90) <= ORTHOGONAL_TOLERANCE_DEG
 
 
 def _order_key(path, meta):
@@ -259,7 +268,9 @@ def pair_files(paths, metadata=None) -> Pairing:
             groups.setdefault(key, []).append(path)
     for key, members in groups.items():
         members = list(dict.fromkeys(members))
-        if len(members) == 2:
+        if len(members) == 2 and key[0] == "azimuth" and not _codes_orthogonal(*members):
+            result.singles.extend(members)  # e.g. run numbers 001 and 002, not azimuths
+        elif len(members) == 2:
             meta = [metadata.get(p) or metadata.get(str(p)) for p in members]
             order = sorted(range(2), key=lambda i: _order_key(members[i], meta[i]))
             result.pairs.append((members[order[0]], members[order[1]]))

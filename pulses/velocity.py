@@ -82,16 +82,22 @@ def _integrated_wavelet():
     return int_psi, float(x[1] - x[0]), float(x[-1] - x[0])
 
 
-@lru_cache(maxsize=4096)
-def difference_filter(scale: float) -> np.ndarray:
-    """Filter ``g`` with ``conv(x, g) = diff`` of the convolution with the integrated wavelet
-    resampled at ``scale`` (MATLAB legacy ``cwt``: ``f = fliplr(intpsi(j))``); read-only."""
+def resampled_integral(scale: float) -> np.ndarray:
+    """The integrated wavelet resampled at ``scale`` and reversed, as MATLAB's legacy ``cwt``:
+    ``j = 1 + floor((0:a*xmax) / (a*step))``, ``f = fliplr(intpsi(j))``."""
     int_psi, step, xmax = _integrated_wavelet()
     j = (np.arange(int(math.floor(scale * xmax)) + 1) / (scale * step)).astype(int)
     j = j[j < int_psi.size]
     if j.size == 1:
         j = np.array([j[0], j[0]])
-    f = int_psi[j][::-1]
+    return int_psi[j][::-1]
+
+
+@lru_cache(maxsize=4096)
+def difference_filter(scale: float) -> np.ndarray:
+    """Filter ``g`` with ``conv(x, g) = diff(conv(x, f))``, ``f`` the :func:`resampled_integral`
+    (``g = [f0, f1 - f0, ..., -f_last]``); read-only."""
+    f = resampled_integral(scale)
     g = np.empty(f.size + 1)
     g[0] = f[0]
     g[1:-1] = np.diff(f)
@@ -116,18 +122,13 @@ def db4_cwt_direct(x, scales) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     out = np.empty((len(scales), x.size))
     for i, a in enumerate(scales):
-        int_psi, step, xmax = _integrated_wavelet()
-        j = (np.arange(int(math.floor(a * xmax)) + 1) / (a * step)).astype(int)
-        j = j[j < int_psi.size]
-        if j.size == 1:
-            j = np.array([j[0], j[0]])
-        y = np.diff(np.convolve(x, int_psi[j][::-1]))
+        y = np.diff(np.convolve(x, resampled_integral(a)))
         start = (y.size - x.size) // 2
         out[i] = -math.sqrt(a) * y[start:start + x.size]
     return out
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=16)
 def _filter_spectra(scales: tuple, size: int) -> np.ndarray:
     spectra = np.empty((len(scales), size // 2 + 1), dtype=complex)
     for i, a in enumerate(scales):
@@ -158,17 +159,26 @@ def db4_cwt(x, scales) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     n = x.shape[-1]
     scales = tuple(float(a) for a in scales)
-    # circular convolution of size M equals the linear one on the kept samples when
-    # M >= n + len(g) - 1 - offset and M >= offset + n (offset <= len(g) / 2)
-    size = max(sfft.next_fast_len(max(n + difference_filter(a).size - 1 - _offset(a), _offset(a) + n),
-                                  real=True) for a in scales)
-    spectrum = sfft.rfft(x, size, axis=-1)
-    spectra = _filter_spectra(scales, size)
     out = np.empty(x.shape[:-1] + (len(scales), n))
-    for i, a in enumerate(scales):
-        k = _offset(a)
-        out[..., i, :] = sfft.irfft(spectrum * spectra[i], size, axis=-1)[..., k:k + n]
+    for size, members in _size_groups(scales, n):
+        spectrum = sfft.rfft(x, size, axis=-1)
+        spectra = _filter_spectra(tuple(scales[i] for i in members), size)
+        for j, i in enumerate(members):
+            k = _offset(scales[i])
+            out[..., i, :] = sfft.irfft(spectrum * spectra[j], size, axis=-1)[..., k:k + n]
     return out
+
+
+@lru_cache(maxsize=8)
+def _size_groups(scales: tuple, n: int, groups: int = 4) -> tuple:
+    """FFT sizes for the scales: circular convolution of size M equals the linear one on the
+    kept samples when ``M >= n + len(g) - 1 - offset`` and ``M >= offset + n``; scales are put
+    in up to ``groups`` runs sharing one size (one forward FFT of the signal per run)."""
+    need = [sfft.next_fast_len(max(n + difference_filter(a).size - 1 - _offset(a), _offset(a) + n), real=True)
+            for a in scales]
+    order = sorted(range(len(scales)), key=lambda i: need[i])
+    runs = [order[i * len(order) // groups:(i + 1) * len(order) // groups] for i in range(groups)]
+    return tuple((max(need[i] for i in run), tuple(run)) for run in runs if run)
 
 
 @lru_cache(maxsize=64)
@@ -219,18 +229,18 @@ def _pulse_wavelet():
     return psi, x
 
 
-def _wavelet_on_samples(n: int, scale: float, at: int) -> tuple[int, np.ndarray]:
-    """The db4 wavelet at ``scale``, centred on sample ``at``, linearly interpolated from the
-    ``wavefun(db4, 4)`` grid onto samples (zero outside its support) as ``analyze_record.m``:
-    returns (first sample, values)."""
+@lru_cache(maxsize=64)
+def _unit_wavelet(scale: float) -> tuple[int, np.ndarray]:
+    """The db4 wavelet at ``scale`` on samples, centred on sample 0, linearly interpolated from
+    the ``wavefun('db4', 4)`` grid (zero outside its support) as ``analyze_record.m`` draws it:
+    (first sample, relative to the centre; values), read-only."""
     psi, x = _pulse_wavelet()
     centre = 0.5 * (x[0] + x[-1])
-    first = max(int(math.ceil(at + (x[0] - centre) * scale)), 0)
-    last = min(int(math.floor(at + (x[-1] - centre) * scale)), n - 1)
-    if last < first:
-        return 0, np.zeros(0)
-    k = np.arange(first, last + 1)
-    return first, np.interp((k - at) / scale + centre, x, psi)
+    first = int(math.ceil((x[0] - centre) * scale))
+    k = np.arange(first, int(math.floor((x[-1] - centre) * scale)) + 1)
+    values = np.interp(k / scale + centre, x, psi)
+    values.flags.writeable = False
+    return first, values
 
 
 def dwt_energy(v) -> float:
@@ -397,26 +407,96 @@ class PulseClassification:
 
 # -- the classification ----------------------------------------------------------------------
 
+@lru_cache(maxsize=4096)
+def _reversed_filter(scale: float) -> np.ndarray:
+    g = difference_filter(scale)[::-1].copy()
+    g.flags.writeable = False
+    return g
+
+
+def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
+    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each)."""
+    out = np.empty(len(scales))
+    n = x.size
+    for i, a in enumerate(scales):
+        gr = _reversed_filter(a)
+        hi = at + _offset(a) + 1  # x indices at + off - (G - 1) .. at + off
+        lo = hi - gr.size
+        if lo >= 0 and hi <= n:
+            seg = x[lo:hi]
+        else:
+            seg = np.zeros(gr.size)
+            seg[max(-lo, 0):gr.size - max(hi - n, 0)] = x[max(lo, 0):min(hi, n)]
+        # einsum, not a BLAS dot: a multithreaded BLAS dot on long vectors stalls on a busy machine
+        out[i] = -math.sqrt(a) * float(np.einsum("i,i->", seg, gr))
+    return out
+
+
+def _transform_piece(piece: np.ndarray, at: int, scale: float, start: int, stop: int) -> np.ndarray:
+    """Transform over samples ``start..stop-1`` of a signal that is ``piece`` from sample ``at``
+    on and zero elsewhere (``_cwt_at`` without building the whole signal)."""
+    g = difference_filter(scale)
+    lo = start + _offset(scale) - (g.size - 1)  # first sample the outputs see
+    length = stop - start + g.size - 1
+    a, b = max(at, lo), min(at + piece.size, lo + length)
+    if b <= a:
+        return np.zeros(stop - start)
+    if (stop - start) * g.size < 100_000:
+        seg = np.zeros(length)
+        seg[a - lo:b - lo] = piece[a - at:b - at]
+        return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
+    size = sfft.next_fast_len(length, real=True)
+    seg = np.zeros(size)
+    seg[a - lo:b - lo] = piece[a - at:b - at]
+    y = sfft.irfft(sfft.rfft(seg) * _window_spectrum(scale, size), size)
+    return y[g.size - 1:g.size - 1 + stop - start]
+
+
 def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarray, energy) -> dict:
-    """``analyze_record.m`` for one candidate; ``signal`` in cm/s."""
+    """``analyze_record.m`` for one candidate; ``signal`` in cm/s.
+
+    The transform of the running residual over the search window is that of the record minus
+    those of the wavelets taken so far (the transform is linear); a wavelet wholly inside the
+    record is the same samples shifted, so its transform is one kernel shifted, computed once.
+    Wavelets cut by the record's ends are transformed as they are."""
     n = signal.size
     refined = np.arange(scales[max(0, row - 1)], scales[min(scales.size - 1, row + 1)] + 1)
-    z = np.array([abs(_cwt_at(signal, a, col, col + 1)[0]) for a in refined])
+    z = np.abs(_cwt_point(signal, refined, col))
     scale = int(refined[int(np.argmax(z))])
     half = math.ceil(scale * WINDOW)
+    # every window searched lies within 2 half of the candidate's time: one transform covers all
+    reach_lo, reach_hi = max(0, col - 2 * half), min(n, col + 2 * half + 1)
+    around = _cwt_at(signal, scale, reach_lo, reach_hi)
     lo, hi = max(0, col - half), min(n, col + half + 1)
+    k = int(np.argmax(np.abs(around[lo - reach_lo:hi - reach_lo])))
+    at0 = lo + k
+    coef = around[at0 - reach_lo]
+    # later wavelets are sought within `half` samples of the first one
+    lo, hi = max(0, at0 - half), min(n, at0 + half + 1)
+    window = around[lo - reach_lo:hi - reach_lo].copy()
+    first, shape = _unit_wavelet(scale)
+    centre = -first
+    span = 2 * half
+    kernel = None  # transform of the unit wavelet at lags -span..span, when first needed
     pulse = np.zeros(n)
-    resid = signal.copy()
-    centre_window = (lo, hi)
+    at = at0
     for i in range(N_WAVELETS):
-        c = _cwt_at(resid, scale, *centre_window)
-        k = int(np.argmax(np.abs(c)))
-        at = centre_window[0] + k
-        if i == 0:  # later wavelets are sought around the first one
-            centre_window = (max(0, at - half), min(n, at + half + 1))
-        first, w = _wavelet_on_samples(n, scale, at)
-        pulse[first:first + w.size] += w * (c[k] / math.sqrt(scale))
-        resid = signal - pulse
+        if i:
+            k = int(np.argmax(np.abs(window)))
+            at, coef = lo + k, window[k]
+        amp = coef / math.sqrt(scale)
+        start = at - centre
+        a, b = max(start, 0), min(start + shape.size, n)
+        pulse[a:b] += amp * shape[a - start:b - start]
+        if i == N_WAVELETS - 1:
+            break
+        if a == start and b == start + shape.size:  # wholly inside: the shifted kernel
+            if kernel is None:
+                kernel = _transform_piece(shape, span, scale, centre, centre + 2 * span + 1)
+            window -= amp * kernel[lo - at + span:hi - at + span]
+        else:  # cut by the record's ends: the transform of the samples kept
+            window -= _transform_piece(amp * shape[a - start:b - start], a, scale, lo, hi)
+    resid = signal - pulse
     e_signal = np.cumsum(signal * signal)
     e_pulse = np.cumsum(pulse * pulse)
     reached = np.flatnonzero(e_pulse <= LATE_PULSE_PERCENT / 100.0 * e_pulse[-1])
@@ -475,18 +555,15 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
         raise RecordError(f"{record.name}: time step {dt:g} s is too long for pulses of "
                           f"{TP_MIN:g} s (at most {TP_MIN * FC:g} s)")
     if v2 is None:
-        c1 = db4_cwt(v1, scales)
-        c2 = np.zeros_like(c1)
+        c1, c2 = db4_cwt(v1, scales), None
         power = c1 * c1
     else:
         c1, c2 = db4_cwt(np.stack([v1, v2]), scales)
         power = c1 * c1 + c2 * c2
-    n = v1.size
-    positions = np.arange(n)
     candidates = []
     for _ in range(N_CANDIDATES):
         row, col = np.unravel_index(int(np.argmax(power)), power.shape)
-        a, b = c1[row, col], c2[row, col]
+        a, b = c1[row, col], (c2[row, col] if c2 is not None else 0.0)
         theta = math.atan(b / a) if a != 0.0 else (math.pi / 2 if b != 0.0 else 0.0)
         signal = v1 * math.cos(theta) + v2 * math.sin(theta) if v2 is not None else v1
         d = _analyze(signal, dt, int(col), int(row), scales, energy)
@@ -495,10 +572,10 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
             pgv=d["pgv"], pgv_ratio=d["pgv_ratio"], energy_ratio=d["energy_ratio"], late=d["late"],
             arrival=record.t_start + d["arrival_index"] * dt, orientation=math.degrees(theta),
             time=record.t_start + int(col) * dt, velocity=d["velocity"], pulse=d["pulse"]))
-        reach = WINDOW * scales[row]
-        power[:, (positions > col - reach) & (positions < col + reach)] = 0.0
-    pulses = [i for i, c in enumerate(candidates) if c.is_pulse]
-    chosen = pulses[0] if pulses else int(np.argmax([c.indicator for c in candidates]))
+        reach = WINDOW * scales[row]  # clear samples strictly within `reach` of the maximum
+        power[:, max(0, math.floor(col - reach) + 1):max(0, math.ceil(col + reach))] = 0.0
+    pulse_like = [i for i, c in enumerate(candidates) if c.is_pulse]
+    chosen = pulse_like[0] if pulse_like else int(np.argmax([c.indicator for c in candidates]))
     c = candidates[chosen]
     if other is not None:
         azimuth = rotated_azimuth(record, other, c.orientation)
@@ -506,7 +583,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
         azimuth = _azimuth(record)
     name = record.name if other is None else f"{record.name}+{other.name}"
     return PulseClassification(
-        name=name, is_pulse=bool(pulses), indicator=c.indicator, tp=c.tp, pgv=c.pgv,
+        name=name, is_pulse=bool(pulse_like), indicator=c.indicator, tp=c.tp, pgv=c.pgv,
         pgv_ratio=c.pgv_ratio, energy_ratio=c.energy_ratio, late=c.late, arrival=c.arrival,
         orientation=c.orientation, azimuth=None if azimuth is None else azimuth % 180.0,
         candidates=tuple(candidates), chosen=chosen, t_start=record.t_start, dt=dt)

@@ -101,6 +101,41 @@ def test_coarse_scales_match_the_reference_rule():
 
 # -- exactness -------------------------------------------------------------------------------
 
+def _naive_pulse(signal, col, row, scales):
+    """analyze_record.m's pulse, literally: the whole residual transformed at every step."""
+    n = signal.size
+    refined = np.arange(scales[max(0, row - 1)], scales[min(scales.size - 1, row + 1)] + 1)
+    scale = int(refined[np.argmax(np.abs(db4_cwt(signal, refined)[:, col]))])
+    psi, x = _pulse_wavelet()
+    half = math.ceil(scale * 0.4)
+    pulse, centre = np.zeros(n), col
+    for i in range(10):
+        c = db4_cwt(signal - pulse, [scale])[0]
+        lo, hi = max(0, centre - half), min(n, centre + half + 1)
+        at = lo + int(np.argmax(np.abs(c[lo:hi])))
+        if i == 0:
+            centre = at
+        u = (np.arange(n) - at) / scale + 3.5
+        pulse += np.interp(u, x, psi, left=0.0, right=0.0) * c[at] / math.sqrt(scale)
+    return scale, pulse
+
+
+def test_pulse_extraction_equals_the_literal_algorithm():
+    # _analyze transforms only the search window and reuses one shifted kernel for wavelets
+    # inside the record; the literal loop transforms the whole residual each time.  Candidates
+    # at a short scale (wavelets inside) and at the longest (cut by the record's ends).
+    from pulses.velocity import _analyze, dwt_energy
+
+    record = _read("shahi_baker_examples/example2.AT2")
+    v = np.cumsum(record.acc) * record.dt * 100
+    scales = coarse_scales(record.dt)
+    for col, row in [(1260, 15), (3000, 3), (400, 50), (7700, 40)]:
+        scale, pulse = _naive_pulse(v, col, row, scales)
+        d = _analyze(v, record.dt, col, row, scales, dwt_energy)
+        assert d["scale"] == scale
+        np.testing.assert_allclose(d["pulse"] * 100, pulse, rtol=0, atol=1e-9 * np.max(np.abs(v)))
+
+
 def _wavelet_velocity(n, dt, scale, at, amplitude):
     """db4 wavelet (its wavefun grid, linear between points) of ``scale`` samples centred on
     sample ``at``, peak ``amplitude``."""
@@ -251,6 +286,12 @@ def test_pair_files_from_names_and_headers():
 def test_pair_files_ambiguous_group_stays_single():
     found = pair_files(["RSN5_A000.AT2", "RSN5_A090.AT2", "RSN5_B000.AT2"])
     assert found.pairs == [] and len(found.singles) == 3 and found.notes
+    # the header's word comes before the name's: a stated horizontal named _3, a stated vertical
+    found = pair_files(["s_1.AT2", "s_3.AT2", "t_1.AT2", "t_2.AT2"],
+                       metadata={"s_3.AT2": {"vertical": False}, "t_2.AT2": {"vertical": True}})
+    assert found.pairs == [("s_1.AT2", "s_3.AT2")] and found.verticals == ["t_2.AT2"]
+    # trailing numbers that are not orthogonal azimuths are not a pair
+    assert pair_files(["run001.AT2", "run002.AT2"]).pairs == []
 
 
 # -- command line ----------------------------------------------------------------------------
