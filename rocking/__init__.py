@@ -18,3 +18,6 @@ __all__ += ["BatchResult", "RockingResult", "linear_error_estimate", "simulate",
 from .frame import equivalent_size, eta_frame, frame_p
 
 __all__ += ["equivalent_size", "eta_frame", "frame_p"]
+from .fragility import CriticalScale, Fragility, critical_scale, fragility
+
+__all__ += ["CriticalScale", "Fragility", "critical_scale", "fragility"]
