@@ -1,23 +1,70 @@
-"""Parsing of command-line quantities: blocks, accelerations, angles, units.
+"""Command-line options shared by several sub-commands, and parsing of command-line quantities
+(blocks, accelerations, angles, units).
 
 Every parser raises :class:`ArgumentError` with a one-line message; the command line turns it
-into exit status 2.
+into exit status 2.  Units of acceleration are those of :mod:`pulses.units` (one place).
 """
 from __future__ import annotations
 
 import math
 import re
 
-from pulses import G
-
 
 class ArgumentError(ValueError):
     """A command-line value that cannot be used (reported in one line, exit status 2)."""
 
 
-#: accepted acceleration units and their factor to m/s^2
-ACCELERATION_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01,
-                      "gal": 0.01, "mm/s2": 0.001, "nm/s2": 1e-9}
+# -- options for reading records (fit, convert, run, classify, simulate) -----------------------------
+def add_record_options(parser) -> None:
+    """Add the options that tell :func:`pulses.read_record` what a file does not say:
+    ``--units``, ``--dt``, ``--column``, ``--format``, ``--trace``.  Read them back with
+    :func:`record_options`."""
+    from pulses.units import CANONICAL_UNITS
+
+    units = ", ".join("cm/s2 (gal)" if u == "cm/s2" else u for u in CANONICAL_UNITS)
+    parser.add_argument("--units", help="units of the samples where a file states none (text, "
+                                        f"MiniSEED), or to override SAC's iacc = nm/s^2: {units}; "
+                                        "not applied to AT2 and K-NET files, which state theirs")
+    parser.add_argument("--dt", help="sampling interval in s, for text files without a time column")
+    parser.add_argument("--column", help="text files: the column holding the acceleration, counted from 1")
+    parser.add_argument("--format", help="file format when detection from the content is not wanted "
+                                         "(at2, text, sac, mseed, knet, or any obspy format)")
+    parser.add_argument("--trace", help="files holding several traces (MiniSEED ...): index (from 0), "
+                                        "id or channel")
+
+
+def record_options(args) -> dict:
+    """Keyword arguments of :func:`pulses.read_record` from the options of
+    :func:`add_record_options` (checked: :class:`ArgumentError` for a bad value)."""
+    return {"format": args.format, "units": parse_units(args.units),
+            "dt": None if args.dt is None else parse_positive(args.dt, "--dt (s)"),
+            "column": parse_column(args.column), "trace": args.trace}
+
+
+def parse_units(text, what: str = "--units"):
+    """Canonical spelling of acceleration units (``"gal"`` -> ``"cm/s2"``), None when not given."""
+    if text is None:
+        return None
+    from pulses import RecordError
+    from pulses.units import canonical_units
+
+    try:
+        return canonical_units(text)
+    except RecordError as exc:
+        raise ArgumentError(f"{what}: {exc}") from None
+
+
+def parse_column(text):
+    """``--column``: a column number counted from 1, None when not given."""
+    if text is None:
+        return None
+    try:
+        column = int(str(text))
+    except ValueError:
+        column = 0
+    if column < 1:
+        raise ArgumentError(f"--column counts from 1, got {text!r}")
+    return column
 
 
 def _finite_positive(value: float, what: str) -> float:
@@ -55,13 +102,16 @@ def parse_acceleration(text: str, default_unit: str | None = None, signed: bool 
     m = re.fullmatch(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)(.*)", s)
     if not m:
         raise ArgumentError(f"cannot read acceleration {text!r}; write e.g. 0.71g or 6.96m/s2")
+    from pulses import RecordError
+    from pulses.units import unit_factor
+
     value, unit = float(m.group(1)), m.group(2).lower() or default_unit
     if unit is None:
         raise ArgumentError(f"acceleration {text!r} has no unit; write e.g. {text}g or {text}m/s2")
-    if unit not in ACCELERATION_UNITS:
-        raise ArgumentError(f"unknown acceleration unit {unit!r} in {text!r}; use one of "
-                            f"g, m/s2, cm/s2, gal")
-    value *= ACCELERATION_UNITS[unit]
+    try:
+        value *= unit_factor(unit)
+    except RecordError as exc:
+        raise ArgumentError(f"acceleration {text!r}: {exc}") from None
     if not math.isfinite(value) or (not signed and value <= 0.0) or value == 0.0:
         raise ArgumentError(f"acceleration must be a non-zero finite value, got {text!r}")
     return value

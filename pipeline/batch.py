@@ -9,14 +9,16 @@ blocks at once), ``rocking.required_width``); nothing here is a second implement
 """
 from __future__ import annotations
 
+import hashlib
 import math
+import os
 import pathlib
 import re
 import threading
 import time
 from dataclasses import dataclass, field
 
-from .report import FIT_TOLERANCE, SHAPE_NAMES, _shape_key
+from .report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 
 RESERVED_IDS = {"summary", "failures", "columns"}
 
@@ -44,6 +46,7 @@ class Options:
     dt: float | None = None
     column: int | None = None
     format: str | None = None
+    trace: str | None = None
     plots: bool = True
 
 
@@ -64,13 +67,27 @@ class StageError(Exception):
 
 
 # -- record ids ------------------------------------------------------------------------------------
+#: longest record id (characters, all ASCII): ``<id>.csv`` and its temporary name stay far below the
+#: 255 bytes file systems allow, whatever the input's name
+MAX_ID_LENGTH = 96
+
+
 def record_ids(paths) -> list[str]:
-    """Unique, file-system-safe ids from the file names, in input order."""
+    """Unique, file-system-safe ids from the file names, in input order.
+
+    Characters other than ASCII letters, digits and ``._+-`` become ``_`` (a name's bytes need not
+    be UTF-8); an id never starts with ``.``, ``+`` or ``-``; a name longer than
+    :data:`MAX_ID_LENGTH` is cut and ends in a short hash of the whole name.
+    """
     ids, seen = [], {}
     for path in paths:
         name = pathlib.PurePath(str(path)).name
         stem = name.rsplit(".", 1)[0] if "." in name.lstrip(".") else name
-        stem = re.sub(r"[^A-Za-z0-9._+-]+", "_", stem).strip("._") or "record"
+        stem = re.sub(r"[^A-Za-z0-9._+-]+", "_", stem)
+        stem = re.sub(r"^[._+-]+|[._]+$", "", stem) or "record"
+        if len(stem) > MAX_ID_LENGTH:
+            digest = hashlib.sha1(os.fsencode(name)).hexdigest()[:8]
+            stem = stem[:MAX_ID_LENGTH - 9].rstrip("._") + "-" + digest
         if stem.lower() in RESERVED_IDS:
             stem += "-record"
         base, k = stem, 1
@@ -88,7 +105,7 @@ def _read(task: Task):
 
     opts = task.options
     return pulses.read_record(task.path, format=opts.format, units=opts.units, dt=opts.dt,
-                              column=opts.column)
+                              column=opts.column, trace=opts.trace)
 
 
 def _g(x):
@@ -149,11 +166,26 @@ def _process_record(task: Task) -> dict:
     return out
 
 
+FAILURE_COLUMNS = Columns(
+    ("record", "-", "Record id (as in the per-record reports)."),
+    ("file", "-", "The record's path as given."),
+    ("stage", "-", "Where it failed: `read` (reading the file), `fit` (pulse fitting), `design` "
+                   "(design rules), `verify` (full-record time histories), `plot`, `write` (the record "
+                   "was processed and its rows are in `summary.csv`, but its own report or figure "
+                   "could not be written, or a file that `pipeline run` did not write is in the way "
+                   "and was left as it is), `worker` (the process running it died) or `internal` "
+                   "(an unforeseen error: please report it)."),
+    ("error", "-", "Type of the error."),
+    ("reason", "-", "The error message, in one line."),
+)
+FAILURE_FIELDS = list(FAILURE_COLUMNS.names)
+
+
 def failure(task: Task, stage: str, exc: BaseException) -> dict:
     """A row of ``failures.csv``."""
     reason = " ".join(str(exc).split()) or repr(exc)
-    return {"record": task.record_id, "file": task.path, "stage": stage,
-            "error": type(exc).__name__, "reason": reason}
+    return FAILURE_COLUMNS.row({"record": task.record_id, "file": task.path, "stage": stage,
+                                "error": type(exc).__name__, "reason": reason})
 
 
 def _interrupted(exc: BaseException) -> bool:
@@ -188,24 +220,54 @@ def _stage(stage, fn, *args, **kwargs):
             timings[key] = timings.get(key, 0.0) + time.perf_counter() - t0
 
 
-def _process(task: Task):
-    import rocking
+# -- report columns, each group declared next to the code that computes it -------------------------
+# A row of ``<record>.csv`` / ``summary.csv`` is these groups in this order; ``Columns.row`` refuses
+# a group whose keys differ from its declaration (an undeclared key, or a declared one not set).
+RECORD_COLUMNS = Columns(
+    ("record", "-", "Record id: the file name without its extension, made file-system safe (other "
+                    "characters become `_`; a name longer than 96 characters is cut and ends in a "
+                    "short hash of the whole name) and unique in input order (`-2`, `-3`, ...). The "
+                    "per-record report is `<record>.csv`."),
+    ("file", "-", "The record's path as given on the command line (bytes that are not UTF-8 written "
+                  "as `\\xff`)."),
+    ("station", "-", "Station code from the file header (blank when the format has none)."),
+    ("component", "-", "Component or channel from the file header."),
+    ("event", "-", "Event name from the file header."),
+    ("format", "-", "File format the record was read as."),
+    ("units", "-", "Units of the samples, as stated by the file header or given with `--units`; "
+                   "samples are converted to m/s^2."),
+    ("dt_s", "s", "Sampling interval."),
+    ("npts", "-", "Number of samples."),
+    ("duration_s", "s", "Time from the first to the last sample."),
+    ("pga_g", "g", "Peak absolute ground acceleration."),
+    ("pgv_m_s", "m/s", "Peak absolute ground velocity (from the fitter, after its baseline correction)."),
+    ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated."),
+    ("pulse_shape", "-", "Best-fitting pulse shape: `sine` (one-sine, Eq. 9), `ricker-sym` (symmetric "
+                         "Ricker, Eq. 7), `ricker-anti` (antisymmetric Ricker, Eq. 8) or `rect` "
+                         "(rectangular)."),
+    ("pulse_ap_g", "g", "Amplitude ap of the best-fitting pulse, signed by its polarity."),
+    ("pulse_tp_s", "s", "Period Tp of the best-fitting pulse (for the Rickers, the period at the peak "
+                        "of the Fourier amplitude)."),
+    ("pulse_t0_s", "s", "Arrival time (sine, rect) or centre (Rickers) of the best-fitting pulse, on "
+                        "the record's time axis."),
+    ("pulse_arrival_s", "s", "Time the best-fitting pulse starts: t0 for sine and rect, t0 - Tp/2 for "
+                             "the Rickers."),
+    ("pulse_lp_m", "m", "Persistence length scale Lp = |ap| Tp^2 of the best-fitting pulse."),
+    ("pulse_score", "-", "Fit quality of the best pulse: the fitter's score (share of the record's "
+                         "energy the pulse explains, 0 to 1)."),
+    ("pulse_correlation", "-", "Correlation between the best pulse and the record within the pulse "
+                               "window (-1 to 1)."),
+    ("shapes_fitting", "-", f"Shapes that fit the record almost equally well (score at least "
+                            f"{FIT_TOLERANCE:g} x the best score), best first, `;`-separated."),
+)
 
-    opts = task.options
-    record = _stage("read", _read, task)
-    fit = _stage("fit", _fit, record, opts.shapes)
-    best = fit.best
-    candidates = list(fit.candidates)
-    fitting = [c for c in candidates if _fits(c, best)]
-    by_shape = {}
-    for c in candidates:  # candidates are ranked: keep the best of each shape
-        by_shape.setdefault(c.shape, c)
 
+def _record_fields(task: Task, record, fit, best, fitting) -> dict:
     meta = record.metadata or {}
     warnings = meta.get("warnings") or []
     if isinstance(warnings, str):
         warnings = [warnings]
-    base = {
+    return RECORD_COLUMNS.row({
         "record": task.record_id,
         "file": task.path,
         "station": meta.get("station"),
@@ -228,7 +290,193 @@ def _process(task: Task):
         "pulse_score": best.score,
         "pulse_correlation": getattr(best, "correlation", None),
         "shapes_fitting": ";".join(c.shape for c in fitting),
-    }
+    })
+
+
+COLUMN_COLUMNS = Columns(
+    ("column", "-", "The column as given: `HxW` for `--block`, `H` for `--height`."),
+    ("column_kind", "-", "`block` (a column as it stands, `--block`) or `height` (only the width a "
+                         "column of this height needs, `--height`; the as-it-stands fields are blank)."),
+    ("height_m", "m", "Full height H of the column."),
+)
+
+
+def _column_fields(col: Column) -> dict:
+    return COLUMN_COLUMNS.row({"column": col.label, "column_kind": col.kind, "height_m": col.height})
+
+
+AS_STANDS_DESIGN_COLUMNS = Columns(
+    ("width_m", "m", "Full width B of the column as it stands (blank for `--height`)."),
+    ("tan_alpha", "-", "Slenderness tan(alpha) = B/H of the column as it stands."),
+    ("alpha_deg", "deg", "Slenderness angle alpha = atan(B/H)."),
+    ("p_rad_s", "rad/s", "Frequency parameter p = sqrt(3 g / (4 R)), R = sqrt((H/2)^2 + (B/2)^2)."),
+    ("p_tp", "-", "p x Tp of the best-fitting pulse (dimensionless)."),
+    ("eq31_tan_alpha", "-", "Eq. 31 minimum tan(alpha) = (ap/g) pTp / (1 + pTp) for the best-fitting "
+                            "pulse at the column's p."),
+    ("envelope_tan_alpha", "-", "Minimum tan(alpha) by the envelope rule (`rocking.envelope_rule`, "
+                                "conservative for every realisable shape) for the best-fitting pulse."),
+    ("exact_tan_alpha", "-", "Exact minimum tan(alpha) for the best-fitting pulse at the column's p: the "
+                             "smallest slenderness that survives the pulse at that and every larger "
+                             "slenderness (time-history analysis, `rocking.min_slenderness`)."),
+)
+
+
+def _as_stands_design(col: Column, block, best, exact) -> dict:
+    import rocking
+
+    if block is None:
+        return AS_STANDS_DESIGN_COLUMNS.blank()
+    p = block.p
+    return AS_STANDS_DESIGN_COLUMNS.row({
+        "width_m": col.width, "tan_alpha": block.tan_alpha,
+        "alpha_deg": math.degrees(block.alpha), "p_rad_s": p, "p_tp": p * best.tp,
+        "eq31_tan_alpha": float(rocking.eq31(best.ap, best.tp, p)),
+        "envelope_tan_alpha": float(rocking.envelope_rule(best.ap, best.tp, p, shape=best.shape)),
+        "exact_tan_alpha": exact[(best.shape, block)],
+    })
+
+
+GOVERNING_COLUMNS = Columns(
+    ("governing_shape", "-", "Shape of the governing pulse (the rule is stated in `columns.md`)."),
+    ("governing_ap_g", "g", "Amplitude of the governing pulse, signed."),
+    ("governing_tp_s", "s", "Period of the governing pulse."),
+    ("governing_eq31_tan_alpha", "-", "Eq. 31 minimum tan(alpha) for the governing pulse at the column's p."),
+)
+
+
+def _governing_fields(gov, block) -> dict:
+    import rocking
+
+    return GOVERNING_COLUMNS.row({
+        "governing_shape": gov.shape, "governing_ap_g": _g(gov.ap), "governing_tp_s": gov.tp,
+        "governing_eq31_tan_alpha": None if block is None else float(rocking.eq31(gov.ap, gov.tp, block.p)),
+    })
+
+
+def shape_columns(shape: str) -> Columns:
+    """The columns of one pulse shape (``sine``, ...), named ``<shape>_*`` (``-`` as ``_``)."""
+    k = _shape_key(shape)
+    return Columns(
+        (f"{k}_fits", "-", f"Whether the `{shape}` shape fits the record (see `shapes_fitting`); "
+                           "blank when the shape was not tried (`--shapes`)."),
+        (f"{k}_ap_g", "g", f"Amplitude of the best `{shape}` pulse, signed."),
+        (f"{k}_tp_s", "s", f"Period of the best `{shape}` pulse."),
+        (f"{k}_score", "-", f"Fit quality (score) of the best `{shape}` pulse."),
+        (f"{k}_eq31_tan_alpha", "-", f"Eq. 31 minimum tan(alpha) for the `{shape}` pulse at the column's p."),
+        (f"{k}_exact_tan_alpha", "-", f"Exact minimum tan(alpha) for the `{shape}` pulse at the column's "
+                                      "p (only for shapes that fit)."),
+        (f"{k}_eq31_width_m", "m", f"Width a column of this height needs by Eq. 31 for the `{shape}` "
+                                   "pulse (fixed point in B; only for shapes that fit)."),
+    )
+
+
+SHAPE_COLUMNS = {shape: shape_columns(shape) for shape in SHAPE_NAMES}
+
+
+def _shape_fields(shape, candidate, fitting, block, exact, widths) -> dict:
+    """The ``<shape>_*`` group: blank where the shape was not tried, does not fit, or (for the
+    as-it-stands values) the column is only a height."""
+    import rocking
+
+    columns = SHAPE_COLUMNS[shape]
+    if candidate is None:
+        return columns.blank()
+    c, k = candidate, _shape_key(shape)
+    eq31_width = None
+    for w, f in widths:  # the fitting candidates of this shape (one per shape from the fitter)
+        if f.shape == shape:
+            eq31_width = w
+    return columns.row({
+        f"{k}_fits": any(c is f for f in fitting), f"{k}_ap_g": _g(c.ap), f"{k}_tp_s": c.tp,
+        f"{k}_score": c.score,
+        f"{k}_eq31_tan_alpha": None if block is None else float(rocking.eq31(c.ap, c.tp, block.p)),
+        f"{k}_exact_tan_alpha": None if block is None else exact.get((shape, block)),
+        f"{k}_eq31_width_m": eq31_width,
+    })
+
+
+AS_STANDS_COLUMNS = Columns(
+    ("eq31_adequate", "-", "The column as it stands satisfies Eq. 31 for the governing pulse "
+                           "(tan_alpha >= governing_eq31_tan_alpha)."),
+    ("overturns", "-", "The column as it stands overturns (|theta| reaches pi/2) under the full record."),
+    ("exceeds_alpha", "-", "|theta| of the column as it stands passes alpha at some time under the full record."),
+    ("max_theta_ratio", "-", "max|theta|/alpha of the column as it stands under the full record (at "
+                             "least pi/(2 alpha) when it overturns)."),
+    ("n_impacts", "-", "Number of impacts of the column as it stands under the full record."),
+    ("model", "-", "Solver model that answered for the column as it stands (`rocking.simulate`, model=auto)."),
+)
+
+
+def _as_stands_fields(block, governing: dict, res) -> dict:
+    if block is None:
+        return AS_STANDS_COLUMNS.blank()
+    return AS_STANDS_COLUMNS.row({
+        "eq31_adequate": block.tan_alpha >= governing["governing_eq31_tan_alpha"],
+        "overturns": bool(res.overturned), "exceeds_alpha": bool(res.exceeded_alpha),
+        "max_theta_ratio": float(res.max_rotation_ratio), "n_impacts": int(res.n_impacts),
+        "model": str(res.model),
+    })
+
+
+EQ31_DESIGN_COLUMNS = Columns(
+    ("eq31_width_m", "m", "Width a column of this height needs by Eq. 31 for the governing pulse "
+                          "(fixed point in B, since p depends on B; `rocking.required_width`, rule eq31)."),
+    ("eq31_width_tan_alpha", "-", "tan(alpha) of the Eq. 31 design, eq31_width_m / height_m."),
+    ("eq31_width_overturns", "-", "The Eq. 31 design overturns under the full record."),
+    ("eq31_width_max_theta_ratio", "-", "max|theta|/alpha of the Eq. 31 design under the full record."),
+    ("eq31_width_model", "-", "Solver model that answered for the Eq. 31 design."),
+)
+
+
+def _eq31_design_fields(height, w31, res31) -> dict:
+    return EQ31_DESIGN_COLUMNS.row({
+        "eq31_width_m": w31, "eq31_width_tan_alpha": w31 / height,
+        "eq31_width_overturns": bool(res31.overturned),
+        "eq31_width_max_theta_ratio": float(res31.max_rotation_ratio),
+        "eq31_width_model": str(res31.model),
+    })
+
+
+VERIFIED_COLUMNS = Columns(
+    ("verified_width_m", "m", "Verified width: the smallest width for which a column of this height "
+                              "survives the full record, at that width and every larger one (a search "
+                              "that finds every transition, so it is not fooled by safe islands; "
+                              "`rocking.required_width`, rule exact). Independent of the pulse fit."),
+    ("verified_tan_alpha", "-", "tan(alpha) of the verified width, verified_width_m / height_m."),
+    ("verified_adequate", "-", "The column as it stands is at least as wide as the verified width "
+                               "(blank for `--height`). A column that survives (`overturns` False) "
+                               "but is not verified-adequate stands on a safe island: some slightly "
+                               "wider column of the same height overturns under the same record."),
+)
+
+
+def _verified_fields(col: Column, ver) -> dict:
+    return VERIFIED_COLUMNS.row({
+        "verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / col.height,
+        "verified_adequate": None if col.width is None else col.width >= float(ver.width),
+    })
+
+
+#: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
+COLUMNS = (RECORD_COLUMNS.columns + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
+           + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
+           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns)
+FIELDS = [name for name, _, _ in COLUMNS]
+
+
+def _process(task: Task):
+    import rocking
+
+    opts = task.options
+    record = _stage("read", _read, task)
+    fit = _stage("fit", _fit, record, opts.shapes)
+    best = fit.best
+    candidates = list(fit.candidates)
+    fitting = [c for c in candidates if _fits(c, best)]
+    by_shape = {}
+    for c in candidates:  # candidates are ranked: keep the best of each shape
+        by_shape.setdefault(c.shape, c)
+    base = _record_fields(task, record, fit, best, fitting)
 
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width)
               for col in task.columns if col.width is not None}
@@ -239,9 +487,8 @@ def _process(task: Task):
     verified_cache = {}
     eq31_cache = {}
     for col in task.columns:
-        row = dict(base)
-        row.update({"column": col.label, "column_kind": col.kind, "height_m": col.height})
         H = col.height
+        block = blocks.get(col)
         curves = []
 
         # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
@@ -252,54 +499,25 @@ def _process(task: Task):
             eq31_cache[H] = _stage("design", eq31_widths)
         widths = eq31_cache[H]
         w31, gov = max(widths, key=lambda wc: wc[0])  # ties: the better fit (ranked first)
-        row.update({"governing_shape": gov.shape, "governing_ap_g": _g(gov.ap),
-                    "governing_tp_s": gov.tp, "eq31_width_m": w31, "eq31_width_tan_alpha": w31 / H})
-        for shape in SHAPE_NAMES:
-            c = by_shape.get(shape)
-            if c is None:
-                continue
-            k = _shape_key(shape)
-            row.update({f"{k}_fits": any(c is f for f in fitting), f"{k}_ap_g": _g(c.ap),
-                        f"{k}_tp_s": c.tp, f"{k}_score": c.score})
-        for w, c in widths:
-            row[f"{_shape_key(c.shape)}_eq31_width_m"] = w
 
-        # -- the column as it stands -----------------------------------------------------------------
-        if col.width is not None:
-            block = blocks[col]
-            p = block.p
+        # -- the column as it stands: design rules, then the full record ---------------------------
+        def design():
+            fields = _as_stands_design(col, block, best, exact)
+            fields.update(_governing_fields(gov, block))
+            for shape in SHAPE_NAMES:
+                fields.update(_shape_fields(shape, by_shape.get(shape), fitting, block, exact, widths))
+            return fields
 
-            def design_as_stands():
-                d = {
-                    "width_m": col.width, "tan_alpha": block.tan_alpha,
-                    "alpha_deg": math.degrees(block.alpha), "p_rad_s": p, "p_tp": p * best.tp,
-                    "eq31_tan_alpha": float(rocking.eq31(best.ap, best.tp, p)),
-                    "envelope_tan_alpha": float(rocking.envelope_rule(best.ap, best.tp, p, shape=best.shape)),
-                    "exact_tan_alpha": exact[(best.shape, block)],
-                    "governing_eq31_tan_alpha": float(rocking.eq31(gov.ap, gov.tp, p)),
-                }
-                for c in by_shape.values():
-                    k = _shape_key(c.shape)
-                    d[f"{k}_eq31_tan_alpha"] = float(rocking.eq31(c.ap, c.tp, p))
-                    if (c.shape, block) in exact:
-                        d[f"{k}_exact_tan_alpha"] = exact[(c.shape, block)]
-                d["eq31_adequate"] = block.tan_alpha >= d["governing_eq31_tan_alpha"]
-                return d
-
-            row.update(_stage("design", design_as_stands))
+        designed = _stage("design", design)
+        res = None
+        if block is not None:
             res = _stage("verify", _sim, block, record, opts.plots)
-            row.update({"overturns": bool(res.overturned), "exceeds_alpha": bool(res.exceeded_alpha),
-                        "max_theta_ratio": float(res.max_rotation_ratio),
-                        "n_impacts": int(res.n_impacts), "model": str(res.model)})
             if opts.plots:
                 curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
         block31 = rocking.Block.from_dimensions(H, w31)
         res31 = _stage("verify", _sim, block31, record, opts.plots)
-        row.update({"eq31_width_overturns": bool(res31.overturned),
-                    "eq31_width_max_theta_ratio": float(res31.max_rotation_ratio),
-                    "eq31_width_model": str(res31.model)})
         if opts.plots:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
             histories.append((col.label, curves))
@@ -307,10 +525,13 @@ def _process(task: Task):
         # -- verified width: smallest width surviving the full record (islands respected) ---------
         if H not in verified_cache:
             verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact")
-        ver = verified_cache[H]
-        row.update({"verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / H})
-        if col.width is not None:
-            row["verified_adequate"] = col.width >= float(ver.width)
+
+        row = dict(base)
+        row.update(_column_fields(col))
+        row.update(designed)
+        row.update(_as_stands_fields(block, designed, res))
+        row.update(_eq31_design_fields(H, w31, res31))
+        row.update(_verified_fields(col, verified_cache[H]))
         rows.append(row)
 
     return rows, (record, fit, fitting, histories)

@@ -36,19 +36,33 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 2
-    try:
-        return int(args.func(args) or 0)
-    except ArgumentError as exc:
-        print(f"pipeline {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+    from . import interrupts
+
+    interrupts.reset()
+    # from the start: an interrupt while the sub-commands are imported is not lost either
+    with interrupts.handling():
+        try:
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            if not getattr(args, "func", None):
+                parser.print_help()
+                return 2
+            try:
+                code = int(args.func(args) or 0)
+            except ArgumentError as exc:
+                print(f"pipeline {args.command}: error: {exc}", file=sys.stderr)
+                return 2
+            except OSError as exc:  # the file system refused (a full disk, a folder gone ...)
+                print(f"pipeline {args.command}: error: {exc}", file=sys.stderr)
+                return 1
+        except KeyboardInterrupt as exc:
+            print("interrupted", file=sys.stderr)
+            return exc.exit_status if isinstance(exc, interrupts.Interrupted) else 130
+        signum = interrupts.pending()
+        if signum is not None:  # an interrupt whose exception something swallowed
+            print("interrupted", file=sys.stderr)
+            return interrupts.EXIT_STATUS[signum]
+        return code
 
 
 if __name__ == "__main__":

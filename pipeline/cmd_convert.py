@@ -9,8 +9,8 @@ from __future__ import annotations
 import pathlib
 import sys
 
-from .args import ArgumentError
-from .cmd_fit import _with_path, add_record_arguments, record_options
+from .args import ArgumentError, add_record_options, record_options
+from .cmd_fit import _with_path
 
 
 def add_parser(subparsers) -> None:
@@ -23,7 +23,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("files", nargs="+", metavar="FILE", help="record files")
     p.add_argument("--to", required=True, choices=["sac", "mseed"], help="output format")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
-    add_record_arguments(p)
+    add_record_options(p)
     p.set_defaults(func=main)
 
 

@@ -5,52 +5,14 @@ One row per record and shape, ranked by the share of the record's energy each pu
 draws each record with the fitted pulses over it (as in Fig. 4 of the paper).
 
 Options for reading records (``--units``, ``--dt``, ``--column``, ``--format``, ``--trace``)
-are shared with ``pipeline convert`` through :func:`add_record_arguments` and
-:func:`read_record_from_args`.
+are those of :func:`pipeline.args.add_record_options`, shared with the other sub-commands.
 """
 from __future__ import annotations
 
 import json
 import sys
 
-from .args import ArgumentError, parse_shapes
-
-
-def add_record_arguments(p) -> None:
-    """The options that tell :func:`pulses.read_record` what a file does not say."""
-    p.add_argument("--units", help="units of the samples where the file states none (text, MiniSEED), "
-                                   "or to override SAC's iacc = nm/s^2: g, m/s2, cm/s2 (gal), mm/s2, nm/s2; "
-                                   "not applied to AT2 and K-NET files, which state theirs")
-    p.add_argument("--dt", help="sampling interval in s, for text files without a time column")
-    p.add_argument("--column", help="text files: the column holding the acceleration, counted from 1")
-    p.add_argument("--format", help="file format when detection from the content is not wanted "
-                                    "(at2, text, sac, mseed, knet, or any obspy format)")
-    p.add_argument("--trace", help="files holding several traces: index (from 0), id or channel")
-
-
-def record_options(args) -> dict:
-    """Keyword arguments of :func:`pulses.read_record` from the parsed options (checked)."""
-    from pulses import RecordError
-    from pulses.units import canonical_units
-
-    from .args import parse_positive
-
-    opts = {"format": args.format, "units": None, "dt": None, "column": None, "trace": args.trace}
-    if args.units is not None:
-        try:
-            opts["units"] = canonical_units(args.units)
-        except RecordError as exc:
-            raise ArgumentError(f"--units: {exc}") from None
-    if args.dt is not None:
-        opts["dt"] = parse_positive(args.dt, "--dt (s)")
-    if args.column is not None:
-        try:
-            opts["column"] = int(args.column)
-        except ValueError:
-            opts["column"] = 0
-        if opts["column"] < 1:
-            raise ArgumentError(f"--column counts from 1, got {args.column!r}")
-    return opts
+from .args import add_record_options, parse_shapes, record_options
 
 
 def add_parser(subparsers) -> None:
@@ -63,7 +25,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("files", nargs="+", metavar="FILE", help="record files (AT2, SAC, MiniSEED, K-NET, text ...)")
     p.add_argument("--shapes", nargs="+", metavar="SHAPE",
                    help="shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: all)")
-    add_record_arguments(p)
+    add_record_options(p)
     p.add_argument("--csv", metavar="FILE", help="write one row per record and shape to this CSV file")
     p.add_argument("--plot", metavar="DIR", help="draw each record with its fitted pulses into DIR/<record>.png")
     p.add_argument("--json", action="store_true", help="print the results as JSON instead of a table")

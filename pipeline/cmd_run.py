@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from .args import ArgumentError, parse_block, parse_length, parse_positive, parse_shapes
+from .args import ArgumentError, add_record_options, parse_block, parse_length, parse_shapes, record_options
 
 DEFAULT_OUT = "pipeline-output"
 
@@ -45,12 +45,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--shapes", nargs="+", metavar="SHAPE",
                    help="pulse shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: "
                         "the fitter's default set)")
-    p.add_argument("--units", help="units of the samples where the files state none, or to override "
-                                   "SAC's iacc = nm/s^2: g, m/s2, cm/s2 (gal), mm/s2, nm/s2")
-    p.add_argument("--dt", help="sampling interval in s, for text files without a time column")
-    p.add_argument("--column", type=str, help="text files: the column holding the acceleration, from 1")
-    p.add_argument("--format", help="file format, when detection from the content is not wanted "
-                                    "(at2, text, sac, mseed, ...)")
+    add_record_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -66,18 +61,6 @@ def parse_jobs(text) -> int | None:
     if jobs < 0:
         raise ArgumentError(f"--jobs must be 0 (one per CPU) or more, got {jobs}")
     return jobs or (os.cpu_count() or 1)
-
-
-def parse_units(text):
-    if text is None:
-        return None
-    from pulses import RecordError
-    from pulses.units import canonical_units
-
-    try:
-        return canonical_units(text)
-    except RecordError as exc:
-        raise ArgumentError(f"--units: {exc}") from None
 
 
 def build_columns(blocks, heights):
@@ -103,18 +86,7 @@ def main(args) -> int:
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
-    column = None
-    if args.column is not None:
-        try:
-            column = int(args.column)
-        except ValueError:
-            column = 0
-        if column < 1:
-            raise ArgumentError(f"--column counts from 1, got {args.column!r}")
-    options = options_from(
-        args, shapes=parse_shapes(args.shapes), units=parse_units(args.units),
-        dt=parse_positive(args.dt, "--dt (s)") if args.dt is not None else None,
-        column=column, format=args.format)
+    options = options_from(args, shapes=parse_shapes(args.shapes), **record_options(args))
     if not args.records:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     paths = expand_inputs(args.records)

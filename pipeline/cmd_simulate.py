@@ -13,14 +13,13 @@ import json
 import math
 import sys
 
-from .args import ArgumentError, parse_acceleration, parse_block, parse_positive
+from .args import (ArgumentError, add_record_options, parse_acceleration, parse_block, parse_positive,
+                   record_options)
 
 PULSES = ("rect", "sine", "ricker-sym", "ricker-anti")
 
 
 def add_parser(subparsers) -> None:
-    from .cmd_fit import add_record_arguments
-
     p = subparsers.add_parser(
         "simulate", help="rocking response of one column to a pulse or a record",
         description="Solve Housner's rocking block (SPEC section 2) under a pulse or a full record "
@@ -42,7 +41,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--csv", help="write the history t, theta, omega to this CSV file")
     p.add_argument("--plot", help="draw the rotation and angular velocity histories to this PNG")
-    add_record_arguments(p)
+    add_record_options(p)
     p.set_defaults(func=run)
 
 
@@ -55,8 +54,6 @@ def _excitation(args):
         ap = parse_acceleration(args.ap)
         tp = parse_positive(args.tp, "--tp (s)")
         return pulses.make_pulse(args.pulse, ap, tp), f"{args.pulse} pulse ap={args.ap} tp={tp:g} s"
-    from .cmd_fit import record_options
-
     try:
         scale = float(args.scale)
     except ValueError:

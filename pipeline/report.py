@@ -9,10 +9,13 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import hashlib
 import io
 import math
 import os
 import pathlib
+import stat
+import tempfile
 
 #: shapes that get their own group of columns, in this order (``pulses.SHAPES`` names)
 SHAPE_NAMES = ("sine", "ricker-sym", "ricker-anti", "rect")
@@ -35,122 +38,30 @@ def _shape_key(shape: str) -> str:
     return shape.replace("-", "_")
 
 
-def _record_columns():
-    return [
-        ("record", "-", "Record id: the file name without its extension, made unique in input order "
-                        "(`-2`, `-3`, ...). The per-record report is `<record>.csv`."),
-        ("file", "-", "The record's path as given on the command line."),
-        ("station", "-", "Station code from the file header (blank when the format has none)."),
-        ("component", "-", "Component or channel from the file header."),
-        ("event", "-", "Event name from the file header."),
-        ("format", "-", "File format the record was read as."),
-        ("units", "-", "Units of the samples, as stated by the file header or given with `--units`; "
-                       "samples are converted to m/s^2."),
-        ("dt_s", "s", "Sampling interval."),
-        ("npts", "-", "Number of samples."),
-        ("duration_s", "s", "Time from the first to the last sample."),
-        ("pga_g", "g", "Peak absolute ground acceleration."),
-        ("pgv_m_s", "m/s", "Peak absolute ground velocity (from the fitter, after its baseline correction)."),
-        ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated."),
-        ("pulse_shape", "-", "Best-fitting pulse shape: `sine` (one-sine, Eq. 9), `ricker-sym` (symmetric "
-                             "Ricker, Eq. 7), `ricker-anti` (antisymmetric Ricker, Eq. 8) or `rect` "
-                             "(rectangular)."),
-        ("pulse_ap_g", "g", "Amplitude ap of the best-fitting pulse, signed by its polarity."),
-        ("pulse_tp_s", "s", "Period Tp of the best-fitting pulse (for the Rickers, the period at the peak "
-                            "of the Fourier amplitude)."),
-        ("pulse_t0_s", "s", "Arrival time (sine, rect) or centre (Rickers) of the best-fitting pulse, on "
-                            "the record's time axis."),
-        ("pulse_arrival_s", "s", "Time the best-fitting pulse starts: t0 for sine and rect, t0 - Tp/2 for "
-                                 "the Rickers."),
-        ("pulse_lp_m", "m", "Persistence length scale Lp = |ap| Tp^2 of the best-fitting pulse."),
-        ("pulse_score", "-", "Fit quality of the best pulse: the fitter's score (share of the record's "
-                             "energy the pulse explains, 0 to 1)."),
-        ("pulse_correlation", "-", "Correlation between the best pulse and the record within the pulse "
-                                   "window (-1 to 1)."),
-        ("shapes_fitting", "-", f"Shapes that fit the record almost equally well (score at least "
-                                f"{FIT_TOLERANCE:g} x the best score), best first, `;`-separated."),
-    ]
+class Columns:
+    """A group of report columns declared together, next to the code that computes them.
 
+    Parameters
+    ----------
+    *columns : tuple of (str, str, str)
+        ``(name, unit, meaning)`` of each column, in report order; ``unit`` is ``-`` for none.
+    """
 
-def _column_columns():
-    cols = [
-        ("column", "-", "The column as given: `HxW` for `--block`, `H` for `--height`."),
-        ("column_kind", "-", "`block` (a column as it stands, `--block`) or `height` (only the width a "
-                             "column of this height needs, `--height`; the as-it-stands fields are blank)."),
-        ("height_m", "m", "Full height H of the column."),
-        ("width_m", "m", "Full width B of the column as it stands (blank for `--height`)."),
-        ("tan_alpha", "-", "Slenderness tan(alpha) = B/H of the column as it stands."),
-        ("alpha_deg", "deg", "Slenderness angle alpha = atan(B/H)."),
-        ("p_rad_s", "rad/s", "Frequency parameter p = sqrt(3 g / (4 R)), R = sqrt((H/2)^2 + (B/2)^2)."),
-        ("p_tp", "-", "p x Tp of the best-fitting pulse (dimensionless)."),
-        ("eq31_tan_alpha", "-", "Eq. 31 minimum tan(alpha) = (ap/g) pTp / (1 + pTp) for the best-fitting "
-                                "pulse at the column's p."),
-        ("envelope_tan_alpha", "-", "Minimum tan(alpha) by the envelope rule (`rocking.envelope_rule`, "
-                                    "conservative for every realisable shape) for the best-fitting pulse."),
-        ("exact_tan_alpha", "-", "Exact minimum tan(alpha) for the best-fitting pulse at the column's p: the "
-                                 "smallest slenderness that survives the pulse at that and every larger "
-                                 "slenderness (time-history analysis, `rocking.min_slenderness`)."),
-        ("governing_shape", "-", "Shape of the governing pulse (the rule is stated in `columns.md`)."),
-        ("governing_ap_g", "g", "Amplitude of the governing pulse, signed."),
-        ("governing_tp_s", "s", "Period of the governing pulse."),
-        ("governing_eq31_tan_alpha", "-", "Eq. 31 minimum tan(alpha) for the governing pulse at the column's p."),
-    ]
-    for shape in SHAPE_NAMES:
-        k = _shape_key(shape)
-        cols += [
-            (f"{k}_fits", "-", f"Whether the `{shape}` shape fits the record (see `shapes_fitting`); "
-                               "blank when the shape was not tried (`--shapes`)."),
-            (f"{k}_ap_g", "g", f"Amplitude of the best `{shape}` pulse, signed."),
-            (f"{k}_tp_s", "s", f"Period of the best `{shape}` pulse."),
-            (f"{k}_score", "-", f"Fit quality (score) of the best `{shape}` pulse."),
-            (f"{k}_eq31_tan_alpha", "-", f"Eq. 31 minimum tan(alpha) for the `{shape}` pulse at the column's p."),
-            (f"{k}_exact_tan_alpha", "-", f"Exact minimum tan(alpha) for the `{shape}` pulse at the column's "
-                                          "p (only for shapes that fit)."),
-            (f"{k}_eq31_width_m", "m", f"Width a column of this height needs by Eq. 31 for the `{shape}` "
-                                       "pulse (fixed point in B; only for shapes that fit)."),
-        ]
-    cols += [
-        ("eq31_adequate", "-", "The column as it stands satisfies Eq. 31 for the governing pulse "
-                               "(tan_alpha >= governing_eq31_tan_alpha)."),
-        ("overturns", "-", "The column as it stands overturns (|theta| reaches pi/2) under the full record."),
-        ("exceeds_alpha", "-", "|theta| of the column as it stands passes alpha at some time under the full record."),
-        ("max_theta_ratio", "-", "max|theta|/alpha of the column as it stands under the full record (at "
-                                 "least pi/(2 alpha) when it overturns)."),
-        ("n_impacts", "-", "Number of impacts of the column as it stands under the full record."),
-        ("model", "-", "Solver model that answered for the column as it stands (`rocking.simulate`, model=auto)."),
-        ("eq31_width_m", "m", "Width a column of this height needs by Eq. 31 for the governing pulse "
-                              "(fixed point in B, since p depends on B; `rocking.required_width`, rule eq31)."),
-        ("eq31_width_tan_alpha", "-", "tan(alpha) of the Eq. 31 design, eq31_width_m / height_m."),
-        ("eq31_width_overturns", "-", "The Eq. 31 design overturns under the full record."),
-        ("eq31_width_max_theta_ratio", "-", "max|theta|/alpha of the Eq. 31 design under the full record."),
-        ("eq31_width_model", "-", "Solver model that answered for the Eq. 31 design."),
-        ("verified_width_m", "m", "Verified width: the smallest width for which a column of this height "
-                                  "survives the full record, at that width and every larger one (a search "
-                                  "that finds every transition, so it is not fooled by safe islands; "
-                                  "`rocking.required_width`, rule exact). Independent of the pulse fit."),
-        ("verified_tan_alpha", "-", "tan(alpha) of the verified width, verified_width_m / height_m."),
-        ("verified_adequate", "-", "The column as it stands is at least as wide as the verified width "
-                                   "(blank for `--height`). A column that survives (`overturns` False) "
-                                   "but is not verified-adequate stands on a safe island: some slightly "
-                                   "wider column of the same height overturns under the same record."),
-    ]
-    return cols
+    def __init__(self, *columns):
+        self.columns = tuple(columns)
+        self.names = tuple(name for name, _, _ in columns)
 
+    def row(self, values: dict) -> dict:
+        """``values`` in declaration order; :class:`ReportError` unless it has exactly the declared
+        keys (None, NaN or a missing value is written as a blank cell)."""
+        if set(values) != set(self.names) or len(values) != len(self.names):
+            extra, missing = sorted(set(values) - set(self.names)), sorted(set(self.names) - set(values))
+            raise ReportError(f"report values do not match their columns: undeclared {extra}, missing {missing}")
+        return {name: values[name] for name in self.names}
 
-#: (name, unit, description) of every column of the per-record reports and ``summary.csv``
-COLUMNS = _record_columns() + _column_columns()
-FIELDS = [name for name, _, _ in COLUMNS]
-
-FAILURE_COLUMNS = [
-    ("record", "-", "Record id (as in the per-record reports)."),
-    ("file", "-", "The record's path as given."),
-    ("stage", "-", "Where it failed: `read` (reading the file), `fit` (pulse fitting), `design` "
-                   "(design rules), `verify` (full-record time histories), `plot`, `worker` (the "
-                   "process running it died) or `internal` (an unforeseen error: please report it)."),
-    ("error", "-", "Type of the error."),
-    ("reason", "-", "The error message, in one line."),
-]
-FAILURE_FIELDS = [name for name, _, _ in FAILURE_COLUMNS]
+    def blank(self) -> dict:
+        """The group with every cell blank (the values do not apply)."""
+        return dict.fromkeys(self.names)
 
 
 # -- formatting --------------------------------------------------------------------------------
@@ -178,15 +89,55 @@ def fmt(value) -> str:
             return fmt(float(value))
     except ImportError:  # pragma: no cover
         pass
-    return " ".join(str(value).split())  # one line
+    return text_cell(value)
+
+
+#: first characters that make a spreadsheet read a text cell as a formula
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def text_cell(value) -> str:
+    """A text cell: one line, any bytes of a file name shown (``\\xff``), and never a formula.
+
+    A text starting with ``= + - @``, tab or carriage return is read as a formula by spreadsheets
+    (CSV injection): it gets a leading apostrophe, which they show as text.  Numbers are written by
+    :func:`fmt` and never pass here.
+    """
+    text = " ".join(display(value).split())
+    return "'" + text if text.startswith(FORMULA_STARTS) else text
+
+
+def display(value) -> str:
+    """``value`` as printable text: bytes of a file name that are not UTF-8 (which Python keeps as
+    lone surrogates) written as ``\\xff``."""
+    text = str(value)
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        try:
+            raw = text.encode("utf-8", "surrogateescape")
+        except UnicodeEncodeError:
+            raw = text.encode("utf-8", "backslashreplace")
+        return raw.decode("utf-8", "backslashreplace")
+
+
+class ReportError(ValueError):
+    """A report row that does not match its declared columns (a programming error)."""
 
 
 def csv_text(fields, rows) -> str:
+    """CSV text of ``rows`` (dicts) under the header ``fields``; every row must have exactly these
+    keys (a key not declared, or a declared one never set, is an error, not a blank)."""
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(fields)
+    declared = set(fields)
     for row in rows:
-        writer.writerow([fmt(row.get(f)) for f in fields])
+        if set(row) != declared:
+            extra, missing = sorted(set(row) - declared), sorted(declared - set(row))
+            raise ReportError(f"report row does not match its columns: undeclared {extra}, missing {missing}")
+        writer.writerow([fmt(row[f]) for f in fields])
     return buf.getvalue()
 
 
@@ -194,24 +145,50 @@ def csv_text(fields, rows) -> str:
 def write_atomic(path, data) -> pathlib.Path:
     """Write ``data`` (str or bytes) to ``path`` through a temporary file and a rename.
 
-    On any interruption (including Ctrl-C) the temporary file is removed and ``path`` keeps its
-    previous content, if any.  Unchanged files are not rewritten.
+    The temporary file is created exclusively in ``path``'s folder (:func:`tempfile.mkstemp`: an
+    unpredictable name, never opened through an existing symbolic link) and renamed over ``path``
+    atomically (a symbolic link at ``path`` is replaced, its target left alone).  On any
+    interruption the temporary file is removed and ``path`` keeps its previous content; Ctrl-C
+    arriving during the write takes effect when the file is whole.  Unchanged files are not
+    rewritten.
     """
+    from . import interrupts
+
     path = pathlib.Path(path)
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
-    with contextlib.suppress(OSError):
-        if path.is_file() and path.stat().st_size == len(raw) and path.read_bytes() == raw:
-            return path
+    if _regular_file_bytes(path) == raw:
+        return path
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    try:
-        with open(tmp, "wb") as fh:
-            fh.write(raw)
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            tmp.unlink()
+    with interrupts.deferred():
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name[:40]}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                os.fchmod(fh.fileno(), 0o666 & ~_umask())  # as an ordinary file, not mkstemp's 0600
+                fh.write(raw)
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            raise
     return path
+
+
+def _regular_file_bytes(path):
+    """Content of ``path`` if it is a regular file (not through a symbolic link), else None."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return None
+    with os.fdopen(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+            return None
+        return fh.read()
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def remove_quietly(path) -> None:
@@ -219,24 +196,148 @@ def remove_quietly(path) -> None:
         pathlib.Path(path).unlink()
 
 
+# -- what the tool wrote ---------------------------------------------------------------------------
+#: the manifest in ``--out``: the files ``pipeline run`` wrote there, which alone it replaces or removes
+MANIFEST = "pipeline-manifest.txt"
+_MANIFEST_HEADER = ("# pipeline run: the files it wrote into this folder (sha256 of the content, path); "
+                    "it replaces or removes no other file\n")
+
+
+class NotOurs(OSError):
+    """A file in the output folder that ``pipeline run`` did not write (left as it is)."""
+
+
+class Outputs:
+    """The report files of one output folder, and the manifest that says which the tool wrote.
+
+    A file is replaced or removed only when its present content is one the tool wrote there
+    (recorded in :data:`MANIFEST` before the file is written, so that an interrupted run still
+    knows its files); any other file in the way is left as it is (:class:`NotOurs`).
+    """
+
+    def __init__(self, folder):
+        self.folder = pathlib.Path(folder)
+        self.path = self.folder / MANIFEST
+        self._written: dict[str, set[str]] = {}
+        raw = _regular_file_bytes(self.path)
+        if raw is None and os.path.lexists(self.path):
+            raise NotOurs(f"{display(self.path)} is not a file pipeline run wrote")
+        if raw is not None:
+            text = raw.decode("utf-8", "replace")
+            if not text.startswith(_MANIFEST_HEADER):
+                raise NotOurs(f"{display(self.path)} was not written by pipeline run")
+            for line in text.splitlines()[1:]:
+                digest, _, rel = line.partition("  ")
+                if len(digest) == 64 and rel:
+                    self._written.setdefault(rel, set()).add(digest)
+
+    def _target(self, rel: str) -> pathlib.Path:
+        return self.folder / rel
+
+    def owned(self, rel: str) -> bool:
+        """Whether the file at ``rel`` (a path relative to the folder) may be replaced: it does not
+        exist, or its content is one the tool wrote there."""
+        path = self._target(rel)
+        if not os.path.lexists(path):
+            return True
+        raw = _regular_file_bytes(path)
+        return raw is not None and _digest(raw) in self._written.get(rel, ())
+
+    def check(self, rel: str) -> None:
+        """Raise :class:`NotOurs` if the file at ``rel`` exists and was not written by the tool."""
+        path = self._target(rel)
+        if not self.owned(rel):
+            raise NotOurs(f"{display(path)} exists and was not written by pipeline run "
+                          f"(not in {MANIFEST}): left as it is")
+        if not _real_folder(path.parent, self.folder):
+            raise NotOurs(f"{display(path.parent)} is not a folder of its own (a symbolic link?): "
+                          f"{path.name} not written")
+
+    def write(self, rel: str, data) -> pathlib.Path:
+        """Write ``data`` to ``rel`` atomically, unless a file the tool did not write is there."""
+        raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+        path = self._target(rel)
+        if _regular_file_bytes(path) == raw:
+            return path  # already so (whoever wrote it, nothing changes)
+        self.check(rel)
+        digest = _digest(raw)
+        if digest not in self._written.get(rel, ()):
+            self._journal(f"{digest}  {rel}\n")
+            self._written.setdefault(rel, set()).add(digest)
+        return write_atomic(path, raw)
+
+    def remove(self, rel: str) -> bool:
+        """Remove the tool's file at ``rel``; True if removed, False if absent; :class:`NotOurs`
+        for a file the tool did not write."""
+        path = self._target(rel)
+        if not os.path.lexists(path):
+            return False
+        self.check(rel)
+        remove_quietly(path)
+        return True
+
+    def _journal(self, line: str) -> None:
+        from . import interrupts
+
+        with interrupts.deferred():
+            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
+            fd = os.open(self.path, flags, 0o666)
+            with os.fdopen(fd, "a", encoding="utf-8") as fh:
+                if fh.tell() == 0:
+                    fh.write(_MANIFEST_HEADER)
+                fh.write(line)
+
+    def finish(self) -> None:
+        """Rewrite the manifest compactly: for each file still there, the content the tool wrote
+        (sorted, so that the same run gives the same manifest)."""
+        lines = []
+        for rel in sorted(self._written):
+            path = self._target(rel)
+            if not os.path.lexists(path):
+                continue
+            raw = _regular_file_bytes(path)
+            digests = self._written[rel]
+            if raw is not None and _digest(raw) in digests:
+                digests = {_digest(raw)}
+            lines += [f"{d}  {rel}\n" for d in sorted(digests)]
+        if lines or os.path.lexists(self.path):
+            write_atomic(self.path, _MANIFEST_HEADER + "".join(lines))
+
+
+def _digest(raw: bytes) -> str:
+    return hashlib.sha256(raw).hexdigest()
+
+
+def _real_folder(folder, top) -> bool:
+    """Whether ``folder`` is ``top`` or a real folder inside it (no symbolic link on the way)."""
+    folder, top = pathlib.Path(folder), pathlib.Path(top)
+    while folder != top:
+        if folder.is_symlink() or not folder.is_dir():
+            return False
+        folder = folder.parent
+    return True
+
+
 # -- the files -------------------------------------------------------------------------------------
-def record_csv_path(out, record_id: str) -> pathlib.Path:
-    return pathlib.Path(out) / f"{record_id}.csv"
+SUMMARY, FAILURES, COLUMNS_MD = "summary.csv", "failures.csv", "columns.md"
+SUMMARY_PLOT = "plots/summary.png"
 
 
-def write_record_csv(out, record_id: str, rows) -> pathlib.Path:
-    return write_atomic(record_csv_path(out, record_id), csv_text(FIELDS, rows))
+def record_csv_name(record_id: str) -> str:
+    """Path of a record's report, relative to the output folder."""
+    return f"{record_id}.csv"
 
 
-def write_summary(out, rows) -> pathlib.Path:
-    return write_atomic(pathlib.Path(out) / "summary.csv", csv_text(FIELDS, rows))
+def record_plot_name(record_id: str) -> str:
+    """Path of a record's figure, relative to the output folder."""
+    return f"plots/{record_id}.png"
 
 
-def write_failures(out, failures) -> pathlib.Path:
-    return write_atomic(pathlib.Path(out) / "failures.csv", csv_text(FAILURE_FIELDS, failures))
+def columns_markdown(columns, failure_columns) -> str:
+    """``columns.md``: the files of the output folder and every column of the reports.
 
-
-def columns_markdown() -> str:
+    ``columns`` and ``failure_columns`` are ``(name, unit, meaning)`` tuples, in report order.
+    """
     lines = [
         "# Reports of `pipeline run`",
         "",
@@ -249,10 +350,18 @@ def columns_markdown() -> str:
         "histories of each column as it stands and of its Eq. 31 design under the full record "
         "(Figs. 9, 11); `plots/summary.png`: required against actual tan(alpha) across records.",
         "- `columns.md`: this file.",
+        f"- `{MANIFEST}`: the files `pipeline run` wrote here (with a hash of their content). A later "
+        "run into this folder replaces or removes only those, and only while their content is still "
+        "what it wrote; any other file in its way is left as it is, and the run says so.",
         "",
         "Accelerations are in g (g = 9.81 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
         "digits; a blank cell means the value does not apply (or, in `<shape>_*` columns, that the shape "
         "does not fit or was not tried). Booleans are `True`/`False`.",
+        "",
+        "Text cells (file names, and what the records' headers say: `station`, `component`, `event`, "
+        "...) that start with `=`, `+`, `-`, `@`, a tab or a carriage return get a leading apostrophe "
+        "(`'`), so that a spreadsheet opening the file shows them as text and never evaluates them as "
+        "a formula; numbers are written as they are.",
         "",
         "## Governing pulse",
         "",
@@ -264,11 +373,7 @@ def columns_markdown() -> str:
         "|---|---|---|",
     ]
     cell = lambda text: text.replace("|", "\\|")  # a bare | would end the table cell
-    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in COLUMNS]
+    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in columns]
     lines += ["", "## Columns of `failures.csv`", "", "| column | unit | meaning |", "|---|---|---|"]
-    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in FAILURE_COLUMNS]
+    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in failure_columns]
     return "\n".join(lines) + "\n"
-
-
-def write_columns_md(out) -> pathlib.Path:
-    return write_atomic(pathlib.Path(out) / "columns.md", columns_markdown())

@@ -5,16 +5,19 @@ the reports are assembled in input order, and files are written atomically with 
 """
 from __future__ import annotations
 
+import contextlib
 import glob
 import logging
 import os
 import pathlib
 import sys
+import tempfile
 from dataclasses import dataclass
 
-from . import report
+from . import interrupts, report
 from .args import ArgumentError
-from .batch import Options, Task, failure, process_record, record_ids
+from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
+                    record_ids)
 
 
 @dataclass
@@ -70,6 +73,7 @@ def make_tasks(paths, columns, options: Options) -> list[Task]:
 # -- executors -------------------------------------------------------------------------------------
 def _serial(tasks):
     for task in tasks:
+        interrupts.check()
         yield process_record(task)
 
 
@@ -95,9 +99,18 @@ def _size(task) -> int:
         return 0
 
 
+def _init_pool_worker() -> None:
+    """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
+    the workers itself (a worker interrupted on its own would only print a traceback)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    init_worker()
+
+
 def _pool(tasks, jobs):
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     plots = any(t.options.plots for t in tasks)
     # Not plain fork: the parent may already run OpenMP threads (numba's parallel solver), and
@@ -115,22 +128,120 @@ def _pool(tasks, jobs):
         import threading
 
         threading.Thread(target=_import_plots, daemon=True).start()
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
+    others = _child_processes()
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker)
+    finished = False
+    try:
         # the largest files first (longer records take longer), so that no long record is left
         # alone at the end while the other workers idle; results are placed by index, so the
         # reports do not depend on this order
         futures = {pool.submit(process_record, t): t for t in sorted(tasks, key=_size, reverse=True)}
-        try:
-            for fut in as_completed(futures):
+        waiting = set(futures)
+        while waiting:
+            # a short wait, so that an interrupt whose exception was swallowed still stops the run
+            done, waiting = wait(waiting, timeout=0.25, return_when=FIRST_COMPLETED)
+            interrupts.check()
+            for fut in done:
                 try:
                     yield fut.result()
                 except Exception as exc:  # the worker process died (e.g. out of memory)
                     t = futures[fut]
                     yield {"index": t.index, "record": t.record_id, "file": t.path, "rows": [],
                            "plot": None, "failure": failure(t, "worker", exc)}
-        except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
+        finished = True
+    finally:
+        if finished:
+            pool.shutdown(wait=True)
+        else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
+            _stop(pool, others)
+
+
+def _child_processes() -> set:
+    """This process's live child processes: those of :mod:`multiprocessing` and, on Linux, any other
+    (the fork server, which :mod:`multiprocessing` does not list)."""
+    import multiprocessing
+
+    children = {("mp", p.pid, p) for p in multiprocessing.active_children()}
+    try:
+        for task in os.listdir("/proc/self/task"):
+            with open(f"/proc/self/task/{task}/children") as fh:
+                children |= {("pid", int(pid), None) for pid in fh.read().split()}
+    except (OSError, ValueError):  # not Linux: the fork server ends when this process does
+        pass
+    return children
+
+
+def _stop(pool, others, grace: float = 1.0) -> None:
+    """Stop ``pool`` now: pending records cancelled, its workers (and the fork server it started)
+    terminated, killed if they have not ended after ``grace`` seconds.  Processes in ``others``
+    (children that existed before the pool) are left alone."""
+    import signal
+    import time
+
+    with interrupts.deferred():
+        pool.shutdown(wait=False, cancel_futures=True)
+        known = {pid for _, pid, _ in others}
+        mine = [(pid, proc) for kind, pid, proc in _child_processes() if pid not in known]
+        # the resource tracker is left running: it ends by itself when this process does, and
+        # this process's queues still report to it
+        mine = [(pid, proc) for pid, proc in mine if proc is not None or not _is_resource_tracker(pid)]
+        seen = set()
+        targets = []
+        for pid, proc in mine:
+            if pid not in seen:
+                seen.add(pid)
+                targets.append((pid, proc))
+        for pid, proc in targets:
+            _signal(pid, proc, signal.SIGTERM)
+        deadline = time.monotonic() + grace
+        for pid, proc in targets:
+            if proc is not None:
+                proc.join(max(0.0, deadline - time.monotonic()))
+        for pid, proc in targets:
+            if proc is not None and proc.is_alive():
+                proc.kill()
+                proc.join(1.0)
+            elif proc is None:
+                _reap(pid, deadline)
+
+
+def _signal(pid, proc, signum) -> None:
+    with contextlib.suppress(OSError):
+        if proc is not None:
+            proc.terminate()
+        else:
+            os.kill(pid, signum)
+
+
+def _reap(pid, deadline) -> None:
+    """Kill a child that :mod:`multiprocessing` does not track (the fork server) if it has not ended
+    by ``deadline``.  It is not waited for: :mod:`multiprocessing` reaps it (and starts a new one
+    if this process runs another pool)."""
+    import signal
+    import time
+
+    while _alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    if _alive(pid):
+        with contextlib.suppress(OSError):
+            os.kill(pid, signal.SIGKILL)
+
+
+def _alive(pid) -> bool:
+    """Whether ``pid`` runs (a process that has ended but is not reaped yet does not)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] not in (b"Z", b"X")
+    except (OSError, IndexError):
+        return False
+
+
+def _is_resource_tracker(pid) -> bool:
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as fh:
+            return b"resource_tracker" in fh.read()
+    except OSError:
+        return False
 
 
 def dask_client(address: str, jobs: int | None):
@@ -187,13 +298,99 @@ def _import_plots():
         pass
 
 
+# -- the output folder -------------------------------------------------------------------------------
+def prepare_output(out, tasks, plots: bool) -> report.Outputs:
+    """Check the output folder before any work is done (:class:`ArgumentError` otherwise): a folder
+    (created if needed) that can be written to; no input among the files the run would write; and
+    its fixed reports (``summary.csv`` ...), where present, written by an earlier run."""
+    out = pathlib.Path(out)
+    shown = report.display(out)
+    if os.path.lexists(out) and not out.is_dir():
+        raise ArgumentError(f"--out {shown} exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(dir=out, prefix=".pipeline-probe.")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ArgumentError(f"--out {shown} is not a folder this run can write to: "
+                            f"{exc.strerror or exc}") from None
+    try:
+        outputs = report.Outputs(out)
+    except report.NotOurs as exc:
+        raise ArgumentError(f"--out {shown}: {exc}; choose another folder") from None
+    fixed = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.MANIFEST]
+    if plots:
+        fixed.append(report.SUMMARY_PLOT)
+    written = fixed + [report.record_csv_name(t.record_id) for t in tasks]
+    if plots:
+        written += [report.record_plot_name(t.record_id) for t in tasks]
+    inputs = {}
+    for t in tasks:
+        with contextlib.suppress(OSError, ValueError):
+            st = os.stat(t.path)
+            inputs[(st.st_dev, st.st_ino)] = t.path
+    for rel in written:
+        try:
+            st = os.stat(out / rel)
+        except (OSError, ValueError):
+            continue
+        if (st.st_dev, st.st_ino) in inputs:
+            raise ArgumentError(f"the report {report.display(out / rel)} would overwrite the input "
+                                f"{report.display(inputs[(st.st_dev, st.st_ino)])}; choose another --out")
+    for rel in fixed[:3] + fixed[4:]:
+        try:
+            outputs.check(rel)
+        except report.NotOurs as exc:
+            raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
+    return outputs
+
+
+def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, say) -> None:
+    """Write (or remove, for a failed record) the record's own report and figure; a problem doing so
+    makes the record a failure of stage ``write`` (the batch goes on)."""
+    rid = res["record"]
+    problems = []
+    try:
+        if res["rows"]:
+            outputs.write(report.record_csv_name(rid), report.csv_text(FIELDS, res["rows"]))
+        else:  # a report from an earlier run would look like this record's
+            outputs.remove(report.record_csv_name(rid))
+    except OSError as exc:
+        problems.append(exc)
+    if plots:
+        try:
+            if res.get("plot"):
+                outputs.write(report.record_plot_name(rid), res["plot"])
+            else:
+                outputs.remove(report.record_plot_name(rid))
+        except OSError as exc:
+            problems.append(exc)
+    res["plot"] = None  # thousands of records: keep only the rows in memory
+    for exc in problems:
+        say(f"pipeline run: {rid}: {report.display(exc)}")
+    if problems and not res["failure"]:
+        res["failure"] = failure(task, "write", problems[0])
+
+
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None) -> RunSummary:
-    """Process ``paths`` for ``columns`` and write every report into ``out``."""
+    """Process ``paths`` for ``columns`` and write every report into ``out``.
+
+    Raises
+    ------
+    ArgumentError
+        When ``out`` is no folder this run can write to, or holds files in the run's way (see
+        :func:`prepare_output`); nothing is computed then.
+    KeyboardInterrupt
+        On Ctrl-C (:class:`pipeline.interrupts.Interrupted` for SIGINT or SIGTERM while
+        :func:`pipeline.interrupts.handling` is active): workers stopped, reports already written
+        complete, no temporary file left.
+    """
     out = pathlib.Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     tasks = make_tasks(paths, columns, options)
+    outputs = prepare_output(out, tasks, options.plots)
     if progress is None:
         progress = (not quiet) and sys.stderr.isatty()
     bar = None
@@ -216,43 +413,39 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
             print(msg, file=sys.stderr)
 
     results = [None] * len(tasks)
-    plots_dir = out / "plots"
+    stream = execute(tasks, jobs=jobs, dask=dask)
     try:
-        for res in execute(tasks, jobs=jobs, dask=dask):
+        for res in stream:
             results[res["index"]] = res
-            rid = res["record"]
-            if res["rows"]:
-                report.write_record_csv(out, rid, res["rows"])
-            else:
-                report.remove_quietly(report.record_csv_path(out, rid))
-            if res.get("plot"):
-                report.write_atomic(plots_dir / f"{rid}.png", res["plot"])
-                res["plot"] = None  # thousands of records: keep only the rows in memory
-            elif options.plots:
-                report.remove_quietly(plots_dir / f"{rid}.png")
+            _write_record(outputs, tasks[res["index"]], res, options.plots, say)
             if res["failure"]:
                 f = res["failure"]
-                say(f"pipeline run: {rid}: failed ({f['stage']}): {f['reason']}")
+                say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
             if bar is not None:
                 bar.update(1)
     finally:
-        if bar is not None:
-            bar.close()
+        with interrupts.deferred():
+            stream.close()  # an interrupted pool is stopped here, at once
+            if bar is not None:
+                bar.close()
+            with contextlib.suppress(OSError):
+                outputs.finish()
 
     rows = [row for res in results for row in res["rows"]]
     failures = [res["failure"] for res in results if res["failure"]]
-    report.write_summary(out, rows)
-    report.write_failures(out, failures)
-    report.write_columns_md(out)
+    outputs.write(report.SUMMARY, report.csv_text(FIELDS, rows))
+    outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
+    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns))
     if options.plots:
         from .plots import summary_figure_png
 
-        report.write_atomic(plots_dir / "summary.png", summary_figure_png(rows))
-    n_failed = sum(1 for res in results if res["failure"])
+        outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
+    outputs.finish()
+    n_failed = len(failures)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out)
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
         if n_failed:
-            msg += f", {n_failed} failed (see {out / 'failures.csv'})"
-        print(f"{msg}; reports in {out}")
+            msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
+        print(f"{msg}; reports in {report.display(out)}")
     return summary

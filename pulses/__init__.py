@@ -4,7 +4,7 @@ from .record import G, Record
 from .scenario import VP_TO_AP, design_pulse, pulse_period
 from .io import read_record
 from .sac import write_sac
-from .fit import Candidate, PulseFit, fit_pulse
+from .fit import Candidate, FitError, PulseFit, fit_pulse
 from .shapes import (
     BETA,
     SHAPES,
@@ -14,12 +14,13 @@ from .shapes import (
     Rectangular,
     SymmetricRicker,
     make_pulse,
+    shape_class,
 )
 
 __all__ = [
     "G", "Record", "BETA", "SHAPES", "Pulse", "Rectangular", "OneSine", "SymmetricRicker",
-    "AntisymmetricRicker", "make_pulse",
-    "RecordError", "read_record", "write_sac", "fit_pulse", "PulseFit", "Candidate",
+    "AntisymmetricRicker", "make_pulse", "shape_class",
+    "RecordError", "read_record", "write_sac", "fit_pulse", "FitError", "PulseFit", "Candidate",
     "design_pulse", "pulse_period", "VP_TO_AP",
 ]
 

@@ -26,6 +26,7 @@ import re
 import numpy as np
 
 from .errors import RecordError
+from .orientation import orientation, seed_orientation
 
 #: one Fortran real: optional sign, digits with optional point (or a point and digits),
 #: optional exponent with E or D
@@ -38,6 +39,16 @@ _NPTS_DT_OLD = re.compile(r"^\s*(\d+)\s+([-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\
                           re.IGNORECASE)
 #: what the third header line says about the quantity and its units
 _UNITS = re.compile(r"IN\s+UNITS\s+OF\s+([A-Z0-9/\^\*\.]+(?:/[A-Z0-9\^\*]+)*)", re.IGNORECASE)
+
+
+#: a component that is an azimuth in degrees: ``228``, ``0``, ``52.5``
+_AZIMUTH_PLAIN = re.compile(r"\d{1,3}(?:\.\d*)?")
+#: a station code then a three-digit azimuth: ``PUL164``, ``H-E06230``, ``LCN260``, ``I-ELC180``
+_AZIMUTH_CODED = re.compile(r"[A-Z][A-Z0-9_-]*?(\d{3})")
+#: vertical components: ``UP``, ``DWN``, ``V``, ``-UP``, ``E06UP``, ``LCN-DWN``
+_VERTICAL = re.compile(r"(?:.*[^A-Z])?(?:UP|DWN|DN|DOWN|V|VERT)|[A-Z0-9-]*?(?:UP|DWN)")
+#: horizontals that state no azimuth: fault-normal, fault-parallel, NGA-West2's H1 and H2
+_HORIZONTAL = {"FN", "FP", "H1", "H2"}
 
 
 def _float(text: str) -> float:
@@ -93,6 +104,27 @@ def _title_fields(line: str) -> dict:
     return out
 
 
+def component_orientation(component: str) -> dict:
+    """``azimuth`` and ``vertical`` (see :mod:`pulses.orientation`) from an AT2 component.
+
+    ``228`` and ``PUL164`` give azimuths 228 and 164 (degrees clockwise from north); ``UP``,
+    ``DWN``, ``V`` and ``-UP`` are vertical; ``FN``, ``FP``, ``H1`` and ``H2`` horizontal with no
+    stated azimuth; anything else says nothing.
+    """
+    code = str(component or "").strip().upper()
+    m = _AZIMUTH_PLAIN.fullmatch(code)
+    if m and float(code) <= 360.0:
+        return orientation(azimuth=float(code))
+    m = _AZIMUTH_CODED.fullmatch(code)
+    if m and float(m.group(1)) <= 360.0:
+        return orientation(azimuth=float(m.group(1)))
+    if _VERTICAL.fullmatch(code):
+        return orientation(vertical=True)
+    if code in _HORIZONTAL:
+        return orientation(vertical=False)
+    return seed_orientation(code)
+
+
 def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
     """Read a PEER ``.AT2`` file.
 
@@ -108,7 +140,8 @@ def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
     dt : float
         Sampling interval, s.
     header : dict
-        ``title``, ``event``, ``date``, ``station``, ``component``, ``quantity``
+        ``title``, ``event``, ``date``, ``station``, ``component``, ``azimuth`` and ``vertical``
+        (where the component states them, see :func:`component_orientation`), ``quantity``
         (``"acceleration"``, ``"velocity"``, ...), ``units`` (as stated, e.g. ``"g"``), ``npts``,
         ``dt``, ``header_style`` (``"NPTS=, DT="`` or ``"NPTS, DT"``) and the four header
         ``lines``.
@@ -154,8 +187,9 @@ def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
     if not (np.isfinite(dt) and dt > 0):
         raise RecordError(f"{path}: header DT={dt!r} is not a positive time step")
     quantity, units = _quantity_and_units(lines[2])
-    header = {"title": lines[1].strip(), **_title_fields(lines[1]), "quantity": quantity,
-              "units": units, "npts": npts, "dt": dt, "header_style": style,
+    fields = _title_fields(lines[1])
+    header = {"title": lines[1].strip(), **fields, **component_orientation(fields["component"]),
+              "quantity": quantity, "units": units, "npts": npts, "dt": dt, "header_style": style,
               "lines": [ln.rstrip() for ln in lines[:4]]}
     return data, dt, header
 

@@ -34,14 +34,14 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
-from .shapes import BETA, SHAPES
+from .shapes import SHAPES, shape_class
 
 #: Tp = MEXH_TP_PER_SCALE * s for PyWavelets' ``mexh`` at scale s (SPEC section 3)
-MEXH_TP_PER_SCALE = math.sqrt(2.0) * math.pi
+MEXH_TP_PER_SCALE = SHAPES["ricker-sym"].pywt[1]
 #: Tp = GAUS3_TP_PER_SCALE * s for PyWavelets' ``gaus3`` at scale s (SPEC section 3)
-GAUS3_TP_PER_SCALE = 2.0 * math.pi / math.sqrt(6.0)
-#: PyWavelets wavelet of each Ricker shape, and its Tp per unit scale
-PYWT_WAVELETS = {"ricker-sym": ("mexh", MEXH_TP_PER_SCALE), "ricker-anti": ("gaus3", GAUS3_TP_PER_SCALE)}
+GAUS3_TP_PER_SCALE = SHAPES["ricker-anti"].pywt[1]
+#: PyWavelets wavelet of each shape that has one, and its Tp per unit scale
+PYWT_WAVELETS = {name: cls.pywt for name, cls in SHAPES.items() if cls.pywt is not None}
 
 
 def _dot(a, b) -> float:
@@ -50,14 +50,22 @@ def _dot(a, b) -> float:
     return float(np.einsum("i,i->", a, b))
 
 
+def _tp_per_scale(shape: str) -> float:
+    cls = shape_class(shape)
+    if cls.pywt is None:
+        raise ValueError(f"pulse shape {shape!r} has no PyWavelets wavelet; those that do: "
+                         f"{', '.join(PYWT_WAVELETS)}")
+    return cls.pywt[1]
+
+
 def tp_from_scale(shape: str, scale: float, dt: float = 1.0) -> float:
     """Pulse period Tp (s) of PyWavelets' ``mexh``/``gaus3`` at ``scale`` (in samples of ``dt`` s)."""
-    return PYWT_WAVELETS[shape][1] * scale * dt
+    return _tp_per_scale(shape) * scale * dt
 
 
 def scale_from_tp(shape: str, tp: float, dt: float = 1.0) -> float:
     """PyWavelets scale (in samples of ``dt`` s) of the Ricker shape with period ``tp`` (s)."""
-    return tp / (PYWT_WAVELETS[shape][1] * dt)
+    return tp / (_tp_per_scale(shape) * dt)
 
 
 def unit_spectrum(shape: str, nu):
@@ -65,46 +73,15 @@ def unit_spectrum(shape: str, nu):
 
     Convention ``W(nu) = integral w(tau) exp(-2 pi i nu tau) d tau`` with the shape's time origin
     (arrival for ``rect``/``sine``, centre for the Rickers); a shape of period ``Tp`` has
-    transform ``Tp W(f Tp)``.
+    transform ``Tp W(f Tp)`` (:meth:`pulses.Pulse.spectrum`).
     """
-    nu = np.asarray(nu, dtype=float)
-    if shape == "ricker-sym":
-        # w = -(1/(2 pi^2)) g'' with g = exp(-pi^2 tau^2), G(nu) = exp(-nu^2)/sqrt(pi)
-        return (2.0 / math.sqrt(math.pi)) * nu**2 * np.exp(-nu**2) + 0j
-    if shape == "ricker-anti":
-        # w = -(1/(beta a^3)) d^3/dtau^3 exp(-a^2 tau^2/2), a = 2 pi / sqrt(3)
-        a = 2.0 * math.pi / math.sqrt(3.0)
-        return (1j * 8.0 * math.pi**3 * math.sqrt(2.0 * math.pi) / (BETA * a**4)) * nu**3 \
-            * np.exp(-2.0 * math.pi**2 * nu**2 / a**2)
-    omega = 2.0 * math.pi * nu
-    one_minus = (1.0 - np.cos(omega)) + 1j * np.sin(omega)  # 1 - exp(-i omega)
-    if shape == "rect":
-        small = np.abs(omega) < 1e-8
-        safe = np.where(small, 1.0, omega)
-        return np.where(small, 1.0 + 0j, one_minus / (1j * safe))
-    if shape == "sine":
-        denom = 4.0 * math.pi**2 - omega**2
-        near = np.abs(np.abs(nu) - 1.0) < 1e-9
-        safe = np.where(near, 1.0, denom)
-        return np.where(near, -0.5j * np.sign(nu), one_minus * (2.0 * math.pi / safe))
-    raise ValueError(f"unknown shape {shape!r}; choose one of {', '.join(SHAPES)}")
+    return shape_class(shape).spectrum(nu)
 
 
 def unit_energy(shape: str) -> float:
     """``integral w(tau)^2 d tau`` of the unit shape (the squared norm of a pulse is ``ap^2 Tp`` times it)."""
-    return _UNIT_ENERGY[shape]
+    return shape_class(shape).energy
 
-
-def _energy(shape):
-    cls = SHAPES[shape]
-    pulse = cls(1.0, 1.0, 0.0)
-    lo, hi = pulse.support
-    tau = np.linspace(lo, hi, 200001)
-    return float(np.trapz(pulse(tau) ** 2, tau)) if hasattr(np, "trapz") else float(
-        np.trapezoid(pulse(tau) ** 2, tau))
-
-
-_UNIT_ENERGY = {"rect": 1.0, "sine": 0.5, "ricker-sym": _energy("ricker-sym"), "ricker-anti": _energy("ricker-anti")}
 
 #: highest frequency kept, in cycles per Tp of the shortest period: above it the Ricker spectra
 #: are below 1e-3 of their peak (rect and sine keep their slowly decaying sinc tails out of
@@ -185,8 +162,8 @@ class Matcher:
         Periods are taken an octave at a time, each with the band (and so the time grid) its
         shortest period needs: a long period is matched on a coarse time grid, which keeps the
         cost proportional to the record length and almost independent of the period range.
-        Allowed times: the centre of a Ricker inside the record, at least half of a rectangular
-        or one-sine pulse inside it.
+        Allowed times: the pulse's centre (:attr:`pulses.Pulse.centre_tau`) inside the record:
+        the centre of a Ricker, at least half of a rectangular or one-sine pulse.
 
         Returns
         -------
@@ -204,11 +181,8 @@ class Matcher:
             stop = max(stop, start + 1)
             group = tps[start:stop]
             share, tau = self._band_share(shape, group)
-            if shape.startswith("ricker"):
-                ok = ((tau >= 0.0) & (tau <= t_end))[None, :]
-            else:
-                half = 0.5 * group[:, None]
-                ok = (tau[None, :] >= -half) & (tau[None, :] <= t_end - half)
+            centre = shape_class(shape).centre_tau * group[:, None]
+            ok = (tau[None, :] >= -centre) & (tau[None, :] <= t_end - centre)
             masked = np.where(ok, share, 0.0)
             in_octave = []
             for sign, k in ((1, int(np.argmax(masked))), (-1, int(np.argmin(masked)))):

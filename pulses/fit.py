@@ -7,7 +7,7 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    maximises the share of the record's energy explained by a pulse of least-squares amplitude.
 2. **Refine** ``ap``, ``Tp`` and ``t0`` by least squares on the record's samples inside a window
    around the pulse (Levenberg-Marquardt with the analytic Jacobian; for the rectangle a grid
-   search over its two edges, see :func:`_refine_rect`).  A straight-line baseline is fitted
+   search over its two edges, see :func:`_refine_edges`).  A straight-line baseline is fitted
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
 
@@ -37,10 +37,10 @@ from .baseline import pgv as _pgv
 from .baseline import significant_duration
 from .cwt import Matcher, _dot, unit_energy
 from .record import G, Record
-from .shapes import BETA, SHAPES, Pulse, make_pulse
+from .shapes import SHAPES, Pulse, make_pulse, shape_class
 
-#: shapes fitted by default, in the order they are reported on ties
-DEFAULT_SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
+#: shapes fitted by default (every registered shape), in the order they are reported on ties
+DEFAULT_SHAPES = tuple(SHAPES)
 #: ratio between neighbouring periods of the coarse grid.  Half a step (3 %) off the true period,
 #: the matched filter still explains 99.8 % of a Ricker's and 97 % of a rectangle's energy, so
 #: the search lands in the right basin and least squares does the rest
@@ -48,8 +48,6 @@ GRID_RATIO = 1.06
 #: for the antisymmetric shapes, a match of the other polarity is refined too when it explains
 #: at least this share of what the best match explains
 SECOND_START = 0.85
-#: shapes that match nearly as well with the opposite polarity half a lobe away
-_TWO_POLARITIES = ("ricker-anti", "sine")
 #: least squares refines the match, it does not replace it: Tp stays within this factor of the
 #: matched period and t0 within one matched period of the matched time (with background motion
 #: that reaches low frequencies, a free fit can trade a short pulse for a long swell of noise)
@@ -58,76 +56,35 @@ TP_LEASH = 1.5
 #: baseline fitted with the pulse is pinned down by the motion around it, so that it does not
 #: trade off against a short pulse
 FIT_MARGIN = 1.0
-#: half-widths of the correlation window around ``t0`` for the Rickers, in Tp
-_WINDOW = {"ricker-sym": (1.0, 1.0), "ricker-anti": (1.25, 1.25)}
+
+
+class FitError(ValueError):
+    """Input the pulse fit cannot use: a record with nothing to fit, or a period range that is
+    not one.  The message is one line that says what is wrong."""
 
 
 # -- sampled unit pulses ---------------------------------------------------------------------
 def unit_samples(shape: str, tp: float, t0: float, t, dt: float) -> np.ndarray:
     """Unit-amplitude pulse at sample times ``t`` (s): point samples, cell averages for ``rect``."""
-    tau = (t - t0) / tp
-    if shape == "sine":
-        return np.where((tau >= 0.0) & (tau <= 1.0), np.sin(2.0 * np.pi * tau), 0.0)
-    if shape == "ricker-sym":
-        x2 = (np.pi * tau) ** 2
-        return (1.0 - 2.0 * x2) * np.exp(-x2)
-    if shape == "ricker-anti":
-        x = (2.0 * np.pi / math.sqrt(3.0)) * tau
-        return (x * x - 3.0) * x * np.exp(-0.5 * x * x) / BETA
-    if shape == "rect":
-        lo = np.maximum(t - 0.5 * dt, t0)
-        hi = np.minimum(t + 0.5 * dt, t0 + tp)
-        return np.clip(hi - lo, 0.0, None) / dt
-    raise ValueError(f"unknown shape {shape!r}; choose one of {', '.join(SHAPES)}")
+    return shape_class(shape).sampled(tp, t0, t, dt)
 
 
 def unit_samples_and_derivatives(shape: str, tp: float, t0: float, t, dt: float):
     """Unit pulse at ``t`` and its derivatives with respect to ``tp`` and ``t0`` (for the Jacobian)."""
-    if shape == "rect":  # cell averages: the edges move through the cells they sit in
-        m = unit_samples(shape, tp, t0, t, dt)
-        lo = np.maximum(t - 0.5 * dt, t0)
-        hi = np.minimum(t + 0.5 * dt, t0 + tp)
-        inside = hi > lo
-        end_moves = inside & (t0 + tp < t + 0.5 * dt)
-        start_moves = inside & (t0 > t - 0.5 * dt)
-        d_tp = end_moves / dt
-        d_t0 = (end_moves.astype(float) - start_moves) / dt
-        return m, d_tp, d_t0
-    tau = (t - t0) / tp
-    if shape == "sine":
-        inside = (tau >= 0.0) & (tau <= 1.0)
-        phase = 2.0 * np.pi * tau
-        m = np.where(inside, np.sin(phase), 0.0)
-        dw = np.where(inside, 2.0 * np.pi * np.cos(phase), 0.0)
-    elif shape == "ricker-sym":
-        x2 = (np.pi * tau) ** 2
-        e = np.exp(-x2)
-        m = (1.0 - 2.0 * x2) * e
-        dw = -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * e
-    else:  # ricker-anti
-        k = 2.0 * np.pi / math.sqrt(3.0)
-        x = k * tau
-        x2 = x * x
-        e = np.exp(-0.5 * x2) / BETA
-        m = (x2 - 3.0) * x * e
-        dw = k * (-x2 * x2 + 6.0 * x2 - 3.0) * e
-    return m, -dw * tau / tp, -dw / tp
+    return shape_class(shape).sampled_with_derivatives(tp, t0, t, dt)
 
 
 def pulse_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
     """Interval (s) over which a candidate's ``correlation`` is measured."""
-    if shape in _WINDOW:
-        before, after = _WINDOW[shape]
-        return t0 - before * tp, t0 + after * tp
-    return t0, t0 + tp
+    lo, hi = shape_class(shape).window_tau
+    return t0 + lo * tp, t0 + hi * tp
 
 
 def _fit_window(shape: str, tp: float, t0: float) -> tuple[float, float]:
     """Interval (s) of samples used by the least-squares refinement: the pulse plus a margin."""
     margin = max(0.5 * tp, FIT_MARGIN)
-    if shape in _WINDOW:  # both Rickers are below 1e-8 of their peak beyond 2 Tp from the centre
-        return t0 - 2.0 * tp - margin, t0 + 2.0 * tp + margin
-    return t0 - margin, t0 + tp + margin
+    lo, hi = shape_class(shape).fit_tau
+    return t0 + lo * tp - margin, t0 + hi * tp + margin
 
 
 def _covers(idx: slice, shape: str, tp: float, t0: float, dt: float, n: int) -> bool:
@@ -193,7 +150,7 @@ class Candidate:
     @property
     def arrival(self) -> float:
         """Time the pulse starts, s: ``t0`` for rect and sine, ``t0 - Tp/2`` for the Rickers."""
-        return self.t0 - 0.5 * self.tp if self.shape.startswith("ricker") else self.t0
+        return self.pulse.arrival
 
     def as_dict(self) -> dict:
         return {"shape": self.shape, "rank": self.rank, "ap_m_s2": self.ap, "ap_g": self.ap_g,
@@ -269,7 +226,7 @@ def default_tp_range(record: Record) -> tuple[float, float]:
     tp_min = max(0.2, 10.0 * record.dt)
     tp_max = min(10.0, 0.25 * record.duration)
     if tp_max <= tp_min:
-        raise ValueError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
+        raise FitError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
                          f"at least {tp_min:g} s")
     return tp_min, tp_max
 
@@ -296,12 +253,11 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     """
     shapes = tuple(DEFAULT_SHAPES if shapes is None else shapes)
     for s in shapes:
-        if s not in SHAPES:
-            raise ValueError(f"unknown pulse shape {s!r}; choose from {', '.join(SHAPES)}")
+        shape_class(s)  # an unknown name fails here, before any work
     if not shapes:
-        raise ValueError("no pulse shape to fit")
-    tp_min, tp_max = tp_range if tp_range is not None else default_tp_range(record)
-    x = record.acc
+        raise FitError("no pulse shape to fit")
+    tp_min, tp_max = default_tp_range(record) if tp_range is None else _checked_tp_range(tp_range, record)
+    x, amplitude = _normalised(record)
     dt = record.dt
     t = np.arange(x.size) * dt  # time from the first sample; record.t_start is added at the end
     matcher = Matcher(x, dt, tp_min, tp_max)
@@ -325,14 +281,48 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         corr = _dot(xw, pw) / denom if denom > 0 else 0.0
         t0_abs = t0 + record.t_start
         window = None if idx is None else (record.t_start + idx.start * dt, record.t_start + (idx.stop - 1) * dt)
+        ap *= amplitude
         candidates.append(Candidate(shape, ap, tp, t0_abs, score, corr, make_pulse(shape, ap, tp, t0_abs),
                                     fit_window=window))
     order = sorted(range(len(candidates)), key=lambda i: -candidates[i].score)
     ranked = [candidates[i] for i in order]
     for k, c in enumerate(ranked, start=1):
         c.rank = k
-    return PulseFit(record.name, ranked, record.pga, _pgv(x, dt), record.duration,
-                    significant_duration(x, dt))
+    return PulseFit(record.name, ranked, record.pga, _pgv(record.acc, dt), record.duration,
+                    significant_duration(record.acc, dt))
+
+
+def _checked_tp_range(tp_range, record: Record) -> tuple[float, float]:
+    """``(tp_min, tp_max)`` as floats; FitError unless ``2 dt < tp_min <= tp_max <= duration``."""
+    try:
+        tp_min, tp_max = (float(v) for v in tp_range)
+    except (TypeError, ValueError):
+        raise FitError(f"tp_range must be two periods in s, got {tp_range!r}") from None
+    if not (math.isfinite(tp_min) and math.isfinite(tp_max) and 0.0 < tp_min <= tp_max):
+        raise FitError(f"tp_range must be two finite periods with 0 < shortest <= longest, got {tp_range!r} s")
+    if tp_min <= 2.0 * record.dt:
+        raise FitError(f"tp_range: the shortest period {tp_min:g} s must span more than two samples "
+                       f"(2 dt = {2.0 * record.dt:g} s)")
+    if tp_max > record.duration:
+        raise FitError(f"tp_range: the longest period {tp_max:g} s exceeds the duration of record "
+                       f"{record.name!r} ({record.duration:g} s)")
+    return tp_min, tp_max
+
+
+def _normalised(record: Record) -> tuple[np.ndarray, float]:
+    """The samples divided by a power of two near their peak, and that power (m/s^2).
+
+    A power of two scales every floating-point operation exactly, so the fit of the normalised
+    samples is the fit of the record, without overflow in its sums of squares of sums of squares.
+    """
+    peak = float(np.max(np.abs(record.acc)))
+    if peak == 0.0:
+        raise FitError(f"record {record.name!r} is zero everywhere: there is no pulse to fit")
+    if not math.isfinite(float(np.dot(record.acc / peak, record.acc / peak)) * peak * peak):
+        raise FitError(f"record {record.name!r}: samples up to {peak:.3g} m/s^2 are too large for their "
+                       "energy (sum of squares) to be a number; check the units")
+    amplitude = math.ldexp(1.0, math.frexp(peak)[1])
+    return record.acc / amplitude, amplitude
 
 
 def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
@@ -348,7 +338,7 @@ def _coarse(matcher: Matcher, shape: str, tps, t_end: float):
     polarities, octaves = matcher.best_match(shape, tps, t_end)
     first = polarities[0]
     picks = [first]
-    if shape in _TWO_POLARITIES and abs(polarities[1][0]) >= SECOND_START * abs(first[0]):
+    if shape_class(shape).antisymmetric and abs(polarities[1][0]) >= SECOND_START * abs(first[0]):
         picks.append(polarities[1])
     for match in octaves:
         if abs(match[0]) < SECOND_START * abs(first[0]):
@@ -380,8 +370,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         return slice(i0, i1)
 
     best = (ap0, tp0, t00, None)
-    if shape == "rect":
-        return _refine_rect(x, t, dt, best, window, baseline, tp0, t00)
+    if shape_class(shape).boxcar:
+        return _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00)
     ap, tp, t0 = ap0, tp0, t00
     for _ in range(3):  # refit when the pulse moved outside the window of the previous pass
         idx = window(tp, t0)
@@ -472,8 +462,8 @@ def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-
     return p, cost
 
 
-def _refine_rect(x, t, dt, best, window, baseline, tp0, t00):
-    """Least squares for the rectangular pulse: a search over its two edges.
+def _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00):
+    """Least squares for a boxcar shape (the rectangular pulse): a search over its two edges.
 
     The cell-averaged rectangle is piecewise linear in its edges, with a kink each time an edge
     crosses a cell boundary, and with background motion the sum of squares has a shallow local
@@ -564,12 +554,12 @@ def _refine_rect(x, t, dt, best, window, baseline, tp0, t00):
         tp_new, t0_new = end - start, start
         if not (math.isfinite(tp_new) and tp_new > dt) or sse((start, end)) > sse((t0, t0 + tp)):
             break
-        A = np.column_stack([unit_samples("rect", tp_new, t0_new, tw, dt)] + extra)
+        A = np.column_stack([unit_samples(shape, tp_new, t0_new, tw, dt)] + extra)
         coef, *_ = np.linalg.lstsq(A, xw, rcond=None)
         ap_new = float(coef[0])
         best = (ap_new, tp_new, t0_new, idx)
         ap, tp, t0 = ap_new, tp_new, t0_new
-        if _covers(idx, "rect", tp, t0, dt, x.size):
+        if _covers(idx, shape, tp, t0, dt, x.size):
             break
     return best
 

@@ -28,7 +28,8 @@ import numpy as np
 from .at2 import _is_at2, read_at2_file
 from .errors import RecordError
 from .record import G, Record
-from .sac import idep_units, shortest_float32
+from .orientation import orientation, seed_orientation
+from .sac import idep_units, sac_orientation, shortest_float32
 from .textfile import hint_from_comments, read_text_file, sniff_text
 from .units import (
     PLAUSIBLE_MAX_G,
@@ -182,7 +183,8 @@ def _read_at2(path):
     except RecordError:
         raise RecordError(f"{path}: the AT2 header states units {header['units']!r}, which are not "
                           f"acceleration units this reader knows") from None
-    meta = {k: header[k] for k in ("event", "date", "station", "component", "title", "header_style")}
+    meta = {k: header[k] for k in ("event", "date", "station", "component", "title", "header_style",
+                                   "azimuth", "vertical") if k in header}
     meta.update(format="at2", npts_header=header["npts"], units_stated=header["units"])
     return values, dt, meta, stated
 
@@ -226,6 +228,7 @@ def _read_obspy(path, fmt, units, trace):
         meta["event"] = str(sac.get("kevnm", "") or "").strip()
         if sac.get("kuser0"):
             meta["sac_name"] = str(sac.get("kuser0")).strip()
+        meta.update(sac_orientation(sac, st.channel))
         quantity, standard = idep_units(sac.get("idep"))
         meta["idep"] = quantity
         if quantity in ("velocity", "displacement"):
@@ -243,10 +246,23 @@ def _read_obspy(path, fmt, units, trace):
         knet = st.get("knet", {})
         meta["event"] = f"M{knet.get('mag', '')} {knet.get('evot', '')}".strip()
         meta["knet_accmax_gal"] = knet.get("accmax")
+        meta.update(knet_orientation(st.channel))
         meta["notes"] = ["K-NET: samples times the header scale factor, mean removed"]
+    else:
+        meta.update(seed_orientation(st.channel))
     if file_format != "KNET" and units is None and stated is None:
         raise RecordError(f"{path}: {file_format} data carry no units; {_units_hint()}")
     return values, dt, meta, stated
+
+
+#: K-NET ``Dir.`` (obspy's channel, KiK-net's 1-6 mapped to NS1 ... UD2) -> orientation
+_KNET_DIRECTIONS = {"NS": orientation(azimuth=0.0), "EW": orientation(azimuth=90.0),
+                    "UD": orientation(vertical=True)}
+
+
+def knet_orientation(channel) -> dict:
+    """``azimuth`` and ``vertical`` from a K-NET or KiK-net direction (``N-S`` 0, ``E-W`` 90, ``U-D``)."""
+    return dict(_KNET_DIRECTIONS.get(str(channel or "").strip().upper()[:2], {}))
 
 
 def _pick_trace(path, stream, trace):

@@ -12,6 +12,7 @@ import os
 import numpy as np
 
 from .errors import RecordError
+from .orientation import orientation, seed_orientation
 from .record import Record
 
 #: SAC ``idep`` enumeration values (as obspy stores them) -> quantity
@@ -31,6 +32,34 @@ def idep_units(idep) -> tuple[str, str | None]:
     return IDEP_QUANTITY.get(idep, f"code {idep}"), IDEP_STANDARD_UNITS.get(idep)
 
 
+def sac_orientation(sac, channel="") -> dict:
+    """``azimuth`` and ``vertical`` (see :mod:`pulses.orientation`) from SAC headers.
+
+    ``cmpinc`` is the angle from vertical-up in degrees: 0 or 180 is vertical, 90 horizontal, and
+    then ``cmpaz`` (degrees clockwise from north) is the azimuth.  Without ``cmpinc`` the channel
+    code ``kcmpnm`` is read as a SEED code (``HNZ`` vertical).
+
+    Parameters
+    ----------
+    sac : mapping
+        The SAC header as obspy gives it (``trace.stats.sac``; undefined fields absent).
+    channel : str, optional
+        The channel code.
+    """
+    cmpinc = sac.get("cmpinc")
+    if cmpinc is None or float(cmpinc) == SAC_UNDEFINED:
+        return seed_orientation(channel)
+    cmpinc = float(cmpinc)
+    if cmpinc in (0.0, 180.0):
+        return orientation(vertical=True)
+    if cmpinc == 90.0:
+        cmpaz = sac.get("cmpaz")
+        if cmpaz is not None and float(cmpaz) != SAC_UNDEFINED:
+            return orientation(azimuth=float(cmpaz))
+        return orientation(vertical=False)
+    return {}  # an inclined component: neither vertical nor horizontal
+
+
 def shortest_float32(value: float) -> float:
     """The shortest decimal that rounds to the same float32 as ``value``.
 
@@ -46,7 +75,8 @@ def write_sac(record: Record, path) -> str:
     This is the SAC standard, so :func:`pulses.read_record` reads the file back without being
     told units.  SAC stores 32-bit floats: samples come back to a relative 6e-8 and ``dt``
     exactly (see :func:`shortest_float32`).  Station, component and event go into ``kstnm``
-    (8 characters), ``kcmpnm`` (8) and ``kevnm`` (16); the record's name into ``kuser0`` (8).
+    (8 characters), ``kcmpnm`` (8) and ``kevnm`` (16); the record's name into ``kuser0`` (8);
+    ``metadata["vertical"]`` and ``metadata["azimuth"]`` into ``cmpinc`` and ``cmpaz``.
 
     Parameters
     ----------
@@ -72,6 +102,12 @@ def write_sac(record: Record, path) -> str:
         value = str(meta.get(key) or "").strip()
         if value:
             setattr(sac, field, value[:width])
+    if meta.get("vertical") is True:
+        sac.cmpinc, sac.cmpaz = 0.0, 0.0
+    elif meta.get("vertical") is False:
+        sac.cmpinc = 90.0
+        if meta.get("azimuth") is not None:
+            sac.cmpaz = float(meta["azimuth"])
     if record.name:
         sac.kuser0 = str(record.name)[:8]
     path = os.fspath(path)

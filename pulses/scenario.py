@@ -3,34 +3,19 @@
 Within about 10 km of the fault the pulse period grows with magnitude, Eq. 6:
 ``ln Tp = -2.9 + 0.5 Mw``, and the velocity pulse has an amplitude ``vp`` of 60-120 cm/s (about
 90 cm/s typical).  The acceleration amplitude then follows from the shape, by integrating it
-once (ground velocity from rest, ``v(t) = int ug''``):
-
-=============  ===========================================================  ====================
-shape          ground velocity                                             ``ap = c vp / Tp``
-=============  ===========================================================  ====================
-rect           ``ap t`` on the pulse, peak ``ap Tp`` at its end              ``c = 1``
-sine           ``ap Tp/(2 pi) (1 - cos(2 pi t/Tp))``, peak ``ap Tp/pi``        ``c = pi``
-ricker-sym     ``ap t exp(-pi^2 t^2/Tp^2)``, peak at ``t = Tp/(pi sqrt 2)``  ``c = pi sqrt(2 e)``
-ricker-anti    ``ap/beta sqrt(3) Tp/(2 pi) (1 - x^2) exp(-x^2/2)``, peak x=0  ``c = 2 pi beta/sqrt 3``
-=============  ===========================================================  ====================
-
-(For the antisymmetric Ricker, ``x = 2 pi t/(sqrt(3) Tp)`` and ``d/dx[(1 - x^2) e^{-x^2/2}] =
-(x^3 - 3x) e^{-x^2/2}``; the side lobes at ``x^2 = 3`` reach only ``2 e^{-3/2} = 0.45`` of the
-central peak.)  The rectangular pulse leaves a residual velocity ``ap Tp``; it is not realisable.
+once (ground velocity from rest, ``v(t) = int ug''``): ``ap = c vp / Tp`` with ``c`` the shape's
+:attr:`pulses.Pulse.vp_to_ap` (1 for the rectangle, pi for the one-sine, ``pi sqrt(2 e)`` for the
+symmetric and ``2 pi beta / sqrt 3`` for the antisymmetric Ricker; each class shows its velocity
+history).  The rectangular pulse leaves a residual velocity ``ap Tp``; it is not realisable.
 """
 from __future__ import annotations
 
 import math
 
-from .shapes import BETA, SHAPES, Pulse, make_pulse
+from .shapes import SHAPES, Pulse, shape_class
 
 #: ``ap = VP_TO_AP[shape] * vp / Tp``: the factor between peak ground velocity and acceleration
-VP_TO_AP = {
-    "rect": 1.0,
-    "sine": math.pi,
-    "ricker-sym": math.pi * math.sqrt(2.0 * math.e),
-    "ricker-anti": 2.0 * math.pi * BETA / math.sqrt(3.0),
-}
+VP_TO_AP = {name: cls.vp_to_ap for name, cls in SHAPES.items()}
 
 #: typical range of near-fault velocity-pulse amplitudes, m/s
 VP_RANGE = (0.6, 1.2)
@@ -46,7 +31,7 @@ def pulse_period(magnitude: float) -> float:
 
 def peak_velocity(pulse: Pulse) -> float:
     """Peak ground velocity (m/s) of a pulse starting from rest, from the closed forms above."""
-    return abs(pulse.ap) * pulse.tp / VP_TO_AP[pulse.shape]
+    return abs(pulse.ap) * pulse.tp / type(pulse).vp_to_ap
 
 
 def design_pulse(magnitude: float, shape: str = "sine", vp: float = 0.9, t0: float = 0.0) -> Pulse:
@@ -69,10 +54,9 @@ def design_pulse(magnitude: float, shape: str = "sine", vp: float = 0.9, t0: flo
         With ``ap = c vp / Tp`` (m/s^2, ``c`` from :data:`VP_TO_AP`).  Mw 7.0, one-sine,
         0.9 m/s: Tp = 1.822 s, ap = 1.552 m/s^2 = 0.158 g.
     """
-    if shape not in SHAPES:
-        raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}")
+    cls = shape_class(shape)
     vp = float(vp)
     if not (math.isfinite(vp) and vp > 0.0):
         raise ValueError(f"vp must be a positive velocity in m/s, got {vp!r}")
     tp = pulse_period(magnitude)
-    return make_pulse(shape, VP_TO_AP[shape] * vp / tp, tp, t0)
+    return cls(cls.vp_to_ap * vp / tp, tp, t0)

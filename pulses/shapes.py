@@ -5,6 +5,13 @@ flips the polarity), period ``tp`` in s and time shift ``t0`` in s.  For the rec
 one-sine pulses ``t0`` is the arrival time (the pulse lives on ``t0 < t < t0 + tp``); for the
 two Ricker wavelets it is the centre.  Calling a shape on an array of times returns the
 ground acceleration in m/s^2.
+
+A shape owns what is known about it, as class attributes and methods on the unit shape
+(amplitude 1, period 1, dimensionless time ``tau = (t - t0) / tp``): its formula and slope,
+support, extrema, Fourier transform, energy, velocity-to-acceleration factor, display name and
+the windows the fitter uses.  Code elsewhere asks the shape (through the registry
+:data:`SHAPES`) and never branches on its name, so a new shape is one new class here, added to
+:data:`SHAPES`, and its tests.
 """
 from __future__ import annotations
 
@@ -20,10 +27,8 @@ BETA = float(
         * math.exp(-(3.0 - math.sqrt(6.0)) / 2.0))
 )
 
-#: Half-width of the support kept for the Ricker wavelets, in periods: beyond it the symmetric
-#: wavelet stays below 2e-19 ap (2.2 Tp) and the antisymmetric one below 3e-20 ap (2.8 Tp), far
-#: below any digit a double-precision solver resolves, so the truncation changes nothing.
-RICKER_HALF_SUPPORT = {"ricker-sym": 2.2, "ricker-anti": 2.8}
+#: ``x = _ANTI_X * tau`` in Eq. 8
+_ANTI_X = 2.0 * math.pi / math.sqrt(3.0)
 
 
 @dataclass(frozen=True)
@@ -38,6 +43,19 @@ class Pulse:
         Pulse period, s (for the Rickers: the period at the peak of the Fourier amplitude).
     t0 : float, optional
         Arrival time (rectangular, one-sine) or centre (Rickers), s.
+
+    Notes
+    -----
+    What a subclass defines, on the unit shape (``tau = (t - t0) / tp``):
+
+    - ``shape`` (short name), ``label`` (display name), ``kind`` (code of the compiled solver);
+    - :meth:`unit` and :meth:`slope` (the formula and its derivative in ``tau``), :meth:`spectrum`
+      (Fourier transform), ``energy`` (``integral unit^2 d tau``), ``vp_to_ap``;
+    - ``support_tau`` (outside it the acceleration is zero), ``extrema_tau``, ``centre_tau``
+      (middle of the pulse: its arrival is half a period earlier), ``antisymmetric``, ``boxcar``;
+    - ``window_tau`` (where the fitter's correlation is measured) and ``fit_tau`` (the samples
+      its least squares uses, before a margin is added);
+    - ``pywt`` (PyWavelets' wavelet of the same curve and Tp per unit scale) where there is one.
     """
 
     ap: float
@@ -46,8 +64,32 @@ class Pulse:
 
     #: short name used across the package: "rect", "sine", "ricker-sym", "ricker-anti"
     shape = "pulse"
+    #: display name
+    label = "pulse"
     #: integer code used by the compiled solver
     kind = 0
+    #: ``(start, end)`` of the unit shape's support, in tau
+    support_tau = (0.0, 1.0)
+    #: tau of the unit shape's extrema inside its support
+    extrema_tau = ()
+    #: tau of the middle of the pulse (its arrival is at ``centre_tau - 1/2``)
+    centre_tau = 0.5
+    #: odd about its centre: it matches a record nearly as well with the opposite polarity
+    #: half a lobe away
+    antisymmetric = False
+    #: ``(start, end)`` in tau of the window over which a fitted pulse's correlation is measured
+    window_tau = (0.0, 1.0)
+    #: ``(start, end)`` in tau of the samples a least-squares fit uses (before its margin)
+    fit_tau = (0.0, 1.0)
+    #: ``integral unit(tau)^2 d tau`` over the support
+    energy = 1.0
+    #: ``ap = vp_to_ap * vp / Tp`` for a pulse of peak ground velocity ``vp`` (from rest)
+    vp_to_ap = 1.0
+    #: ``(PyWavelets name, Tp per unit scale)`` of the same curve, or None
+    pywt = None
+    #: 1 between two edges and 0 elsewhere: sampled as cell averages, piecewise linear in its
+    #: edges, so least squares searches the edges instead of following a gradient
+    boxcar = False
 
     def __post_init__(self):
         for name in ("ap", "tp", "t0"):
@@ -58,20 +100,50 @@ class Pulse:
         if self.tp <= 0.0:
             raise ValueError(f"{type(self).__name__}: tp must be positive, got {self.tp!r} s")
 
-    # -- shape-specific pieces -------------------------------------------------------
+    # -- the unit shape (amplitude 1, period 1) ----------------------------------------------
+    @staticmethod
+    def unit(tau):
+        """Unit-amplitude shape at dimensionless time ``tau = (t - t0) / tp`` (inside the support)."""
+        raise NotImplementedError
+
+    @staticmethod
+    def slope(tau):
+        """``d unit / d tau`` (inside the support)."""
+        raise NotImplementedError
+
     def _unit(self, tau):
-        """Unit-amplitude shape at dimensionless time ``tau = (t - t0) / tp``."""
+        """:meth:`unit` (the name that ``rocking.reference`` and ``benchmarks/baseline.py`` call)."""
+        return self.unit(tau)
+
+    @staticmethod
+    def spectrum(nu):
+        """Fourier transform of the unit shape at frequency ``nu`` (cycles per Tp).
+
+        Convention ``W(nu) = integral w(tau) exp(-2 pi i nu tau) d tau`` with the shape's time
+        origin; a shape of period ``Tp`` has transform ``Tp W(f Tp)``.
+        """
         raise NotImplementedError
 
-    @property
-    def support(self) -> tuple[float, float]:
-        """``(start, end)`` in s outside which the acceleration is zero."""
-        raise NotImplementedError
+    @classmethod
+    def sampled(cls, tp: float, t0: float, t, dt: float) -> np.ndarray:
+        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support.
 
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        """Times (s) where the acceleration or its derivatives jump: solvers split there."""
-        return self.support
+        Point samples; a shape whose point samples do not locate it finer than ``dt`` (the
+        rectangle) overrides this with cell averages over ``[t - dt/2, t + dt/2]``.
+        """
+        tau = (t - t0) / tp
+        lo, hi = cls.support_tau
+        return np.where((tau >= lo) & (tau <= hi), cls.unit(tau), 0.0)
+
+    @classmethod
+    def sampled_with_derivatives(cls, tp: float, t0: float, t, dt: float):
+        """:meth:`sampled` and its derivatives with respect to ``tp`` and ``t0`` (for a Jacobian)."""
+        tau = (t - t0) / tp
+        lo, hi = cls.support_tau
+        inside = (tau >= lo) & (tau <= hi)
+        m = np.where(inside, cls.unit(tau), 0.0)
+        dw = np.where(inside, cls.slope(tau), 0.0)
+        return m, -dw * tau / tp, -dw / tp
 
     # -- common API -------------------------------------------------------------------
     def __call__(self, t):
@@ -80,7 +152,28 @@ class Pulse:
         start, end = self.support
         tau = (t - self.t0) / self.tp
         inside = (t >= start) & (t <= end)
-        return np.where(inside, self.ap * self._unit(tau), 0.0)
+        return np.where(inside, self.ap * self.unit(tau), 0.0)
+
+    @property
+    def support(self) -> tuple[float, float]:
+        """``(start, end)`` in s outside which the acceleration is zero."""
+        lo, hi = self.support_tau
+        return (self.t0 + lo * self.tp, self.t0 + hi * self.tp)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times (s) where the acceleration or its derivatives jump: solvers split there."""
+        return self.support
+
+    @property
+    def extrema(self) -> list[float]:
+        """Times (s) of the extrema of the acceleration inside its support."""
+        return [self.t0 + tau * self.tp for tau in self.extrema_tau]
+
+    @property
+    def arrival(self) -> float:
+        """Time the pulse starts, s: half a period before its centre."""
+        return self.t0 + (self.centre_tau - 0.5) * self.tp
 
     @property
     def omega_p(self) -> float:
@@ -114,18 +207,59 @@ class Pulse:
         return f"{type(self).__name__}(ap={self.ap:.6g}, tp={self.tp:.6g}, t0={self.t0:.6g})"
 
 
+def _one_minus_exp(omega):
+    """``1 - exp(-i omega)``."""
+    return (1.0 - np.cos(omega)) + 1j * np.sin(omega)
+
+
 class Rectangular(Pulse):
-    """Housner's rectangular pulse: ``ap`` for ``t0 < t < t0 + tp`` (design pulse of Eq. 31)."""
+    """Housner's rectangular pulse: ``ap`` for ``t0 < t < t0 + tp`` (design pulse of Eq. 31).
+
+    It leaves a residual velocity ``ap Tp``: it is not realisable, only a design idealisation.
+    """
 
     shape = "rect"
+    label = "rectangular"
     kind = 1
+    boxcar = True
+    energy = 1.0
+    #: peak velocity ``ap Tp`` at its end
+    vp_to_ap = 1.0
 
-    def _unit(self, tau):
+    @staticmethod
+    def unit(tau):
         return np.ones_like(tau)
 
-    @property
-    def support(self):
-        return (self.t0, self.t0 + self.tp)
+    @staticmethod
+    def slope(tau):
+        return np.zeros_like(tau)
+
+    @staticmethod
+    def spectrum(nu):
+        omega = 2.0 * math.pi * np.asarray(nu, dtype=float)
+        small = np.abs(omega) < 1e-8
+        safe = np.where(small, 1.0, omega)
+        return np.where(small, 1.0 + 0j, _one_minus_exp(omega) / (1j * safe))
+
+    @classmethod
+    def sampled(cls, tp, t0, t, dt):
+        # point samples cannot place the edges closer than dt: the cell averages can
+        lo = np.maximum(t - 0.5 * dt, t0)
+        hi = np.minimum(t + 0.5 * dt, t0 + tp)
+        return np.clip(hi - lo, 0.0, None) / dt
+
+    @classmethod
+    def sampled_with_derivatives(cls, tp, t0, t, dt):
+        # cell averages: the edges move through the cells they sit in
+        m = cls.sampled(tp, t0, t, dt)
+        lo = np.maximum(t - 0.5 * dt, t0)
+        hi = np.minimum(t + 0.5 * dt, t0 + tp)
+        inside = hi > lo
+        end_moves = inside & (t0 + tp < t + 0.5 * dt)
+        start_moves = inside & (t0 > t - 0.5 * dt)
+        d_tp = end_moves / dt
+        d_t0 = (end_moves.astype(float) - start_moves) / dt
+        return m, d_tp, d_t0
 
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
@@ -137,23 +271,38 @@ class OneSine(Pulse):
     """One-sine pulse, Eq. 9: ``ap sin(2 pi (t - t0) / tp)`` for ``t0 < t < t0 + tp``."""
 
     shape = "sine"
+    label = "one-sine"
     kind = 2
+    extrema_tau = (0.25, 0.75)
+    antisymmetric = True
+    energy = 0.5
+    #: velocity ``ap Tp/(2 pi) (1 - cos(2 pi t/Tp))``, peak ``ap Tp / pi``
+    vp_to_ap = math.pi
 
-    def _unit(self, tau):
+    @staticmethod
+    def unit(tau):
         return np.sin(2.0 * np.pi * tau)
 
-    @property
-    def support(self):
-        return (self.t0, self.t0 + self.tp)
+    @staticmethod
+    def slope(tau):
+        return 2.0 * np.pi * np.cos(2.0 * np.pi * tau)
+
+    @staticmethod
+    def spectrum(nu):
+        nu = np.asarray(nu, dtype=float)
+        omega = 2.0 * math.pi * nu
+        denom = 4.0 * math.pi**2 - omega**2
+        near = np.abs(np.abs(nu) - 1.0) < 1e-9
+        safe = np.where(near, 1.0, denom)
+        return np.where(near, -0.5j * np.sign(nu), _one_minus_exp(omega) * (2.0 * math.pi / safe))
 
 
 class _Ricker(Pulse):
-    """The Ricker wavelets' common part: a support of :data:`RICKER_HALF_SUPPORT` periods each side."""
+    """The Ricker wavelets' common part: centred on ``t0``, with a truncated support."""
 
-    @property
-    def support(self):
-        half = RICKER_HALF_SUPPORT[self.shape] * self.tp
-        return (self.t0 - half, self.t0 + half)
+    centre_tau = 0.0
+    #: both Rickers are below 1e-8 of their peak beyond 2 Tp from the centre
+    fit_tau = (-2.0, 2.0)
 
 
 class SymmetricRicker(_Ricker):
@@ -164,11 +313,36 @@ class SymmetricRicker(_Ricker):
     """
 
     shape = "ricker-sym"
+    label = "symmetric Ricker"
     kind = 3
+    #: beyond 2.2 Tp the wavelet stays below 2e-19 ap, far below any digit a double-precision
+    #: solver resolves, so the truncation changes nothing
+    support_tau = (-2.2, 2.2)
+    extrema_tau = (-math.sqrt(1.5) / math.pi, 0.0, math.sqrt(1.5) / math.pi)
+    #: holds all but 1e-3 of the amplitude
+    window_tau = (-1.0, 1.0)
+    #: ``integral (1 - 2 u^2)^2 exp(-2 u^2) du / pi`` with ``u = pi tau``
+    energy = 3.0 / (4.0 * math.sqrt(2.0 * math.pi))
+    #: velocity ``ap t exp(-pi^2 t^2 / Tp^2)``, peak at ``t = Tp / (pi sqrt 2)``
+    vp_to_ap = math.pi * math.sqrt(2.0 * math.e)
+    #: ``mexh`` at scale ``s`` is Eq. 7 with ``x = sqrt(2) pi t / Tp``: ``Tp = sqrt(2) pi s``
+    pywt = ("mexh", math.sqrt(2.0) * math.pi)
 
-    def _unit(self, tau):
+    @staticmethod
+    def unit(tau):
         x2 = (np.pi * tau) ** 2
         return (1.0 - 2.0 * x2) * np.exp(-x2)
+
+    @staticmethod
+    def slope(tau):
+        x2 = (np.pi * tau) ** 2
+        return -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * np.exp(-x2)
+
+    @staticmethod
+    def spectrum(nu):
+        # w = -(1/(2 pi^2)) g'' with g = exp(-pi^2 tau^2), G(nu) = exp(-nu^2)/sqrt(pi)
+        nu = np.asarray(nu, dtype=float)
+        return (2.0 / math.sqrt(math.pi)) * nu**2 * np.exp(-nu**2) + 0j
 
 
 class AntisymmetricRicker(_Ricker):
@@ -180,21 +354,56 @@ class AntisymmetricRicker(_Ricker):
     """
 
     shape = "ricker-anti"
+    label = "antisymmetric Ricker"
     kind = 4
+    #: beyond 2.8 Tp the wavelet stays below 3e-20 ap
+    support_tau = (-2.8, 2.8)
+    #: where ``x^2 = 3 -+ sqrt(6)``
+    extrema_tau = tuple(sgn * math.sqrt(3.0 + d * math.sqrt(6.0)) * (math.sqrt(3.0) / (2.0 * math.pi))
+                        for sgn in (-1, 1) for d in (-1, 1))
+    antisymmetric = True
+    #: holds all but 1e-3 of the amplitude
+    window_tau = (-1.25, 1.25)
+    #: ``integral (x^2 - 3)^2 x^2 exp(-x^2) dx / (a beta^2)`` with ``x = a tau``
+    energy = 15.0 * math.sqrt(math.pi) / (8.0 * _ANTI_X * BETA**2)
+    #: velocity ``ap/beta sqrt(3) Tp/(2 pi) (1 - x^2) exp(-x^2/2)``, peak at ``x = 0`` (the side
+    #: lobes at ``x^2 = 3`` reach only ``2 exp(-3/2) = 0.45`` of it)
+    vp_to_ap = 2.0 * math.pi * BETA / math.sqrt(3.0)
+    #: ``gaus3`` at scale ``s`` is Eq. 8 with ``u = x / sqrt(2)``: ``Tp = 2 pi s / sqrt(6)``
+    pywt = ("gaus3", 2.0 * math.pi / math.sqrt(6.0))
 
-    def _unit(self, tau):
+    @staticmethod
+    def unit(tau):
         x = 2.0 * np.pi * tau / np.sqrt(3.0)
         return (x * x - 3.0) * x * np.exp(-0.5 * x * x) / BETA
 
+    @staticmethod
+    def slope(tau):
+        x = 2.0 * np.pi * tau / np.sqrt(3.0)
+        x2 = x * x
+        return _ANTI_X * (-x2 * x2 + 6.0 * x2 - 3.0) * np.exp(-0.5 * x2) / BETA
 
-#: shape name -> class
+    @staticmethod
+    def spectrum(nu):
+        # w = -(1/(beta a^3)) d^3/dtau^3 exp(-a^2 tau^2/2), a = 2 pi / sqrt(3)
+        nu = np.asarray(nu, dtype=float)
+        a = _ANTI_X
+        return (1j * 8.0 * math.pi**3 * math.sqrt(2.0 * math.pi) / (BETA * a**4)) * nu**3 \
+            * np.exp(-2.0 * math.pi**2 * nu**2 / a**2)
+
+
+#: shape name -> class: the registry every other module iterates
 SHAPES = {cls.shape: cls for cls in (Rectangular, OneSine, SymmetricRicker, AntisymmetricRicker)}
+
+
+def shape_class(shape: str) -> type[Pulse]:
+    """The class of a shape from its short name; ValueError for an unknown name."""
+    try:
+        return SHAPES[shape]
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}") from None
 
 
 def make_pulse(shape: str, ap: float, tp: float, t0: float = 0.0) -> Pulse:
     """Build a pulse from its short name (``"rect"``, ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``)."""
-    try:
-        cls = SHAPES[shape]
-    except KeyError:
-        raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}") from None
-    return cls(ap, tp, t0)
+    return shape_class(shape)(ap, tp, t0)

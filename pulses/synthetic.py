@@ -9,7 +9,7 @@ A synthetic record is a pulse of given shape, amplitude, period and time, plus o
 - a baseline drift: a straight line in acceleration, ``drift * |ap| * (t / T - 1/2)``.
 
 The pulse is sampled at the sample times (the rectangular pulse as its average over each
-sample's cell, from its antiderivative, so that its edges are defined below ``dt``).
+sample's cell, so that its edges are defined below ``dt``), as the fitter samples it.
 """
 from __future__ import annotations
 
@@ -17,20 +17,17 @@ import numpy as np
 from scipy import signal
 
 from .record import Record
-from .shapes import make_pulse
+from .shapes import make_pulse, shape_class
 
 #: default band of the background motion, Hz
 NOISE_BAND = (0.5, 10.0)
 
 
 def sampled_pulse(shape: str, ap: float, tp: float, t0: float, t, dt: float) -> np.ndarray:
-    """Samples of a pulse at times ``t`` (s): point values, cell averages for ``rect``."""
-    t = np.asarray(t, dtype=float)
-    if shape == "rect":
-        def antiderivative(s):
-            return ap * np.clip(s - t0, 0.0, tp)
-        return (antiderivative(t + 0.5 * dt) - antiderivative(t - 0.5 * dt)) / dt
-    return make_pulse(shape, ap, tp, t0)(t)
+    """Samples of a pulse at times ``t`` (s): point values, cell averages for ``rect``
+    (:meth:`pulses.Pulse.sampled`)."""
+    make_pulse(shape, ap, tp, t0)  # checks the name and the values
+    return ap * shape_class(shape).sampled(tp, t0, np.asarray(t, dtype=float), dt)
 
 
 def band_noise(n: int, dt: float, rms: float, rng, band=NOISE_BAND) -> np.ndarray:

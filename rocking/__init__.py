@@ -15,3 +15,9 @@ __all__ += [
 from .solver import BatchResult, RockingResult, linear_error_estimate, simulate, simulate_many
 
 __all__ += ["BatchResult", "RockingResult", "linear_error_estimate", "simulate", "simulate_many"]
+from .frame import equivalent_size, eta_frame, frame_p
+
+__all__ += ["equivalent_size", "eta_frame", "frame_p"]
+from .fragility import CriticalScale, Fragility, critical_scale, fragility
+
+__all__ += ["CriticalScale", "Fragility", "critical_scale", "fragility"]

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 from pulses import G
 
+from .frame import check_cap_mass_ratio, eta_frame, frame_p
+
 #: slenderness at which Eq. 5 gives a perfectly plastic impact (eta = 0): asin(sqrt(2/3))
 ALPHA_PLASTIC = math.asin(math.sqrt(2.0 / 3.0))
 
@@ -29,9 +31,15 @@ class Block:
     alpha : float
         Slenderness angle ``atan(b/h)``, rad, in (0, pi/2).
     eta : float, optional
-        Coefficient of restitution of the angular velocity at impact; default Eq. 5.
+        Coefficient of restitution of the angular velocity at impact; default Eq. 5 (for a frame,
+        :func:`rocking.frame.eta_frame`).
     height, width : float, optional
         Full dimensions in m, when known (set by :meth:`from_dimensions`).
+    cap_mass_ratio : float, optional
+        A rocking frame (SPEC section 8): columns capped by a free beam of ``cap_mass_ratio``
+        times their total mass.  ``p`` is then the frame's (see :meth:`from_dimensions`); 0 (the
+        default) is the lone column.  Not part of equality: blocks with the same ``p``,
+        ``alpha`` and ``eta`` rock alike.
     """
 
     p: float
@@ -39,6 +47,7 @@ class Block:
     eta: float | None = None
     height: float | None = field(default=None, compare=False)
     width: float | None = field(default=None, compare=False)
+    cap_mass_ratio: float = field(default=0.0, compare=False)
 
     def __post_init__(self):
         p, alpha = float(self.p), float(self.alpha)
@@ -46,23 +55,36 @@ class Block:
             raise ValueError(f"Block: p must be positive and finite, got {self.p!r} rad/s")
         if not (math.isfinite(alpha) and 0.0 < alpha < math.pi / 2):
             raise ValueError(f"Block: alpha must lie in (0, pi/2) rad, got {self.alpha!r}")
-        eta = eta_housner(alpha) if self.eta is None else float(self.eta)
+        gamma = check_cap_mass_ratio(self.cap_mass_ratio)
+        if self.eta is not None:
+            eta = float(self.eta)
+        else:
+            eta = eta_housner(alpha) if gamma == 0.0 else eta_frame(alpha, gamma)
         if not (math.isfinite(eta) and 0.0 <= eta <= 1.0):
             raise ValueError(f"Block: eta must lie in [0, 1], got {self.eta!r}")
         object.__setattr__(self, "p", p)
         object.__setattr__(self, "alpha", alpha)
         object.__setattr__(self, "eta", eta)
+        object.__setattr__(self, "cap_mass_ratio", gamma)
 
     @classmethod
-    def from_dimensions(cls, height: float, width: float, eta: float | None = None) -> "Block":
-        """Block of full ``height`` and ``width`` (m): ``R = sqrt(h^2 + b^2)``, ``p = sqrt(3g/4R)``."""
+    def from_dimensions(cls, height: float, width: float, eta: float | None = None, *,
+                        cap_mass_ratio: float = 0.0) -> "Block":
+        """Block of full ``height`` and ``width`` (m): ``R = sqrt(h^2 + b^2)``, ``p = sqrt(3g/4R)``.
+
+        With ``cap_mass_ratio = gamma > 0``: a rocking frame of such columns capped by a free beam
+        of ``gamma`` times their total mass (SPEC section 8), ``p`` multiplied by
+        ``sqrt((1 + 2 gamma)/(1 + 3 gamma))`` and ``eta`` defaulting to the frame's.
+        """
+        gamma = check_cap_mass_ratio(cap_mass_ratio)
         height, width = float(height), float(width)
         if not (math.isfinite(height) and height > 0.0 and math.isfinite(width) and width > 0.0):
             raise ValueError(f"Block: height and width must be positive and finite, got "
                              f"{height!r} x {width!r} m")
         radius = math.hypot(height / 2.0, width / 2.0)
-        return cls(math.sqrt(3.0 * G / (4.0 * radius)), math.atan2(width, height), eta,
-                   height=height, width=width)
+        p = frame_p(math.sqrt(3.0 * G / (4.0 * radius)), gamma)
+        return cls(p, math.atan2(width, height), eta, height=height, width=width,
+                   cap_mass_ratio=gamma)
 
     @classmethod
     def from_tan_alpha(cls, p: float, tan_alpha: float, eta: float | None = None) -> "Block":
@@ -71,7 +93,8 @@ class Block:
 
     @property
     def R(self) -> float:
-        """Half-diagonal ``sqrt(h^2 + b^2)``, m (from ``p`` when built from ``p``)."""
+        """Half-diagonal ``sqrt(h^2 + b^2)``, m, from ``p`` (a frame's: the size of the lone
+        column that rocks like it, ``R (1 + 3 gamma)/(1 + 2 gamma)``)."""
         return 3.0 * G / (4.0 * self.p**2)
 
     @property
@@ -98,5 +121,7 @@ class Block:
         dims = ""
         if self.height is not None:
             dims = f", {self.height:g} x {self.width:g} m"
+        if self.cap_mass_ratio:
+            dims += f", cap_mass_ratio={self.cap_mass_ratio:g}"
         return (f"Block(p={self.p:.6g} rad/s, alpha={self.alpha:.6g} rad "
                 f"(tan {self.tan_alpha:.4g}), eta={self.eta:.4g}{dims})")

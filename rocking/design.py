@@ -22,6 +22,7 @@ import numpy as np
 from pulses import G, make_pulse
 
 from .block import Block
+from .frame import check_cap_mass_ratio, frame_p
 
 #: failure criteria: which verdict of the solver counts as failure
 CRITERIA = ("overturn", "exceed")
@@ -362,7 +363,8 @@ def _unit_pulse(shape, tp):
 
 
 def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_scan=N_SCAN,
-                          n_zone=None, rtol=RTOL, model="fast", refine="all", ksection=KSECTION):
+                          n_zone=None, rtol=RTOL, model="fast", refine="all", ksection=KSECTION,
+                          cap_mass_ratio=0.0):
     """Exact minimum slenderness for many ``(pTp, ap/g)`` points of one pulse shape at once.
 
     By the similarity law (SPEC section 4) the answer depends only on ``pTp`` and ``ap/g``, so
@@ -372,9 +374,11 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     ``refine="top"`` refines only the transition that decides ``tan_alpha`` (the others, and so
     :attr:`MinSlenderness.safe_islands`, stay at scan resolution) and ``ksection=2`` refines by
     bisection: the same ``tan_alpha`` (to ``rtol``) from fewer runs, which is what
-    ``pipeline run`` needs for a few blocks per record.
+    ``pipeline run`` needs for a few blocks per record.  ``cap_mass_ratio``: a rocking frame
+    (``p_tp`` is then the frame's ``p`` times ``Tp``; its ``eta`` at each slenderness).
     """
     _check_criterion(criterion)
+    gamma = check_cap_mass_ratio(cap_mass_ratio)
     p_tp = np.atleast_1d(np.asarray(p_tp, dtype=float)).ravel()
     ap_over_g = np.atleast_1d(np.asarray(ap_over_g, dtype=float)).ravel()
     p_tp, ap_over_g = np.broadcast_arrays(p_tp, ap_over_g)
@@ -388,7 +392,8 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     known[:, -1] = True            # tan(alpha) = ap/g: never uplifts
 
     def evaluate(idx, tans):
-        blocks = [Block(float(p_tp[i]), math.atan(t)) for i, t in zip(idx, tans)]
+        blocks = [Block(float(p_tp[i]), math.atan(t), cap_mass_ratio=gamma)
+                  for i, t in zip(idx, tans)]
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
     scan = _scan_refine(evaluate, x, known=known, rtol=rtol, zone=n_zone != 0, n_zone=n_zone,
@@ -410,7 +415,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
 
 
 def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, n_zone=None, rtol=RTOL,
-                    model="fast"):
+                    model="fast", cap_mass_ratio=0.0):
     """Exact minimum slenderness (SPEC section 5, the paper's Fig. 8).
 
     The smallest ``tan(alpha)`` for which a block of frequency parameter ``p`` survives
@@ -435,6 +440,9 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, n_zone=Non
         be missed); relative width of the final brackets.
     model : str
         Solver model of :func:`rocking.simulate_many` (``"fast"`` or ``"reference"``).
+    cap_mass_ratio : float
+        A rocking frame (SPEC section 8): ``p`` is then the frame's (``block.p``) and ``eta``
+        the frame's at each slenderness; 0, the lone column.
 
     Returns
     -------
@@ -442,6 +450,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, n_zone=Non
         with ``.tan_alpha`` and ``.transitions``.
     """
     _check_criterion(criterion)
+    gamma = check_cap_mass_ratio(cap_mass_ratio)
     p = float(p)
     if not (math.isfinite(p) and p > 0):
         raise ValueError(f"p must be positive, got {p!r}")
@@ -450,7 +459,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, n_zone=Non
             return MinSlenderness(0.0, (), p, criterion, 0.0, 0.0, 0, pulse)
         res = min_slenderness_batch(pulse.shape, p * pulse.tp, abs(pulse.ap) / G,
                                     criterion=criterion, n_scan=n_scan, n_zone=n_zone, rtol=rtol,
-                                    model=model)[0]
+                                    model=model, cap_mass_ratio=cap_mass_ratio)[0]
         res.p, res.excitation = p, pulse
         return res
     # a record (or any excitation the solver accepts): scan tan(alpha) directly
@@ -461,7 +470,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=N_SCAN, n_zone=Non
     known[:, -1] = True
 
     def evaluate(idx, tans):
-        blocks = [Block(p, math.atan(t)) for t in tans]
+        blocks = [Block(p, math.atan(t), cap_mass_ratio=gamma) for t in tans]
         return _failed(_batch(blocks, pulse, None, model=model), criterion)
 
     scan = _scan_refine(evaluate, x, known=known, rtol=rtol, refine="top", zone=n_zone != 0,
@@ -578,6 +587,7 @@ class RequiredWidth:
     transitions: tuple = ()
     runs: int = 0
     eta: float | None = None
+    cap_mass_ratio: float = 0.0
 
     @property
     def tan_alpha(self) -> float:
@@ -585,7 +595,8 @@ class RequiredWidth:
 
     @property
     def block(self) -> Block:
-        return Block.from_dimensions(self.height, self.width, self.eta)
+        return Block.from_dimensions(self.height, self.width, self.eta,
+                                     cap_mass_ratio=self.cap_mass_ratio)
 
     @property
     def p(self) -> float:
@@ -596,15 +607,16 @@ class RequiredWidth:
         return math.atan2(self.width, self.height)
 
 
-def _p_of(height, width):
-    return math.sqrt(3.0 * G / (4.0 * math.hypot(height / 2.0, width / 2.0)))
+def _p_of(height, width, gamma=0.0):
+    return frame_p(math.sqrt(3.0 * G / (4.0 * math.hypot(height / 2.0, width / 2.0))), gamma)
 
 
 RULES = ("eq31", "envelope", "eq20", "exact")
 
 
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
-                   shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=RTOL, model="fast"):
+                   shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=RTOL, model="fast",
+                   cap_mass_ratio=0.0):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -635,6 +647,9 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         of the final bracket.  For a record only the top transition is refined
         (its verdicts may change hundreds of times with the width) and the widths scanned are
         chosen adaptively; the answer holds at the resolution stated in :func:`_record_width`.
+    cap_mass_ratio : float
+        The width of the columns of a rocking frame whose beam has this mass over the columns'
+        total mass (SPEC section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
 
     Returns
     -------
@@ -646,9 +661,10 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         raise ValueError(f"height must be positive, got {height!r} m")
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
+    gamma = check_cap_mass_ratio(cap_mass_ratio)
     if rule == "exact":
         return _exact_width(height, excitation, criterion=criterion, eta=eta, n_scan=n_scan,
-                            rtol=rtol, model=model, n_zone=n_zone)
+                            rtol=rtol, model=model, n_zone=n_zone, gamma=gamma)
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
         raise ValueError(f"rule={rule!r} needs a pulse (ap, Tp); for a whole record fit its pulse "
                          "first or use rule='exact'")
@@ -664,7 +680,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     # steps.  Started from the no-uplift width H ap/g, an upper bound of the answer.
     width = height * ap / G
     for it in range(1, 201):
-        new = height * f(_p_of(height, width))
+        new = height * f(_p_of(height, width, gamma))
         if abs(new - width) <= 1e-13 * max(height, 1.0):
             width = new
             break
@@ -672,22 +688,24 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     else:  # pragma: no cover - the map is a strong contraction for any realistic column
         from scipy.optimize import brentq
 
-        width = brentq(lambda b: b - height * f(_p_of(height, b)), 0.0, height * ap / G + 1e-300,
+        width = brentq(lambda b: b - height * f(_p_of(height, b, gamma)), 0.0, height * ap / G + 1e-300,
                        xtol=1e-14)
     return RequiredWidth(width=float(width), height=height, rule=rule, iterations=it,
                          method=f"fixed point of {rule} in B (p depends on B): "
-                                f"{it} iterations", eta=eta)
+                                f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
 
 
-def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None):
+def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None,
+                 gamma=0.0):
     _check_criterion(criterion)
     top = height * _peak(excitation) / G       # wider than this the column never uplifts
     if top <= 0:
-        return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion)
+        return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion,
+                             cap_mass_ratio=gamma)
 
     def runs(widths):
-        return _batch([Block.from_dimensions(height, float(b), eta) for b in widths], excitation,
-                      None, model=model)
+        return _batch([Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma)
+                       for b in widths], excitation, None, model=model)
 
     def evaluate(idx, widths):
         return _failed(runs(widths), criterion)
@@ -698,9 +716,11 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
             res = runs(widths)
             return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
 
-        return _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
-                             n_scan=REC_SCAN if n_scan is None else n_scan, rtol=rtol,
-                             n_zone=REC_ZONE_POINTS if n_zone is None else n_zone)
+        res = _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
+                            n_scan=REC_SCAN if n_scan is None else n_scan, rtol=rtol,
+                            n_zone=REC_ZONE_POINTS if n_zone is None else n_zone)
+        res.cap_mass_ratio = gamma
+        return res
     x = _scan_points(np.array([top]), N_SCAN if n_scan is None else n_scan)
     known = np.zeros(x.shape, dtype=bool)
     known[:, -1] = True
@@ -718,7 +738,7 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                 f"refinement of {len(br)} verdict change(s) ({scan.runs} solver runs in "
                 f"{scan.calls} batches)"),
         criterion=criterion, transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br),
-        runs=scan.runs, eta=eta)
+        runs=scan.runs, eta=eta, cap_mass_ratio=gamma)
 
 
 #: Verified width under a whole record (:func:`_record_width`): ``REC_SCAN`` widths geometric from

@@ -312,3 +312,95 @@ def test_pipeline_fit_table_csv_json_plot(tmp_path, capsys):
     assert main(["fit", str(tmp_path / "missing.AT2"), sac]) == 1  # one bad file: reported, others fitted
     captured = capsys.readouterr()
     assert "no such file" in captured.err and "ricker-anti" in captured.out
+
+
+# -- the shape registry ----------------------------------------------------------------------------------
+@pytest.mark.parametrize("shape", SHAPES)
+def test_shape_slope_and_extrema(shape):
+    cls = pulses.SHAPES[shape]
+    lo, hi = cls.support_tau
+    tau = np.linspace(lo, hi, 2001)[1:-1]
+    h = 1e-6
+    # central differences of the formula: error O(h^2 unit''') ~ 1e-10 against slopes of order 10
+    numeric = (cls.unit(tau + h) - cls.unit(tau - h)) / (2 * h)
+    np.testing.assert_allclose(cls.slope(tau), numeric, atol=1e-7)
+    for x in cls.extrema_tau:  # an extremum: zero slope, and no larger value within 1e-3 Tp
+        assert abs(float(cls.slope(np.array([x]))[0])) < 1e-12
+        around = np.abs(cls.unit(np.array([x - 1e-3, x + 1e-3])))
+        assert np.all(around <= abs(float(cls.unit(np.array([x]))[0])))
+    pulse = cls(2.0, 1.5, 0.3)
+    # the arrival is half a period before the centre: t0 for rect and sine, t0 - Tp/2 for the Rickers
+    assert pulse.arrival == pytest.approx(0.3 - (0.75 if shape.startswith("ricker") else 0.0))
+
+
+def test_unknown_shape_fails_loudly():
+    from pulses.cwt import unit_spectrum as spectrum
+    from pulses.fit import unit_samples
+
+    for call in (lambda: pulses.make_pulse("triangle", 1.0, 1.0), lambda: pulses.shape_class("triangle"),
+                 lambda: unit_samples("triangle", 1.0, 0.0, np.zeros(3), 0.01),
+                 lambda: spectrum("triangle", np.zeros(3)), lambda: tp_from_scale("sine", 1.0),
+                 lambda: fit_pulse(synthetic_record("sine", 1.0, 1.0, 5.0, 20.0, DT), shapes=["triangle"])):
+        with pytest.raises(ValueError):
+            call()
+
+
+class _Gaussian(pulses.Pulse):
+    """A shape defined only here: ``exp(-pi tau^2)``, Fourier transform ``exp(-pi nu^2)``."""
+
+    shape = "gauss-test"
+    support_tau = (-3.0, 3.0)
+    centre_tau = 0.0
+    window_tau = (-1.0, 1.0)
+    fit_tau = (-2.0, 2.0)
+    energy = 1.0 / math.sqrt(2.0)  # integral exp(-2 pi tau^2)
+
+    @staticmethod
+    def unit(tau):
+        return np.exp(-np.pi * tau**2)
+
+    @staticmethod
+    def slope(tau):
+        return -2.0 * np.pi * tau * np.exp(-np.pi * tau**2)
+
+    @staticmethod
+    def spectrum(nu):
+        return np.exp(-np.pi * np.asarray(nu, dtype=float) ** 2) + 0j
+
+
+def test_a_new_shape_is_one_class(monkeypatch):
+    # matching, refinement and results ask the shape, never its name: a shape registered in
+    # SHAPES is fitted like the others, to the noise-free bar of 1e-4
+    monkeypatch.setitem(pulses.SHAPES, _Gaussian.shape, _Gaussian)
+    rec = synthetic_record("gauss-test", -3.0, 1.3, 8.2, 20.0, DT)
+    c = fit_pulse(rec, shapes=["gauss-test", "sine"]).best
+    assert c.shape == "gauss-test" and isinstance(c.pulse, _Gaussian)
+    assert (c.ap, c.tp, c.t0) == pytest.approx((-3.0, 1.3, 8.2), rel=1e-4)
+    assert c.arrival == pytest.approx(8.2 - 0.65)
+
+
+# -- bad input ----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("tp_range,words", [((0, 0), "0 < shortest <= longest"), ((-1, 5), "0 < shortest"),
+                                            ((5, 1), "shortest <= longest"), ((float("nan"), 2), "finite"),
+                                            ((0.005, 2), "more than two samples"), ((0.5, 1e9), "exceeds"),
+                                            (3.0, "two periods")])
+def test_bad_tp_range_is_a_one_line_value_error(tp_range, words):
+    rec = synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, DT)
+    with pytest.raises(pulses.FitError, match=words) as err:
+        fit_pulse(rec, tp_range=tp_range)
+    assert isinstance(err.value, ValueError) and "\n" not in str(err.value)
+
+
+def test_records_with_nothing_to_fit_or_too_large_are_refused():
+    rec = synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, DT, noise=0.15, seed=1)
+    for bad, words in ((Record(np.zeros(4001), DT), "zero everywhere"), (rec.scaled(1e300), "too large")):
+        with pytest.raises(pulses.FitError, match=words) as err:
+            fit_pulse(bad)
+        assert isinstance(err.value, ValueError) and "\n" not in str(err.value)
+    # the fit is linear in the record: scaled by 2^500 or 2^-900 (exact in binary floating point,
+    # far beyond where sums of squares would overflow or underflow) it is the same fit, scaled
+    base = fit_pulse(rec).best
+    for k in (500, -900):
+        c = fit_pulse(rec.scaled(2.0**k)).best
+        assert (c.shape, c.tp, c.t0, c.score) == (base.shape, base.tp, base.t0, base.score)
+        assert c.ap == base.ap * 2.0**k

@@ -14,7 +14,7 @@ import pytest
 import pulses
 import rocking
 from pipeline import report
-from pipeline.batch import Column, Options, record_ids
+from pipeline.batch import FAILURE_FIELDS, Column, Options, record_ids
 from pipeline.cli import main
 from pulses import G
 
@@ -119,7 +119,7 @@ def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20)
     assert not list(out.glob("missing*.csv")) and not list(out.glob(".*"))  # no stray temp files
     # every column of the reports is explained in columns.md, with a unit
     md = (out / "columns.md").read_text()
-    for name in list(summary[0]) + list(report.FAILURE_FIELDS):
+    for name in list(summary[0]) + list(FAILURE_FIELDS):
         assert f"| `{name}` |" in md
     import re
 
@@ -251,6 +251,7 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
     assert "interrupted" in err and "Traceback" not in err
     files = [p for p in out.rglob("*") if p.is_file()]
     assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
+    files = [p for p in files if p.name != report.MANIFEST]  # the list of files written, not a report
     for path in files:  # every report written is whole: the header and one row
         rows = read_csv(path)
         assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
@@ -461,3 +462,43 @@ def test_example_records_regenerate_identically(tmp_path):
         assert rec.metadata["units"] == "nm/s2" and rec.metadata["units_source"] == "file"
         assert 20.0 <= rec.duration <= 30.0 and rec.dt == 0.01
     assert (tmp_path / "examples.csv").read_bytes() == (DATA / "examples.csv").read_bytes()
+
+
+# -- shared record options; --trace in run -----------------------------------------------------------
+def test_record_options_are_the_same_for_every_reading_command():
+    """fit, convert, run and simulate take the same record options and read them the same way."""
+    from pipeline.args import record_options
+    from pipeline.cli import build_parser
+
+    parser = build_parser()
+    common = ["--units", "gal", "--dt", "0.005", "--column", "2", "--format", "text", "--trace", "HNN"]
+    argvs = {"fit": ["fit", "x.txt"], "convert": ["convert", "x.txt", "--to", "sac", "--out", "o"],
+             "run": ["run", "x.txt", "--block", "7.5x1.8"], "simulate": ["simulate", "--block", "7.5x1.8",
+                                                                          "--record", "x.txt"]}
+    parsed = {name: record_options(parser.parse_args(argv + common)) for name, argv in argvs.items()}
+    expected = {"format": "text", "units": "cm/s2", "dt": 0.005, "column": 2, "trace": "HNN"}
+    assert all(opts == expected for opts in parsed.values()), parsed
+
+
+def test_run_reads_the_trace_asked_for(tmp_path):
+    """A two-trace MiniSEED file: without --trace the record fails with a message naming --trace;
+    with --trace HNN the report's PGA is that trace's peak (numpy's max of the samples written)."""
+    from obspy import Stream, Trace
+
+    traces = []
+    for k, (channel, ap_g) in enumerate([("HNE", 0.3), ("HNN", 0.5)]):
+        t, acc = synthetic(40 + k, ap_g=ap_g)
+        tr = Trace(data=acc.astype(np.float64))
+        tr.stats.delta, tr.stats.station, tr.stats.channel = t[1] - t[0], "STA", channel
+        traces.append(tr)
+    path = tmp_path / "two.mseed"
+    Stream(traces).write(str(path), format="MSEED", encoding="FLOAT64")
+    args = ["--units", "m/s2", "--block", "7.5x1.8", "--shapes", "sine", "--no-plots", "-q"]
+    assert main(["run", str(path), *args, "--out", str(tmp_path / "a")]) == 1
+    (fail,) = read_csv(tmp_path / "a" / "failures.csv")
+    assert fail["stage"] == "read" and "--trace" in fail["reason"]
+    assert main(["run", str(path), *args, "--trace", "HNN", "--out", str(tmp_path / "b")]) == 0
+    (row,) = read_csv(tmp_path / "b" / "two.csv")
+    peak = np.max(np.abs(traces[1].data)) / G
+    assert float(row["pga_g"]) == pytest.approx(peak, rel=1e-5)  # 6 significant digits written
+    assert row["component"] in ("HNN", "")

@@ -93,6 +93,96 @@ def test_obspy_reads_at2_through_the_plugin():
     assert _read_at2(str(path))[0].stats.station == "Rinaldi Receiving Sta"
 
 
+# -- component orientation: metadata["azimuth"] and metadata["vertical"] -------------------------
+# (file, component azimuth in degrees): the "component" column of ../shared/records/MANIFEST.md
+AT2_AZIMUTHS = [
+    ("Rinaldi228.AT2", 228), ("Rinaldi318.AT2", 318), ("NGA_no_1063_RRS228.AT2", 228),
+    ("RSN77_SFERN_PUL164.AT2", 164), ("RSN181_IMPVALL.H_H-E06230.AT2", 230),
+    ("RSN181_IMPVALL.H_H-E06140.AT2", 140), ("RSN879_LANDERS_LCN260.AT2", 260),
+    ("RSN879_LANDERS_LCN345.AT2", 345), ("RSN1084_NORTHR_SCS052.AT2", 52),
+    ("RSN1084_NORTHR_SCS142.AT2", 142), ("RSN6_IMPVALL.I_I-ELC180.AT2", 180),
+    ("RSN15_KERN_TAF021.AT2", 21), ("RSN68_SFERN_PEL090.AT2", 90), ("RSN125_FRIULI.A_A-TMZ000.AT2", 0),
+    ("RSN30_PARKF_C05085.AT2", 85), ("haselREC_NGA-West2-Reduced/RSN77_2.AT2", 254),
+    ("haselREC_NGA-West2-Reduced/RSN150_1.AT2", 230), ("haselREC_NGA-West2-Reduced/RSN150_2.AT2", 320),
+    ("haselREC_NGA-West2-Reduced/RSN250_1.AT2", 0), ("haselREC_NGA-West2-Reduced/RSN250_2.AT2", 90),
+    ("haselREC_NGA-West2-Reduced/RSN159_1.AT2", 3), ("haselREC_NGA-West2-Reduced/RSN159_2.AT2", 273),
+    ("haselREC_NGA-West2-Reduced/RSN6_2.AT2", 270), ("shahi_baker_examples/example1.AT2", 140),
+    ("shahi_baker_examples/example2.AT2", 230),
+]
+
+
+@pytest.mark.parametrize("name,azimuth", AT2_AZIMUTHS)
+def test_at2_azimuth_from_header(name, azimuth):
+    meta = read_record(shared_record(name)).metadata
+    assert meta["azimuth"] == azimuth and isinstance(meta["azimuth"], float)
+    assert meta["vertical"] is False
+
+
+@pytest.mark.parametrize("component,expect", [
+    # NGA-West2 and older PEER component codes: a station code then the azimuth
+    ("PUL164", {"azimuth": 164.0, "vertical": False}), ("H-E06230", {"azimuth": 230.0, "vertical": False}),
+    ("LCN260", {"azimuth": 260.0, "vertical": False}), ("360", {"azimuth": 0.0, "vertical": False}),
+    ("UP", {"vertical": True}), ("DWN", {"vertical": True}), ("V", {"vertical": True}),
+    ("-UP", {"vertical": True}), ("E06UP", {"vertical": True}), ("HNZ", {"vertical": True}),
+    ("FN", {"vertical": False}),
+    ("", {}), ("Somewhere", {}), ("400", {}),  # nothing stated, or not an angle: nothing said
+])
+def test_at2_component_codes(tmp_path, component, expect):
+    path = tmp_path / "c.AT2"
+    path.write_text("PEER NGA STRONG MOTION DATABASE RECORD\n"
+                    f"Test-01, 1/2/2000, Somewhere, {component}\n"
+                    "ACCELERATION TIME SERIES IN UNITS OF G\nNPTS=   12, DT=   .0100 SEC,\n"
+                    + "  .1E-01 -.2E-01  .3E-01 -.4E-01  .5E-01\n" * 2 + "  .1E-01 -.2E-01\n")
+    meta = read_record(path).metadata
+    assert {k: meta[k] for k in ("azimuth", "vertical") if k in meta} == expect
+
+
+def test_knet_direction_gives_azimuth():
+    meta = read_record(shared_record("obspy_test_data/test.knet")).metadata
+    assert meta["component"] == "EW"  # header "Dir. E-W" (MANIFEST: component E-W)
+    assert meta["azimuth"] == 90.0 and meta["vertical"] is False
+
+
+@pytest.mark.parametrize("cmpinc,cmpaz,kcmpnm,expect", [
+    (90.0, 228.0, None, {"azimuth": 228.0, "vertical": False}),
+    (90.0, None, None, {"vertical": False}),          # horizontal, azimuth not stated
+    (0.0, 0.0, None, {"vertical": True}), (180.0, None, None, {"vertical": True}),
+    (45.0, 30.0, None, {}),                           # inclined: neither
+    (None, 228.0, None, {}),                          # cmpaz without cmpinc says nothing
+    (None, None, "HNZ", {"vertical": True}), (None, None, "HN1", {"vertical": False}),
+])
+def test_sac_cmpinc_cmpaz(tmp_path, cmpinc, cmpaz, kcmpnm, expect):
+    from obspy.io.sac import SACTrace
+
+    sac = SACTrace(data=(0.3 * G * np.sin(np.linspace(0, 20, 500))).astype(np.float32), delta=0.01,
+                   idep="iacc")
+    if cmpinc is not None:
+        sac.cmpinc = cmpinc
+    if cmpaz is not None:
+        sac.cmpaz = cmpaz
+    if kcmpnm is not None:
+        sac.kcmpnm = kcmpnm
+    sac.write(str(tmp_path / "o.sac"))
+    meta = read_record(tmp_path / "o.sac", units="m/s2").metadata
+    assert {k: meta[k] for k in ("azimuth", "vertical") if k in meta} == expect
+
+
+def test_orientation_through_sac_and_mseed(tmp_path):
+    from obspy import Trace
+
+    at2 = read_record(shared_record("Rinaldi228.AT2"))
+    back = read_record(write_sac(at2, tmp_path / "r.sac"))  # cmpinc 90, cmpaz 228
+    assert (back.metadata["azimuth"], back.metadata["vertical"]) == (228.0, False)
+    tr = Trace(data=np.asarray(_record().acc, dtype=np.float64))
+    tr.stats.delta, tr.stats.channel = 0.01, "HNZ"
+    tr.write(str(tmp_path / "z.mseed"), format="MSEED")
+    meta = read_record(tmp_path / "z.mseed", units="m/s2").metadata
+    assert meta["vertical"] is True and "azimuth" not in meta
+    text = read_record(shared_record("base_isolation_benchmark/rinaldi.txt"), units="cm/s2", dt=0.005,
+                       column=1).metadata
+    assert "azimuth" not in text and "vertical" not in text  # plain text states neither
+
+
 # -- refusals: one clear RecordError each ----------------------------------------------------------
 def test_missing_empty_truncated_npts(tmp_path):
     with pytest.raises(RecordError, match="no such file"):
