@@ -14,19 +14,13 @@ from __future__ import annotations
 import json
 import sys
 
-from .args import ArgumentError
+from .args import ArgumentError, add_record_options, record_options
 
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
            "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio"]
 #: the subset ``pipeline run`` reports
 RUN_COLUMNS = ["pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "orientation_deg", "azimuth_deg"]
-
-try:  # shared record-reading options (consolidated in args.py where that has them)
-    from .args import add_record_arguments, record_options
-except ImportError:
-    from .cmd_fit import add_record_arguments, record_options
-
 
 def result_row(result, file="", file2="") -> dict:
     """One report row of a :class:`pulses.PulseClassification` (see :data:`COLUMNS`)."""
@@ -67,7 +61,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--pairs", choices=["auto", "none"], default="auto",
                    help="auto (default): pair the other files from their names and headers and "
                         "leave verticals out; none: classify every file as one component")
-    add_record_arguments(p)
+    add_record_options(p)
     p.add_argument("--csv", metavar="FILE", help="write one row per pair or component to this CSV file")
     p.add_argument("--json", action="store_true", help="print the rows as JSON instead of a table")
     p.add_argument("--plot", metavar="DIR", help="draw each classification into DIR/<name>.png")
