@@ -4,9 +4,8 @@ Shahi & Baker's published values (the README's section "Is the record pulse-like
 Run: ``PYTHONPATH=. python benchmarks/classify_records.py [RAW_DIR]`` (default
 ``../shared/records/raw``).  Prints a Markdown table and a summary; the README's table is this
 output.  Record numbers come from ``../shared/records/MANIFEST.md``; published values from
-``../shared/notes/sb14_nga_west2_pulses.csv``.  Where the reader gives no azimuth the AT2
-header's component is used, and for the two-column text files the directions the manifest
-states.  The last columns compare the velocity pulse's Tp with the best fitted acceleration
+``../shared/notes/sb14_nga_west2_pulses.csv``.  Azimuths are the readers' (AT2 headers), and
+for the two-column text files the directions the manifest states.  The last columns compare the velocity pulse's Tp with the best fitted acceleration
 pulse (:func:`pulses.fit_pulse`) of the component in the pulse's direction.
 """
 from __future__ import annotations
@@ -70,13 +69,7 @@ def _published():
 
 
 def _at2(raw, name):
-    record = pulses.read_record(raw / name)
-    if "azimuth" not in record.metadata:
-        try:
-            record.metadata["azimuth"] = float(record.metadata.get("component"))
-        except (TypeError, ValueError):
-            pass
-    return record
+    return pulses.read_record(raw / name)
 
 
 def _text(raw, name, column, azimuth):

@@ -52,15 +52,8 @@ def _published(rsn: int) -> dict:
 
 
 def _read(name: str) -> pulses.Record:
-    """A shared record with ``metadata["azimuth"]`` (from the AT2 header's component where the
-    reader does not set it)."""
-    record = pulses.read_record(shared_record(name))
-    if "azimuth" not in record.metadata:
-        try:
-            record.metadata["azimuth"] = float(record.metadata.get("component"))
-        except (TypeError, ValueError):
-            pass
-    return record
+    """A shared record (its reader states the component's azimuth)."""
+    return pulses.read_record(shared_record(name))
 
 
 def _axis_difference(a: float, b: float) -> float:
@@ -281,6 +274,18 @@ def test_pair_files_from_names_and_headers():
         ("d/Rinaldi228.AT2", "d/Rinaldi318.AT2"), ("d/x1.AT2", "d/x2.AT2"), ("d/a_1.txt", "d/a_2.txt")])
     assert sorted(found.verticals) == sorted(["e/RSN150_3.AT2", "d/RSN181_IMPVALL.H_H-E06-UP.AT2", "d/a_3.txt"])
     assert sorted(found.singles) == sorted(["d/RSN15_KERN_TAF021.AT2", "d/kobe.txt"])
+
+
+def test_pair_files_on_the_shared_records(shared_records):
+    # what the files say (names, headers read by pulses.read_record) pairs every station
+    names = [p for p in sorted(shared_records.rglob("*.AT2"))]
+    meta = {p: pulses.read_record(p).metadata for p in names}
+    found = pair_files(names, metadata=meta)
+    got = {tuple(sorted(str(p.relative_to(shared_records)) for p in pair)) for pair in found.pairs}
+    expected = {tuple(sorted(pair[:2])) for pair in PULSE_PAIRS}
+    expected.add(("RSN6_IMPVALL.I_I-ELC180.AT2", "haselREC_NGA-West2-Reduced/RSN6_2.AT2"))
+    assert got == expected
+    assert not found.verticals
 
 
 def test_pair_files_ambiguous_group_stays_single():
