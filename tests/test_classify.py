@@ -320,6 +320,9 @@ def test_pipeline_classify_command(tmp_path, capsys):
     png = sorted(plots.glob("*.png"))
     assert len(png) == 1
     first_bytes = png[0].read_bytes()
+    import matplotlib.image
+
+    assert matplotlib.image.imread(png[0]).shape[1] >= 1000  # pixels wide
     assert main(["classify", "--pair", str(one), str(two), "--pairs", "none", "--plot", str(plots)]) == 0
     assert png[0].read_bytes() == first_bytes  # deterministic file
     fields = classify_fields(pulses.read_record(one), pulses.read_record(two))
