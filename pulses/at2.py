@@ -22,11 +22,15 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 
 import numpy as np
 
+from . import formats
 from .errors import RecordError
+from .formats import MAX_SAMPLES, too_long
 from .orientation import orientation, seed_orientation
+from .units import canonical_units
 
 #: one Fortran real: optional sign, digits with optional point (or a point and digits),
 #: optional exponent with E or D
@@ -125,13 +129,18 @@ def component_orientation(component: str) -> dict:
     return seed_orientation(code)
 
 
-def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
+def read_at2_file(path, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, float, dict]:
     """Read a PEER ``.AT2`` file.
+
+    The samples are read in blocks of lines, each parsed by numpy, so memory stays
+    proportional to the samples (8 bytes each).
 
     Parameters
     ----------
     path : str or path-like
         The file.
+    max_samples : int, optional
+        A longer record is refused (:data:`pulses.formats.MAX_SAMPLES` by default).
 
     Returns
     -------
@@ -149,38 +158,44 @@ def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
     Raises
     ------
     RecordError
-        For a missing, empty, truncated or corrupt file, or one whose sample count disagrees
-        with ``NPTS``.
+        For a missing, empty, truncated or corrupt file, one whose sample count disagrees
+        with ``NPTS``, or one longer than ``max_samples``.
     """
     path = os.fspath(path)
     try:
         with open(path, "r", encoding="utf-8-sig", errors="replace") as fh:
-            text = fh.read()
+            lines = [fh.readline() for _ in range(4)]
+            lines = [ln for ln in lines if ln]
+            if not "".join(lines).strip() and not _rest_has_text(fh):
+                raise RecordError(f"{path}: the file is empty")
+            if len(lines) < 4:
+                raise RecordError(f"{path}: truncated PEER AT2 file: {len(lines)} line(s), the header alone has 4")
+            npts_dt = parse_npts_dt(lines[3])
+            if npts_dt is None:
+                raise RecordError(f"{path}: not a PEER AT2 file: line 4 should give NPTS and DT "
+                                  f"(e.g. 'NPTS=  1991, DT= .0100 SEC'), found {lines[3].strip()[:60]!r}")
+            npts, dt = npts_dt
+            if npts > max_samples:
+                raise RecordError(too_long(path, max_samples, npts))
+            blocks, count, lineno = [], 0, 4
+            while True:
+                block = fh.readlines(_BLOCK_CHARS)
+                if not block:
+                    break
+                values = _parse_block(path, block, lineno)
+                lineno += len(block)
+                count += values.size
+                if count > max_samples:
+                    raise RecordError(too_long(path, max_samples))
+                blocks.append(values)
     except FileNotFoundError:
         raise RecordError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise RecordError(f"{path}: is a directory, not a record file") from None
     except OSError as exc:
         raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    lines = text.splitlines()
-    if not text.strip():
-        raise RecordError(f"{path}: the file is empty")
-    if len(lines) < 4:
-        raise RecordError(f"{path}: truncated PEER AT2 file: {len(lines)} line(s), the header alone has 4")
-    npts_dt = parse_npts_dt(lines[3])
-    if npts_dt is None:
-        raise RecordError(f"{path}: not a PEER AT2 file: line 4 should give NPTS and DT "
-                          f"(e.g. 'NPTS=  1991, DT= .0100 SEC'), found {lines[3].strip()[:60]!r}")
-    npts, dt = npts_dt
+    data = np.concatenate(blocks) if blocks else np.zeros(0)
     style = "NPTS=, DT=" if _NPTS_DT_NEW.search(lines[3]) else "NPTS, DT"
-    values = []
-    for lineno, line in enumerate(lines[4:], start=5):
-        tokens = _NUMBER.findall(line)
-        rest = _NUMBER.sub("", line)
-        if rest.strip():
-            raise RecordError(f"{path}: line {lineno} is not a list of numbers: {line.strip()[:60]!r}")
-        values.extend(tokens)
-    data = np.array([_float(v) for v in values], dtype=float)
     if data.size != npts:
         what = "truncated" if data.size < npts else "longer than its header says"
         raise RecordError(f"{path}: {what}: header NPTS={npts} but the file holds {data.size} samples")
@@ -192,6 +207,86 @@ def read_at2_file(path) -> tuple[np.ndarray, float, dict]:
               "quantity": quantity, "units": units, "npts": npts, "dt": dt, "header_style": style,
               "lines": [ln.rstrip() for ln in lines[:4]]}
     return data, dt, header
+
+
+#: characters read per block of sample lines
+_BLOCK_CHARS = 1 << 22
+#: characters of a sample block that numpy may parse directly (D exponents turned into E first)
+_FAST_CHARS = set("0123456789.+-EeDd \t\n")
+_D_TO_E = str.maketrans("Dd", "Ee")
+#: a sign that touches the number before it (``-.1E-02-.2E-02``); an exponent's sign follows E
+_TOUCHING_SIGN = re.compile(r"(?<=[\d.])(?=[-+])")
+
+
+def _rest_has_text(fh) -> bool:
+    while True:
+        block = fh.read(_BLOCK_CHARS)
+        if not block:
+            return False
+        if block.strip():
+            return True
+
+
+def _from_text(text: str) -> np.ndarray | None:
+    """The numbers in ``text`` (blank-separated) by numpy, or ``None`` where it stops early."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)  # numpy < 2.? warns where it stops
+        try:
+            return np.fromstring(text, dtype=float, sep=" ")
+        except (ValueError, DeprecationWarning):
+            return None
+
+
+def _parse_block(path: str, lines: list, lineno: int) -> np.ndarray:
+    """The samples of a block of AT2 lines (the first is line ``lineno + 1`` of the file)."""
+    text = "".join(lines)
+    if _FAST_CHARS.issuperset(text):
+        text = text.translate(_D_TO_E)
+        values = _from_text(text)
+        if values is None:
+            values = _from_text(_TOUCHING_SIGN.sub(" ", text))
+        if values is not None:
+            return values
+    # anything numpy did not read is read line by line, to name the line at fault
+    tokens = []
+    for n, line in enumerate(lines, start=lineno + 1):
+        found = _NUMBER.findall(line)
+        if _NUMBER.sub("", line).strip():
+            raise RecordError(f"{path}: line {n} is not a list of numbers: {line.strip()[:60]!r}")
+        tokens.extend(found)
+    return np.array([_float(v) for v in tokens], dtype=float)
+
+
+def read(path: str, options: formats.ReadOptions) -> formats.Reading:
+    """The AT2 format's reader: acceleration only, in the units the header states.
+
+    Raises
+    ------
+    RecordError
+        For a velocity or displacement file (``.VT2``, ``.DT2``), a header that states no
+        units or units that are not acceleration, and every error of :func:`read_at2_file`.
+    """
+    values, dt, header = read_at2_file(path, max_samples=options.max_samples)
+    if header["quantity"] in ("velocity", "displacement"):
+        raise RecordError(f"{path}: this is a {header['quantity']} record ({header['lines'][2].strip()}); "
+                          f"give the acceleration record (.AT2) instead")
+    if header["quantity"] != "acceleration" or header["units"] is None:
+        raise RecordError(f"{path}: the AT2 header does not say 'ACCELERATION ... IN UNITS OF ...': "
+                          f"{header['lines'][2].strip()[:60]!r}")
+    try:
+        stated = canonical_units(header["units"])
+    except RecordError:
+        raise RecordError(f"{path}: the AT2 header states units {header['units']!r}, which are not "
+                          f"acceleration units this reader knows") from None
+    meta = {k: header[k] for k in ("event", "date", "station", "component", "title", "header_style",
+                                   "azimuth", "vertical") if k in header}
+    meta.update(format="at2", npts_header=header["npts"], units_stated=header["units"])
+    return formats.Reading(values, dt, meta, units=stated, units_rule=formats.UNITS_STATED)
+
+
+def detect(path: str) -> bool:
+    """An AT2 file by name (``.AT2``; ``.VT2``, ``.DT2`` to refuse them clearly) or by content."""
+    return str(path).lower().endswith((".at2", ".vt2", ".dt2")) or _is_at2(path)
 
 
 # -- obspy waveform plugin -----------------------------------------------------------------
@@ -223,3 +318,7 @@ def _read_at2(filename, headonly=False, **kwargs):
         tr.stats.npts = header["npts"]
     tr.stats.at2 = AttribDict({k: v for k, v in header.items() if k != "lines"})
     return Stream([tr])
+
+
+FORMAT = formats.register(formats.RecordFormat(name="at2", aliases=("peer",), detect=detect, read=read,
+                                               sniff_order=10))

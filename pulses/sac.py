@@ -1,4 +1,5 @@
-"""SAC files: what ``idep`` says about units, and writing a record as SAC.
+"""SAC files: the record format (read through obspy), what ``idep`` says about units, and writing
+a record as SAC.
 
 By the SAC standard the dependent-variable code ``idep`` gives the quantity *and* its units:
 ``iacc`` means nm/s^2, ``ivel`` nm/s, ``idisp`` nm (SPEC section 7).  Many files in the wild
@@ -11,6 +12,7 @@ import os
 
 import numpy as np
 
+from . import formats, obspyformat
 from .errors import RecordError
 from .orientation import orientation, seed_orientation
 from .record import Record
@@ -69,6 +71,36 @@ def shortest_float32(value: float) -> float:
     return float(np.format_float_positional(np.float32(value), unique=True, trim="-"))
 
 
+def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
+    """Interpret a SAC trace obspy read: ``delta`` as written, ``b``, ``kevnm``, ``idep``'s units.
+
+    Raises
+    ------
+    RecordError
+        For a velocity or displacement record (``idep`` = ``ivel``, ``idisp``).
+    """
+    sac = tr.stats.sac
+    meta = obspyformat.trace_metadata(tr)
+    meta["t_start"] = float(sac.get("b", 0.0) or 0.0)
+    meta["event"] = str(sac.get("kevnm", "") or "").strip()
+    if sac.get("kuser0"):
+        meta["sac_name"] = str(sac.get("kuser0")).strip()
+    meta.update(sac_orientation(sac, tr.stats.channel))
+    quantity, standard = idep_units(sac.get("idep"))
+    meta["idep"] = quantity
+    if quantity in ("velocity", "displacement"):
+        raise RecordError(f"{path}: SAC idep says this is a {quantity} record; records must be ground "
+                          f"acceleration (idep = iacc)")
+    reading = formats.Reading(np.asarray(tr.data, dtype=float),
+                              shortest_float32(sac.get("delta", tr.stats.delta)), meta,
+                              units_rule=formats.UNITS_STANDARD)
+    if quantity == "acceleration":
+        reading.units = standard  # nm/s2 by the SAC standard; the user may override with units=
+    else:
+        reading.no_units = f"SAC idep is {quantity}, so the file does not state its units"
+    return reading
+
+
 def write_sac(record: Record, path) -> str:
     """Write ``record`` as a binary SAC file of ground acceleration in nm/s^2 (``idep = iacc``).
 
@@ -116,3 +148,8 @@ def write_sac(record: Record, path) -> str:
     except OSError as exc:
         raise RecordError(f"{path}: cannot write SAC file: {exc.strerror or exc}") from None
     return path
+
+
+FORMAT = formats.register(formats.RecordFormat(
+    name="sac", obspy_name="SAC", from_trace=from_trace,
+    read=lambda path, options: obspyformat.read(path, options, "SAC")))

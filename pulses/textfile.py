@@ -19,7 +19,9 @@ import re
 
 import numpy as np
 
+from . import formats
 from .errors import RecordError
+from .formats import MAX_SAMPLES, too_long
 
 _SPLIT = re.compile(r"[\s,;]+")
 _COMMENT = ("%", "#", "!", "//")
@@ -51,8 +53,11 @@ def sniff_text(path, max_lines: int = 40) -> bool:
     return bool(numeric) and all(numeric)
 
 
-def read_text_file(path, column: int | None = None):
+def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPLES):
     """Read columns of numbers from a text or CSV file.
+
+    The file is read in blocks of lines, each parsed by numpy, so memory stays proportional to
+    the samples kept (the first column and the chosen one, 8 bytes each a row).
 
     Parameters
     ----------
@@ -61,6 +66,8 @@ def read_text_file(path, column: int | None = None):
     column : int, optional
         Which column holds the acceleration, counted from 1.  Needed when the file has several
         acceleration columns; with one column, or a time column and one other, it may be left out.
+    max_samples : int, optional
+        More rows than this are refused (:data:`pulses.formats.MAX_SAMPLES` by default).
 
     Returns
     -------
@@ -75,47 +82,37 @@ def read_text_file(path, column: int | None = None):
     Raises
     ------
     RecordError
-        For a missing or empty file, ragged or non-numeric rows, an ambiguous column, or a time
-        column that is not uniformly sampled.
+        For a missing or empty file, ragged or non-numeric rows, an ambiguous column, a time
+        column that is not uniformly sampled, or more than ``max_samples`` rows.
     """
     path = os.fspath(path)
     try:
         with open(path, "r", encoding="utf-8-sig") as fh:
-            lines = fh.read().splitlines()
+            parsed = _Rows(path, column, max_samples)
+            while True:
+                lines = fh.readlines(_BLOCK_CHARS)
+                if not lines:
+                    break
+                parsed.add(lines)
     except FileNotFoundError:
         raise RecordError(f"{path}: no such file") from None
     except UnicodeDecodeError:
         raise RecordError(f"{path}: not a text file (and not a format obspy recognises)") from None
     except OSError as exc:
         raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    comments, rows, names = [], [], None
-    for lineno, line in enumerate(lines, start=1):
-        s = line.strip()
-        if not s:
-            continue
-        if s.startswith(_COMMENT):
-            comments.append(s.lstrip("%#!/ ").rstrip())
-            continue
-        tokens = [t for t in _SPLIT.split(s) if t]
-        if not all(_is_number(t) for t in tokens):
-            if not rows and names is None:
-                names = tokens
-                continue
-            raise RecordError(f"{path}: line {lineno} is not a row of numbers: {s[:60]!r}")
-        rows.append((lineno, tokens))
-    if not rows:
+    if not parsed.nrows:
         raise RecordError(f"{path}: the file holds no samples (empty or only comments)")
-    ncols = len(rows[0][1])
-    for lineno, tokens in rows:
-        if len(tokens) != ncols:
-            last = " (truncated last line?)" if lineno == rows[-1][0] else ""
-            raise RecordError(f"{path}: line {lineno} has {len(tokens)} value(s), the first data line "
-                              f"has {ncols}{last}")
-    table = np.array([[float(t) for t in tokens] for _, tokens in rows], dtype=float)
-
-    first = table[:, 0]
+    ncols = parsed.ncols
+    if parsed.ragged is not None:
+        lineno, count = parsed.ragged
+        last = " (truncated last line?)" if lineno == parsed.last_row else ""
+        raise RecordError(f"{path}: line {lineno} has {count} value(s), the first data line "
+                          f"has {ncols}{last}")
+    first = np.concatenate(parsed.first)
+    kept = np.concatenate(parsed.kept) if parsed.kept_index else first
+    names = parsed.names
     named_time = bool(names) and names[0].lower().startswith(("t", "time", "sec"))
-    time_column = ncols >= 2 and table.shape[0] >= 2 and (
+    time_column = ncols >= 2 and first.size >= 2 and (
         named_time or bool(np.all(np.diff(first) > 0)))
     if column is None:
         if ncols == 1:
@@ -140,9 +137,106 @@ def read_text_file(path, column: int | None = None):
             raise RecordError(f"{path}: non-uniform sampling: time steps range from {steps.min():.6g} "
                               f"to {steps.max():.6g} s; resample to a uniform step first")
         dt_from_time = float(dt_mean)
-    info = {"comments": comments, "columns": ncols, "column": column, "time_column": time_column,
+    info = {"comments": parsed.comments, "columns": ncols, "column": column, "time_column": time_column,
             "names": names}
-    return table[:, column - 1].copy(), dt_from_time, info
+    # the chosen column was kept while reading: the first, or the one named (or the second)
+    return (first if column == 1 else kept), dt_from_time, info
+
+
+#: characters of a block that numpy may parse directly: numbers and separators only
+_FAST_CHARS = set("0123456789.+-eE \t\n,;")
+_TO_BLANKS = str.maketrans(",;", "  ")
+#: characters read per block of lines
+_BLOCK_CHARS = 1 << 22
+
+
+class _Rows:
+    """Rows of numbers gathered block by block: comments, header, column count, kept columns.
+
+    A block of plain numeric rows is parsed by :func:`numpy.loadtxt`; any other block (comments,
+    the header row, a bad or ragged row, ``nan``) is read line by line with the same rules, so
+    the messages name the exact line.
+    """
+
+    def __init__(self, path, column, max_samples):
+        self.path, self.column, self.max_samples = path, column, max_samples
+        self.comments, self.names, self.ncols = [], None, None
+        self.first, self.kept, self.kept_index = [], [], None
+        self.nrows, self.lineno, self.last_row, self.ragged = 0, 0, None, None
+
+    def add(self, lines):
+        table = self._fast(lines) if self.ncols is not None and self.ragged is None else None
+        if table is None:
+            table = self._slow(lines)
+        else:
+            self.lineno += len(lines)
+            for back, line in enumerate(reversed(lines)):
+                if line.strip():
+                    self.last_row = self.lineno - back
+                    break
+        if table is not None and table.shape[0]:
+            self._keep(table)
+
+    def _fast(self, lines):
+        block = "".join(lines)
+        if not _FAST_CHARS.issuperset(block):
+            return None
+        if not block.strip():
+            return np.empty((0, self.ncols))
+        try:
+            table = np.loadtxt(block.translate(_TO_BLANKS).splitlines(), ndmin=2, comments=None)
+        except ValueError:
+            return None
+        if table.shape[0] and table.shape[1] != self.ncols:
+            return None
+        return table
+
+    def _slow(self, lines):
+        rows = []
+        for line in lines:
+            self.lineno += 1
+            s = line.strip()
+            if not s:
+                continue
+            if s.startswith(_COMMENT):
+                self.comments.append(s.lstrip("%#!/ ").rstrip())
+                continue
+            tokens = [t for t in _SPLIT.split(s) if t]
+            if not all(_is_number(t) for t in tokens):
+                if self.ncols is None and self.names is None:
+                    self.names = tokens
+                    continue
+                raise RecordError(f"{self.path}: line {self.lineno} is not a row of numbers: {s[:60]!r}")
+            if self.ncols is None:
+                self.ncols = len(tokens)
+            self.last_row = self.lineno
+            if len(tokens) != self.ncols and self.ragged is None:
+                self.ragged = (self.lineno, len(tokens))
+            if self.ragged is None:
+                rows.append([float(t) for t in tokens])
+            else:
+                self._count(1)
+        if self.ragged is not None:
+            if rows:
+                self._keep(np.array(rows, dtype=float))
+            return None
+        return np.array(rows, dtype=float).reshape(len(rows), self.ncols or 0)
+
+    def _count(self, n):
+        self.nrows += n
+        if self.nrows > self.max_samples:
+            raise RecordError(too_long(self.path, self.max_samples))
+
+    def _keep(self, table):
+        self._count(table.shape[0])
+        if self.kept_index is None and self.ncols >= 2:
+            # the first column may be time; keep it and the acceleration column the caller
+            # named (or the second, the one a time column goes with)
+            wanted = int(self.column) - 1 if self.column is not None else 1
+            self.kept_index = wanted if 1 <= wanted < self.ncols else None
+        self.first.append(table[:, 0].copy())
+        if self.kept_index is not None:
+            self.kept.append(table[:, self.kept_index].copy())
 
 
 def hint_from_comments(comments) -> str:
@@ -153,3 +247,18 @@ def hint_from_comments(comments) -> str:
         return ""
     text = " ".join(hits)
     return f" (its comments say: {text[:120]!r})"
+
+
+def read(path: str, options: formats.ReadOptions) -> formats.Reading:
+    """The text format's reader: the chosen column; units and ``dt`` come from the user."""
+    values, dt_time, info = read_text_file(path, column=options.column, max_samples=options.max_samples)
+    meta = {"format": "text", "comments": info["comments"], "columns": info["columns"],
+            "column": info["column"], "time_column": info["time_column"],
+            "component": f"column {info['column']}" if info["columns"] > 1 else ""}
+    hint = hint_from_comments(info["comments"])
+    return formats.Reading(values, dt_time, meta, units_rule=formats.UNITS_NONE, hint=hint,
+                           no_units=f"the file does not state its units{hint}")
+
+
+FORMAT = formats.register(formats.RecordFormat(
+    name="text", aliases=("txt", "csv", "ascii"), detect=sniff_text, read=read, sniff_order=20))
