@@ -7,7 +7,10 @@ into exit status 2.  Units of acceleration are those of :mod:`pulses.units` (one
 from __future__ import annotations
 
 import math
+import os
+import pathlib
 import re
+import tempfile
 
 
 class ArgumentError(ValueError):
@@ -37,7 +40,7 @@ def record_options(args) -> dict:
     """Keyword arguments of :func:`pulses.read_record` from the options of
     :func:`add_record_options` (checked: :class:`ArgumentError` for a bad value)."""
     return {"format": args.format, "units": parse_units(args.units),
-            "dt": None if args.dt is None else parse_positive(args.dt, "--dt (s)"),
+            "dt": None if args.dt is None else parse_dt(args.dt),
             "column": parse_column(args.column), "trace": args.trace}
 
 
@@ -52,6 +55,20 @@ def parse_units(text, what: str = "--units"):
         return canonical_units(text)
     except RecordError as exc:
         raise ArgumentError(f"{what}: {exc}") from None
+
+
+#: sampling intervals accepted, s: strong-motion records are sampled at 50 to 1000 Hz; these
+#: bounds leave room on both sides and stop typing errors (``--dt 5`` for 0.005 s)
+DT_RANGE_S = (1e-5, 1.0)
+
+
+def parse_dt(text) -> float:
+    """``--dt``: a sampling interval in s within :data:`DT_RANGE_S`."""
+    dt = parse_positive(text, "--dt (s)")
+    lo, hi = DT_RANGE_S
+    if not lo <= dt <= hi:
+        raise ArgumentError(f"--dt (s) must lie between {lo:g} s and {hi:g} s, got {dt:g}")
+    return dt
 
 
 def parse_column(text):
@@ -73,8 +90,22 @@ def _finite_positive(value: float, what: str) -> float:
     return value
 
 
+#: sizes of a column accepted on the command line, m: from a 1 cm laboratory specimen to a 1 km
+#: tower; beyond them the numbers are typing errors, and the solver's time and length scales
+#: (p = sqrt(3 g / 4 R)) leave the range it is tested in
+SIZE_RANGE_M = (0.01, 1000.0)
+
+
+def _size(value: float, what: str) -> float:
+    value = _finite_positive(value, what)
+    lo, hi = SIZE_RANGE_M
+    if not lo <= value <= hi:
+        raise ArgumentError(f"{what} must lie between {lo:g} m and {hi:g} m, got {value:g}")
+    return value
+
+
 def parse_block(text: str) -> tuple[float, float]:
-    """``"7.5x1.8"`` -> ``(height, width)`` in m."""
+    """``"7.5x1.8"`` -> ``(height, width)`` in m, each within :data:`SIZE_RANGE_M`."""
     parts = re.split(r"\s*[xX*]\s*", str(text).strip())
     if len(parts) != 2:
         raise ArgumentError(f"--block expects HEIGHTxWIDTH in m, such as 7.5x1.8; got {text!r}")
@@ -82,15 +113,16 @@ def parse_block(text: str) -> tuple[float, float]:
         height, width = float(parts[0]), float(parts[1])
     except ValueError:
         raise ArgumentError(f"--block expects HEIGHTxWIDTH in m, such as 7.5x1.8; got {text!r}") from None
-    return (_finite_positive(height, "block height (m)"), _finite_positive(width, "block width (m)"))
+    return _size(height, "block height (m)"), _size(width, "block width (m)")
 
 
 def parse_length(text: str, what: str = "length (m)") -> float:
+    """A column's size in m (``"6"`` or ``"6m"``), within :data:`SIZE_RANGE_M`."""
     try:
         value = float(str(text).strip().rstrip("m"))
     except ValueError:
         raise ArgumentError(f"{what}: expected a number in m, got {text!r}") from None
-    return _finite_positive(value, what)
+    return _size(value, what)
 
 
 def parse_acceleration(text: str, default_unit: str | None = None, signed: bool = True) -> float:
@@ -160,3 +192,21 @@ def parse_shapes(items):
             else:
                 raise ArgumentError(f"unknown pulse shape {name!r}; choose from {', '.join(SHAPES)} or all")
     return tuple(dict.fromkeys(names))
+
+
+def output_folder(path, what: str = "--out") -> pathlib.Path:
+    """An output folder, created if needed and checked writable before any work is done."""
+    from .report import display
+
+    out = pathlib.Path(path)
+    if os.path.lexists(out) and not out.is_dir():
+        raise ArgumentError(f"{what} {display(out)} exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(dir=out, prefix=".pipeline-probe.")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ArgumentError(f"{what} {display(out)} is not a folder this command can write to: "
+                            f"{exc.strerror or exc}") from None
+    return out

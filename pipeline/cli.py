@@ -40,7 +40,7 @@ def main(argv=None) -> int:
 
     interrupts.reset()
     # from the start: an interrupt while the sub-commands are imported is not lost either
-    with interrupts.handling():
+    with interrupts.handling(to_exit=argv is None):  # argv None: the program itself, about to exit
         try:
             parser = build_parser()
             args = parser.parse_args(argv)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pathlib
 import sys
 
-from .args import ArgumentError, add_record_options, record_options
+from .args import add_record_options, output_folder, record_options
 from .cmd_fit import _with_path
 
 
@@ -55,10 +55,7 @@ def main(args) -> int:
     import pulses
 
     opts = record_options(args)
-    out = pathlib.Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ArgumentError(f"--out {args.out!r} exists and is not a folder")
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(args.out)
     failures = 0
     for path in args.files:
         try:

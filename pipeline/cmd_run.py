@@ -7,6 +7,8 @@ import os
 from .args import ArgumentError, add_record_options, parse_block, parse_length, parse_shapes, record_options
 
 DEFAULT_OUT = "pipeline-output"
+#: most worker processes: each holds the solver and a record (a few hundred MB)
+MAX_JOBS = 256
 
 
 def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
@@ -58,8 +60,8 @@ def parse_jobs(text) -> int | None:
         jobs = int(str(text))
     except ValueError:
         raise ArgumentError(f"--jobs expects a whole number of processes, got {text!r}") from None
-    if jobs < 0:
-        raise ArgumentError(f"--jobs must be 0 (one per CPU) or more, got {jobs}")
+    if not 0 <= jobs <= MAX_JOBS:
+        raise ArgumentError(f"--jobs must be 0 (one per CPU) to {MAX_JOBS}, got {jobs}")
     return jobs or (os.cpu_count() or 1)
 
 

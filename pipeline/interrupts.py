@@ -56,10 +56,13 @@ def _handler(signum, frame):
 
 
 @contextlib.contextmanager
-def handling():
+def handling(to_exit: bool = False):
     """Handle SIGINT and SIGTERM as described in the module's docstring for the block's duration.
 
-    Outside the main thread (where handlers cannot be installed) it does nothing.
+    With ``to_exit`` (the process ends after the block), once a signal has been received further
+    signals are ignored, so that they cannot turn a clean exit into a traceback or a death by
+    signal.  Outside the main thread (where handlers
+    cannot be installed) it does nothing.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -70,9 +73,14 @@ def handling():
         yield
     finally:
         _state.active -= 1
-        if not _state.active:
+        if not _state.active and not (to_exit and _state.signum is not None):
             for sig, old in previous.items():
                 signal.signal(sig, old)
+        elif not _state.active:
+            # ignored, not only noted: Python's exit resets handlers it installed to the default,
+            # and a signal then would kill the process before its exit handlers ran
+            for sig in previous:
+                signal.signal(sig, signal.SIG_IGN)
 
 
 def pending() -> int | None:

@@ -309,10 +309,11 @@ def _digest(raw: bytes) -> str:
 
 
 def _real_folder(folder, top) -> bool:
-    """Whether ``folder`` is ``top`` or a real folder inside it (no symbolic link on the way)."""
+    """Whether ``folder`` is ``top`` or inside it with no symbolic link or file on the way (folders
+    not there yet are created as real ones)."""
     folder, top = pathlib.Path(folder), pathlib.Path(top)
     while folder != top:
-        if folder.is_symlink() or not folder.is_dir():
+        if folder.is_symlink() or (os.path.lexists(folder) and not folder.is_dir()):
             return False
         folder = folder.parent
     return True

@@ -11,11 +11,10 @@ import logging
 import os
 import pathlib
 import sys
-import tempfile
 from dataclasses import dataclass
 
 from . import interrupts, report
-from .args import ArgumentError
+from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
 
@@ -181,16 +180,14 @@ def _stop(pool, others, grace: float = 1.0) -> None:
     with interrupts.deferred():
         pool.shutdown(wait=False, cancel_futures=True)
         known = {pid for _, pid, _ in others}
-        mine = [(pid, proc) for kind, pid, proc in _child_processes() if pid not in known]
+        found = {}
+        for kind, pid, proc in _child_processes():  # a process of multiprocessing's, if it is one
+            if pid not in known and found.get(pid) is None:
+                found[pid] = proc
         # the resource tracker is left running: it ends by itself when this process does, and
         # this process's queues still report to it
-        mine = [(pid, proc) for pid, proc in mine if proc is not None or not _is_resource_tracker(pid)]
-        seen = set()
-        targets = []
-        for pid, proc in mine:
-            if pid not in seen:
-                seen.add(pid)
-                targets.append((pid, proc))
+        targets = [(pid, proc) for pid, proc in found.items()
+                   if proc is not None or not _is_resource_tracker(pid)]
         for pid, proc in targets:
             _signal(pid, proc, signal.SIGTERM)
         deadline = time.monotonic() + grace
@@ -303,18 +300,8 @@ def prepare_output(out, tasks, plots: bool) -> report.Outputs:
     """Check the output folder before any work is done (:class:`ArgumentError` otherwise): a folder
     (created if needed) that can be written to; no input among the files the run would write; and
     its fixed reports (``summary.csv`` ...), where present, written by an earlier run."""
-    out = pathlib.Path(out)
+    out = output_folder(out)
     shown = report.display(out)
-    if os.path.lexists(out) and not out.is_dir():
-        raise ArgumentError(f"--out {shown} exists and is not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        fd, probe = tempfile.mkstemp(dir=out, prefix=".pipeline-probe.")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise ArgumentError(f"--out {shown} is not a folder this run can write to: "
-                            f"{exc.strerror or exc}") from None
     try:
         outputs = report.Outputs(out)
     except report.NotOurs as exc:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 import pathlib
@@ -502,3 +503,263 @@ def test_run_reads_the_trace_asked_for(tmp_path):
     peak = np.max(np.abs(traces[1].data)) / G
     assert float(row["pga_g"]) == pytest.approx(peak, rel=1e-5)  # 6 significant digits written
     assert row["component"] in ("HNN", "")
+
+
+# -- nothing lost, nothing hung, nothing injected (issue 19) ----------------------------------------
+SAFE_ARGS = ["--block", "7.5x1.8", "--shapes", "sine", "--no-plots", "-q"]
+
+
+def test_an_input_inside_out_is_never_overwritten(tmp_path, capsys):
+    """The issue's reproduction: a text record named <id>.csv inside --out was overwritten by its
+    own report, and deleted on the next run. Now an argument error, the input untouched."""
+    src = shared_record("base_isolation_benchmark/erzikan.txt")
+    b1 = tmp_path / "b1"
+    b1.mkdir()
+    rec = b1 / "erzikan.csv"
+    rec.write_bytes(src.read_bytes())
+    argv = ["run", str(rec), "--units", "cm/s2", "--dt", "0.005", "--column", "1", "--block", "7.5x1.8",
+            "--out", str(b1), "-q"]
+    for _ in range(2):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert "would overwrite the input" in err and "\n" not in err
+        assert rec.read_bytes() == src.read_bytes()
+    assert sorted(p.name for p in b1.iterdir()) == ["erzikan.csv"]  # nothing else written either
+
+
+def test_files_the_run_did_not_write_are_left_as_they_are(tmp_path, capsys):
+    """A user's own <id>.csv, an edited report, and a failed record's namesake are never replaced
+    or deleted; the run says so, and the record's rows still reach summary.csv."""
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    a, b = write_good(recs, 1), write_good(recs, 2)
+    out = tmp_path / "out"
+    out.mkdir()
+    mine = out / "good01.csv"
+    mine.write_text("my own notes\n")
+    (out / "missing.csv").write_text("kept\n")  # the report name of a record that fails
+    code = main(["run", str(a), str(b), str(recs / "missing.sac"), *SAFE_ARGS[:-1], "--out", str(out)])
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "good01.csv exists and was not written by pipeline run" in err
+    assert mine.read_text() == "my own notes\n" and (out / "missing.csv").read_text() == "kept\n"
+    fails = {f["record"]: f for f in read_csv(out / "failures.csv")}
+    assert fails["good01"]["stage"] == "write" and fails["missing"]["stage"] == "read"
+    assert [r["record"] for r in read_csv(out / "summary.csv")] == ["good01", "good02"]
+    # a report the run wrote, then edited by the user, is not replaced on the next run either
+    edited = out / "good02.csv"
+    edited.write_text(edited.read_text() + "my remark\n")
+    assert main(["run", str(b), *SAFE_ARGS, "--out", str(out)]) == 1
+    assert edited.read_text().endswith("my remark\n")
+    # ... while its own, unchanged reports are replaced or removed as the records require
+    os.unlink(edited)
+    assert main(["run", str(b), *SAFE_ARGS, "--out", str(out)]) == 0
+    b.write_bytes(b"")  # the record now fails: its own earlier report goes, it would look current
+    assert main(["run", str(b), *SAFE_ARGS, "--out", str(out)]) == 1
+    assert not (out / "good02.csv").exists()
+    assert mine.read_text() == "my own notes\n" and (out / "missing.csv").read_text() == "kept\n"
+
+
+def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys, monkeypatch):
+    """A summary.csv the run did not write, an --out that is a file or cannot be written: exit 2 in
+    one line, before any record is read."""
+    from pipeline import runner
+
+    def no_work(task):
+        raise AssertionError("a record was processed")
+
+    monkeypatch.setattr(runner, "process_record", no_work)
+    rec = write_good(tmp_path, 1)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.csv").write_text("mine\n")
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    for where in (out, afile, afile / "sub", "/proc"):
+        assert main(["run", str(rec), *SAFE_ARGS, "--out", str(where)]) == 2, where
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("pipeline run: error:") and "\n" not in err, err
+    assert (out / "summary.csv").read_text() == "mine\n" and afile.read_text() == "x"
+
+
+def test_write_errors_and_odd_names_fail_one_record_only(tmp_path):
+    """A 250-character file name, a name whose bytes are not UTF-8, and a report path taken by a
+    folder: each is handled or fails alone; the batch writes summary.csv and failures.csv."""
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    long_name = recs / ("L" * 250 + ".sac")
+    os.rename(write_good(recs, 1), long_name)
+    odd = os.path.join(os.fsencode(recs), b"caf\xe9-\xff.sac")
+    os.rename(write_good(recs, 2), odd)
+    blocked = write_good(recs, 3)
+    out = tmp_path / "out"
+    (out / "good03.csv").mkdir(parents=True)  # the report's path is taken by a folder
+    paths = [str(long_name), os.fsdecode(odd), str(blocked)]
+    assert main(["run", *paths, *SAFE_ARGS, "--out", str(out)]) == 1
+    summary = read_csv(out / "summary.csv")
+    ids = [r["record"] for r in summary]
+    assert len(ids) == 3 and ids[1] == "caf_-" and ids[2] == "good03"
+    assert len(ids[0]) <= 96 and ids[0].startswith("L" * 80)  # cut, with a hash of the whole name
+    assert (out / f"{ids[0]}.csv").is_file() and (out / "caf_-.csv").is_file()
+    assert summary[1]["file"].endswith("caf\\xe9-\\xff.sac")  # the bytes shown, not lost
+    (fail,) = read_csv(out / "failures.csv")
+    assert fail["record"] == "good03" and fail["stage"] == "write"
+    assert max(len(os.fsencode(p.name)) for p in out.iterdir()) < 120
+
+
+def test_no_write_goes_through_a_planted_symlink(tmp_path):
+    """Symbolic links planted in --out (at the old predictable temporary name, and at a report's
+    name) never lead a write to their target."""
+    rec = write_good(tmp_path, 1)
+    out = tmp_path / "out"
+    out.mkdir()
+    victim, victim2 = tmp_path / "victim", tmp_path / "victim2"
+    victim.write_text("precious\n")
+    victim2.write_text("precious too\n")
+    (out / f".summary.csv.tmp-{os.getpid()}").symlink_to(victim)  # the name this process used
+    (out / "good01.csv").symlink_to(victim2)
+    assert main(["run", str(rec), *SAFE_ARGS, "--out", str(out)]) == 1  # the report is left out
+    assert victim.read_text() == "precious\n" and victim2.read_text() == "precious too\n"
+    assert (out / "good01.csv").is_symlink()
+    (fail,) = read_csv(out / "failures.csv")
+    assert fail["stage"] == "write" and "not written by pipeline run" in fail["reason"]
+    assert len(read_csv(out / "summary.csv")) == 1
+
+
+def test_text_cells_are_never_formulas(tmp_path, monkeypatch):
+    """Header text and file names that a spreadsheet would evaluate get a leading apostrophe;
+    numbers (negative ones included) are written as they are."""
+    t, acc = synthetic(5, ap_g=-0.5)  # a negative pulse: signed amplitudes below zero
+    monkeypatch.chdir(tmp_path)
+    meta = {"station": "@SUM(1)", "component": "-HNE", "event": "=cmd|' /C calc'!A0"}
+    pulses.write_sac(pulses.Record(acc, t[1] - t[0], name="x", metadata=meta), "+evil.sac")
+    assert main(["run", "+evil.sac", *SAFE_ARGS, "--out", "out"]) == 0
+    text = (tmp_path / "out" / "summary.csv").read_text()
+    (row,) = read_csv(tmp_path / "out" / "summary.csv")
+    assert row["event"] == "'=cmd|' /C calc'!A0"[:17] and row["station"] == "'@SUM(1)"
+    assert row["component"] == "'-HNE" and row["file"] == "'+evil.sac" and row["record"] == "evil"
+    assert float(row["pulse_ap_g"]) < 0 and not row["pulse_ap_g"].startswith("'")
+    cells = [c for line in csv.reader(io.StringIO(text)) for c in line]
+    assert not [c for c in cells if c[:1] in "=+@\t\r" and c[:1]]
+    assert "leading apostrophe" in (tmp_path / "out" / "columns.md").read_text()
+
+
+@pytest.mark.parametrize("bad", [["--block", "1e308x1"], ["--height", "1e308"], ["--block", "1e-300x1e-300"],
+                                 ["--block", "7.5x1.8", "--dt", "5"], ["--block", "7.5x1.8", "--jobs", "100000"]])
+def test_absurd_sizes_are_argument_errors(bad, tmp_path, capsys):
+    rec = write_good(tmp_path, 1)
+    assert main(["run", str(rec), *bad, "--out", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pipeline run: error:") and "\n" not in err
+
+
+def test_report_rows_must_match_their_declared_columns():
+    """Writing a row with an undeclared key, or without a declared one, fails (no silent blank)."""
+    from pipeline.batch import FIELDS, RECORD_COLUMNS
+
+    row = dict.fromkeys(FIELDS, 1.0)
+    assert report.csv_text(FIELDS, [row]).count("\n") == 2
+    for bad in ({**row, "typo_column": 1.0}, {k: v for k, v in row.items() if k != "pga_g"}):
+        with pytest.raises(report.ReportError):
+            report.csv_text(FIELDS, [bad])
+    values = dict.fromkeys(RECORD_COLUMNS.names)
+    assert list(RECORD_COLUMNS.row(values)) == list(RECORD_COLUMNS.names)
+    with pytest.raises(report.ReportError):
+        RECORD_COLUMNS.row({**values, "extra": 1})
+    with pytest.raises(report.ReportError):
+        RECORD_COLUMNS.row({k: v for k, v in values.items() if k != "event"})
+
+
+def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
+    """Ctrl-C whose exception is swallowed (as in a callback Python cannot raise from) still ends
+    the run with status 130 before the next record."""
+    import signal
+    import time
+
+    from pipeline import runner
+
+    real, seen = runner.process_record, []
+
+    def swallowing(task):
+        seen.append(task.record_id)
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.1)  # the handler runs here
+        except KeyboardInterrupt:
+            pass
+        return real(task)
+
+    monkeypatch.setattr(runner, "process_record", swallowing)
+    recs = [str(write_good(tmp_path, k)) for k in range(3)]
+    assert main(["run", *recs, *SAFE_ARGS, "--out", str(tmp_path / "out")]) == 130
+    assert seen == ["good00"]
+
+
+def _interrupt_run(tmp_path, signals, jobs="2"):
+    """Start `pipeline run` on longer records in its own process group (as a terminal's job), send
+    ``signals`` to the group once two reports exist; return (exit status, seconds from the first
+    signal to the exit, its processes before the signals, stderr, out folder)."""
+    import signal
+    import time
+
+    psutil = pytest.importorskip("psutil")
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    paths = [str(write_good(recs, k, duration=40.0)) for k in range(12)]
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "pipeline", "run", *paths, "--block", "7.5x1.8",
+                             "--shapes", "sine", "--no-plots", "--jobs", jobs, "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.time() + 240
+    while time.time() < deadline and len(list(out.glob("good*.csv"))) < 2 and proc.poll() is None:
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()
+    family = psutil.Process(proc.pid).children(recursive=True)
+    t0 = time.monotonic()
+    for sig in signals:
+        os.killpg(proc.pid, sig)
+        time.sleep(0.15)
+    try:
+        _, err = proc.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+        pytest.fail("the run did not end within 10 s of the interrupt")
+    elapsed = time.monotonic() - t0
+    _, alive = psutil.wait_procs(family, timeout=3)
+    assert not alive, [(p.pid, p.cmdline()) for p in alive]
+    return proc.returncode, elapsed, family, err, out
+
+
+def _check_reports_whole(out):
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
+    for path in files:
+        if path.name != report.MANIFEST:
+            rows = read_csv(path)
+            assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
+
+
+def test_double_ctrl_c_with_two_jobs_ends_at_once_and_leaves_no_process(tmp_path):
+    """The issue's hang: two Ctrl-C with --jobs 2 (sent to the process group, as a terminal does).
+    Exit 130 well within 10 s (measured ~0.3-1 s here), no worker or fork server left behind, every
+    report whole, no temporary file."""
+    import signal
+
+    code, elapsed, family, err, out = _interrupt_run(tmp_path, [signal.SIGINT, signal.SIGINT])
+    print(f"double Ctrl-C: exit {code} {elapsed:.2f} s after the first signal")
+    assert code == 130, err
+    assert len(family) >= 3  # fork server and two workers (and the resource tracker) existed
+    assert "interrupted" in err and "Traceback" not in err
+    _check_reports_whole(out)
+
+
+def test_sigterm_ends_a_pool_run_with_143(tmp_path):
+    import signal
+
+    code, elapsed, family, err, out = _interrupt_run(tmp_path, [signal.SIGTERM, signal.SIGINT, signal.SIGTERM])
+    print(f"SIGTERM: exit {code} {elapsed:.2f} s after the first signal")
+    assert code == 143, err
+    assert "Traceback" not in err
+    _check_reports_whole(out)
