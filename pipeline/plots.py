@@ -30,15 +30,17 @@ MAX_PULSES = 4
 #: most curves per rotation-history panel (the column as it stands and the Eq. 31 design)
 MAX_CURVES = 2
 _PULSE_STYLES = ["-", "--", "-.", ":"]
+#: record figure in inches: margins (room for the y label and tick labels as wide as "-0.0075",
+#: the x tick labels and label, the first title), height of a panel, gap between panels (a title)
+_RECORD_LEFT, _RECORD_RIGHT, _RECORD_TOP, _RECORD_BOTTOM = 0.95, 0.15, 0.36, 0.55
+_PANEL, _GAP = 1.75, 0.45
 #: matplotlib is not thread-safe and dask may run tasks in threads of one process
 _LOCK = threading.Lock()
 
 
-def _figure(width, height) -> Figure:
-    """A new figure, sizes in inches; constrained layout keeps labels inside and off each other."""
-    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
-    fig.get_layout_engine().set(w_pad=0.06, h_pad=0.06)
-    return fig
+def _figure(width, height, layout=None) -> Figure:
+    """A new figure, sizes in inches."""
+    return Figure(figsize=(width, height), dpi=DPI, layout=layout)
 
 
 def _png(fig: Figure) -> bytes:
@@ -89,7 +91,12 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
     fitting = list(fitting)
     if len(fitting) > MAX_PULSES:
         raise ValueError(f"at most {MAX_PULSES} fitted pulses per record figure, got {len(fitting)}")
-    fig = _figure(8.0, 2.6 + 2.2 * len(histories))
+    width, height = 8.0, _RECORD_TOP + _RECORD_BOTTOM + (1 + len(histories)) * _PANEL + len(histories) * _GAP
+    fig = _figure(width, height)
+    # margins fixed in inches (what a layout engine gives for these labels, checked by
+    # tests/test_plots.py): a layout engine measures every text before drawing it, 25 % of the cost
+    fig.subplots_adjust(left=_RECORD_LEFT / width, right=1.0 - _RECORD_RIGHT / width, top=1.0 - _RECORD_TOP / height,
+                        bottom=_RECORD_BOTTOM / height, hspace=_GAP / _PANEL)
     axes = fig.subplots(1 + len(histories), 1, sharex=True, squeeze=False)[:, 0]
     ax = axes[0]
     t = record.time
@@ -98,7 +105,9 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
         ax.plot(*_thin(t, c.pulse(t) / G), color=f"C{i}", lw=1.6 if i == 0 else 1.1, ls=_PULSE_STYLES[i],
                 label=f"{c.shape}: ap {c.ap / G:+.3g} g, Tp {c.tp:.3g} s, score {c.score:.2f}")
     ax.set_ylabel("ground acc. (g)", fontsize=LABEL_SIZE)
-    ax.set_title(f"{record_id}: record and fitted pulse{'s' if len(fitting) > 1 else ''}", fontsize=TITLE_SIZE)
+    # titles at a given height (y=1): matplotlib otherwise measures the axes' ticks to place them
+    ax.set_title(f"{record_id}: record and fitted pulse{'s' if len(fitting) > 1 else ''}", fontsize=TITLE_SIZE,
+                 y=1.0)
     for ax, (label, curves) in zip(axes[1:], histories):
         if len(curves) > MAX_CURVES:
             raise ValueError(f"at most {MAX_CURVES} curves per history panel, got {len(curves)}")
@@ -109,7 +118,7 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
         ax.axhline(1.0, color="k", lw=0.5, ls=":")  # overturning starts past |theta| = alpha
         ax.axhline(-1.0, color="k", lw=0.5, ls=":")
         ax.set_ylabel("theta / alpha", fontsize=LABEL_SIZE)
-        ax.set_title(f"column {label} m under the full record", fontsize=TITLE_SIZE - 1)
+        ax.set_title(f"column {label} m under the full record", fontsize=TITLE_SIZE - 1, y=1.0)
     for ax in axes:
         _style(ax)
         if ax.get_legend_handles_labels()[0]:
@@ -150,7 +159,8 @@ def summary_figure(rows) -> Figure:
         Two panels, 10 in wide: the columns as they stand (``column_kind`` "block"), and the Eq. 31
         design against the verified width of every row.
     """
-    fig = _figure(10.0, 4.8)
+    # drawn once a run: a layout engine places the labels
+    fig = _figure(10.0, 4.8, layout="constrained")
     ax1, ax2 = fig.subplots(1, 2)
     blocks = [r for r in rows if r.get("column_kind") == "block"]
     hi = 0.0

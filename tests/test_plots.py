@@ -64,6 +64,44 @@ def test_record_figure_draws_the_record_its_pulses_and_rotations(tmp_path):
     assert not {k for k in info if k.lower() in ("software", "creation time", "date")}
 
 
+def _text_boxes(fig):
+    """Window extents (pixels) of the figure's visible, non-empty texts, by kind."""
+    fig.draw_without_rendering()
+    boxes = {"title": [], "ylabel": [], "yticks": [], "other": []}
+    for ax in fig.axes:
+        boxes["title"].append(ax.title.get_window_extent())
+        boxes["ylabel"].append(ax.yaxis.label.get_window_extent())
+        boxes["yticks"] += [t.get_window_extent() for t in ax.get_yticklabels() if t.get_text()]
+        boxes["other"] += [t.get_window_extent() for t in [*ax.get_xticklabels(), ax.xaxis.label,
+                                                           ax.yaxis.get_offset_text()]
+                           if t.get_visible() and t.get_text()]
+    return boxes
+
+
+def test_record_figure_labels_inside_and_apart(tmp_path):
+    """The record figure's margins are fixed in inches: every label stays inside the figure and off
+    the others, also with wide tick labels (a weak record: ticks like -0.010) and one column."""
+    path = write_good(tmp_path, 4)
+    task, = make_tasks([str(path)], [Column(7.5, 1.8), Column(6.0, 1.2)], Options())
+    record, fit, fitting, histories = _process(task)[1]
+    figures = [plots.record_figure(task.record_id, record, fit, fitting, histories),
+               plots.record_figure(task.record_id, record.scaled(0.02), fit, [], histories[:1])]
+    assert [t.get_text() for t in figures[1].axes[0].get_yticklabels()][1].startswith("\N{MINUS SIGN}0.0")
+    for fig in figures:
+        boxes = _text_boxes(fig)
+        inside = fig.bbox
+        every = [b for kind in boxes.values() for b in kind]
+        for b in every:
+            assert inside.x0 <= b.x0 and b.x1 <= inside.x1 and inside.y0 <= b.y0 and b.y1 <= inside.y1
+        for label in boxes["ylabel"]:
+            assert not any(label.overlaps(b) for b in boxes["yticks"])
+        for i, title in enumerate(boxes["title"]):
+            assert not any(title.overlaps(ax.bbox) for ax in fig.axes)
+            assert not any(title.overlaps(b) for b in every if b is not title)
+        # y labels aligned (placed by the widest tick labels)
+        assert len({round(b.x0, 6) for b in boxes["ylabel"]}) == 1
+
+
 def test_long_records_are_thinned_for_drawing_only():
     """A record longer than MAX_POINTS samples is drawn with every k-th sample (k the smallest step
     that fits), first sample kept."""
