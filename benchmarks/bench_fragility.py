@@ -91,10 +91,11 @@ def main(argv=None):
             both = [(f, s, c) for _, f, s, c in brute if f is not None and c is not None]
             above = [(c - f) / s for f, s, c in both]
             lower = sum(1 for f, s, c in both if c < f - s)
+            higher = sorted(round(float(a), 2) for a in above if a > 1.0)
             print(f"  brute 1000 factors (0.2-5): {statistics.median(dts) * 1e3:.0f} ms median; "
-                  f"critical_scale - first brute failure, in brute steps: max {max(above):+.2f}; "
-                  f"{lower} of {len(both)} lower by more than a step (slivers the brute scan "
-                  f"stepped over)")
+                  f"critical_scale - first brute failure, in brute steps: higher by more than a "
+                  f"step on {len(higher)} of {len(both)} {higher}; lower by more than a step on "
+                  f"{lower} (slivers the brute scan stepped over)")
         print()
     return 0
 
