@@ -63,12 +63,14 @@ def test_critical_scale_of_a_pulse_matches_critical_amplitudes():
     # a second method: critical_amplitudes scans amplitudes (m/s^2) uniformly from the uplift
     # acceleration and bisects to 1e-9; both answers are refined brackets, so they agree to the
     # looser rtol (1e-6) unless one of them found a sliver the other missed
-    block = Block.from_dimensions(7.5, 1.8)
-    for shape, tp in [("sine", 0.8), ("ricker-sym", 1.5), ("rect", 0.6)]:
-        pulse = make_pulse(shape, G, tp)
-        amps = rocking.critical_amplitudes(block, shape, tp, up_to=6 * G * block.tan_alpha)
-        cs = rocking.critical_scale(block, pulse, up_to=6 * block.tan_alpha)
-        assert cs.scale * G == pytest.approx(amps.minimum, rel=2e-6)
+    for gamma in (0.0, 2.0):                # the column, and a frame
+        block = Block.from_dimensions(7.5, 1.8, cap_mass_ratio=gamma)
+        for shape, tp in [("sine", 0.8), ("ricker-sym", 1.5), ("rect", 0.6)]:
+            pulse = make_pulse(shape, G, tp)
+            amps = rocking.critical_amplitudes(block, shape, tp, up_to=10 * G * block.tan_alpha)
+            cs = rocking.critical_scale(block, pulse, up_to=10 * block.tan_alpha)
+            assert amps.minimum is not None
+            assert cs.scale * G == pytest.approx(amps.minimum, rel=2e-6)
 
 
 def test_frame_with_zero_cap_mass_is_the_column(brute):
@@ -123,6 +125,10 @@ def test_fragility_fit_against_scipy():
         assert abs(grad) < 1e-5
     with pytest.raises(ValueError, match="up_to"):
         rocking.fragility(cens)
+    # CriticalScale results that did not overturn are censored at their own up_to
+    block = Block.from_dimensions(7.5, 1.8)
+    stays = rocking.critical_scale(block, make_pulse("sine", G, 0.8), up_to=0.5 * block.tan_alpha)
+    assert rocking.fragility(list(cens[k <= up_to]) + [stays] * 3).censored_at.tolist() == [stays.up_to] * 3
 
 
 def test_fragility_in_pga(brute):
