@@ -28,7 +28,7 @@ import numpy as np
 
 from . import formats
 from .errors import RecordError
-from .formats import MAX_SAMPLES, too_long
+from .formats import MAX_SAMPLES, join_blocks, too_long
 from .orientation import orientation, seed_orientation
 from .units import canonical_units
 
@@ -194,7 +194,7 @@ def read_at2_file(path, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, flo
         raise RecordError(f"{path}: is a directory, not a record file") from None
     except OSError as exc:
         raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    data = np.concatenate(blocks) if blocks else np.zeros(0)
+    data = join_blocks(blocks)
     style = "NPTS=, DT=" if _NPTS_DT_NEW.search(lines[3]) else "NPTS, DT"
     if data.size != npts:
         what = "truncated" if data.size < npts else "longer than its header says"
@@ -211,8 +211,8 @@ def read_at2_file(path, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, flo
 
 #: characters read per block of sample lines
 _BLOCK_CHARS = 1 << 22
-#: characters of a sample block that numpy may parse directly (D exponents turned into E first)
-_FAST_CHARS = set("0123456789.+-EeDd \t\n")
+#: a character that numpy is not given directly (only numbers, D exponents turned into E first)
+_NOT_FAST = re.compile(r"[^0-9.+\-EeDd \t\n]")
 _D_TO_E = str.maketrans("Dd", "Ee")
 #: a sign that touches the number before it (``-.1E-02-.2E-02``); an exponent's sign follows E
 _TOUCHING_SIGN = re.compile(r"(?<=[\d.])(?=[-+])")
@@ -240,7 +240,7 @@ def _from_text(text: str) -> np.ndarray | None:
 def _parse_block(path: str, lines: list, lineno: int) -> np.ndarray:
     """The samples of a block of AT2 lines (the first is line ``lineno + 1`` of the file)."""
     text = "".join(lines)
-    if _FAST_CHARS.issuperset(text):
+    if not _NOT_FAST.search(text):
         text = text.translate(_D_TO_E)
         values = _from_text(text)
         if values is None:
