@@ -11,7 +11,9 @@ line, with a short last line::
 
 The older NGA/PEER header writes the fourth line as ``1991    0.0100    NPTS, DT``.  Numbers may
 lack a leading zero (``.0100``, ``-.25E-02``) and may touch (no space before a minus sign), so
-samples are read with a regular expression, never by splitting on blanks or by fixed columns.
+samples are never read by fixed columns: numpy reads blocks of lines, with a blank put before a
+sign that touches the number before it, and a block numpy stops in is read with a regular
+expression line by line (which names the line that is not numbers).
 The sample count is checked against ``NPTS``: sample ``k`` (0-based) is at ``t = k DT``, so the
 record lasts ``(NPTS - 1) DT``.
 
@@ -219,6 +221,7 @@ _TOUCHING_SIGN = re.compile(r"(?<=[\d.])(?=[-+])")
 
 
 def _rest_has_text(fh) -> bool:
+    """Whether anything but blanks follows in ``fh`` (read in blocks)."""
     while True:
         block = fh.read(_BLOCK_CHARS)
         if not block:
@@ -230,7 +233,8 @@ def _rest_has_text(fh) -> bool:
 def _from_text(text: str) -> np.ndarray | None:
     """The numbers in ``text`` (blank-separated) by numpy, or ``None`` where it stops early."""
     with warnings.catch_warnings():
-        warnings.simplefilter("error", DeprecationWarning)  # numpy < 2.? warns where it stops
+        # where numpy stops early it raises ValueError, or (older numpy) warns and returns less
+        warnings.simplefilter("error", DeprecationWarning)
         try:
             return np.fromstring(text, dtype=float, sep=" ")
         except (ValueError, DeprecationWarning):
