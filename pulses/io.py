@@ -8,9 +8,9 @@ it and applies the checks every record gets.  Formats (``format=``):
 ``"text"``
     Plain text or CSV columns (see :mod:`pulses.textfile`); the user gives ``units`` and ``dt``
     (``dt`` may come from a time column instead).
-``"sac"`` (:mod:`pulses.sac`), ``"knet"`` (:mod:`pulses.knet`) and every other format obspy reads (``"mseed"``, ...)
-    Through :func:`obspy.read` (:mod:`pulses.obspyformat`).  SAC: ``idep`` states the quantity; ``iacc`` means nm/s^2 by the
-    SAC standard, honoured unless the user passes ``units``.  K-NET: obspy leaves the samples in
+``"sac"`` (:mod:`pulses.sac`), ``"knet"`` (:mod:`pulses.knet`), every other obspy format (``"mseed"``, ...)
+    Through :func:`obspy.read` (:mod:`pulses.obspyformat`).  SAC: ``idep`` states the quantity;
+    ``iacc`` means nm/s^2 by the SAC standard, honoured unless the user passes ``units``.  K-NET: obspy leaves the samples in
     counts and puts the header's scale factor, converted from gal to m/s^2, into
     ``stats.calib``; the reader multiplies by it and removes the mean (the K-NET convention), so
     the units are stated (m/s^2).  Formats that state no units (MiniSEED, ...) need ``units``.
