@@ -12,7 +12,7 @@ bytes a row on average): 200 MB is 7.6 million samples, under the 10^7 that
 152 MB is 10^7 samples.  The target: well under 1 GB of peak memory (the reader before blocks of
 lines: 5.6 GB for 200 MB of text).
 
-Measured (2 shared cores, load about 10): text 194 MB, 7.4 M samples: peak 309 MB, 17.7 s; AT2
+Measured (2 shared cores, load about 10): text 200 MB, 7.6 M samples: peak 315 MB, 22.7 s; AT2
 152 MB, 10^7 samples: peak 295 MB, 14.5 s; the reader before blocks of lines, text 19 MB: peak
 508 MB, 20.4 s (the new one: 113 MB, 2.1 s).
 """

@@ -112,6 +112,7 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
 
 
 def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
+    """:func:`read_record` on a ``str`` path: dispatch to the format, then the common checks."""
     p = pathlib.Path(path)
     if not p.exists():
         raise RecordError(f"{path}: no such file")
