@@ -55,6 +55,8 @@ _AZIMUTH_CODED = re.compile(r"[A-Z][A-Z0-9_-]*?(\d{3})")
 _VERTICAL = re.compile(r"(?:.*[^A-Z])?(?:UP|DWN|DN|DOWN|V|VERT)|[A-Z0-9-]*?(?:UP|DWN)")
 #: horizontals that state no azimuth: fault-normal, fault-parallel, NGA-West2's H1 and H2
 _HORIZONTAL = {"FN", "FP", "H1", "H2"}
+#: compass directions, alone or after a station code and a hyphen (``TCU068-N``)
+_COMPASS = {"N": 0.0, "NS": 0.0, "N-S": 0.0, "E": 90.0, "EW": 90.0, "E-W": 90.0, "S": 180.0, "W": 270.0}
 
 
 def _float(text: str) -> float:
@@ -113,7 +115,8 @@ def _title_fields(line: str) -> dict:
 def component_orientation(component: str) -> dict:
     """``azimuth`` and ``vertical`` (see :mod:`pulses.orientation`) from an AT2 component.
 
-    ``228`` and ``PUL164`` give azimuths 228 and 164 (degrees clockwise from north); ``UP``,
+    ``228`` and ``PUL164`` give azimuths 228 and 164 (degrees clockwise from north), ``N``,
+    ``E-W`` and ``TCU068-N`` 0, 90 and 0; ``UP``,
     ``DWN``, ``V`` and ``-UP`` are vertical; ``FN``, ``FP``, ``H1`` and ``H2`` horizontal with no
     stated azimuth; anything else says nothing.
     """
@@ -124,6 +127,9 @@ def component_orientation(component: str) -> dict:
     m = _AZIMUTH_CODED.fullmatch(code)
     if m and float(m.group(1)) <= 360.0:
         return orientation(azimuth=float(m.group(1)))
+    compass = _COMPASS.get(code, _COMPASS.get(code.rsplit("-", 1)[-1]))
+    if compass is not None:
+        return orientation(azimuth=compass)
     if _VERTICAL.fullmatch(code):
         return orientation(vertical=True)
     if code in _HORIZONTAL:

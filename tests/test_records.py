@@ -124,7 +124,8 @@ def test_at2_azimuth_from_header(name, azimuth):
     ("LCN260", {"azimuth": 260.0, "vertical": False}), ("360", {"azimuth": 0.0, "vertical": False}),
     ("UP", {"vertical": True}), ("DWN", {"vertical": True}), ("V", {"vertical": True}),
     ("-UP", {"vertical": True}), ("E06UP", {"vertical": True}), ("HNZ", {"vertical": True}),
-    ("FN", {"vertical": False}),
+    ("FN", {"vertical": False}), ("TCU068-N", {"azimuth": 0.0, "vertical": False}),
+    ("E", {"azimuth": 90.0, "vertical": False}), ("TMZ", {}),  # a station code, not a SEED channel
     ("", {}), ("Somewhere", {}), ("400", {}),  # nothing stated, or not an angle: nothing said
 ])
 def test_at2_component_codes(tmp_path, component, expect):
