@@ -579,6 +579,9 @@ def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys,
         assert main(["run", str(rec), *SAFE_ARGS, "--out", str(where)]) == 2, where
         err = capsys.readouterr().err.strip()
         assert err.startswith("pipeline run: error:") and "\n" not in err, err
+    (tmp_path / "empty").mkdir()  # a folder without records: nothing to do is a wrong argument
+    assert main(["run", str(tmp_path / "empty"), *SAFE_ARGS, "--out", str(tmp_path / "o")]) == 2
+    assert "no record files in" in capsys.readouterr().err
     assert (out / "summary.csv").read_text() == "mine\n" and afile.read_text() == "x"
 
 
