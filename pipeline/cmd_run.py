@@ -92,6 +92,11 @@ def main(args) -> int:
     if not args.records:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     paths = expand_inputs(args.records)
+    if not paths:
+        from .report import display
+
+        raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
+                            "(a folder gives the files directly in it)")
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
                   quiet=args.quiet)
     return summary.exit_code
