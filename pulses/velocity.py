@@ -157,16 +157,24 @@ def db4_cwt(x, scales) -> np.ndarray:
     numpy.ndarray, shape (len(scales), n) or (m, len(scales), n)
     """
     x = np.asarray(x, dtype=float)
-    n = x.shape[-1]
     scales = tuple(float(a) for a in scales)
-    out = np.empty(x.shape[:-1] + (len(scales), n))
+    out = np.empty(x.shape[:-1] + (len(scales), x.shape[-1]))
+    for i, row in _cwt_rows(x, scales):
+        out[..., i, :] = row
+    return out
+
+
+def _cwt_rows(x: np.ndarray, scales: tuple):
+    """The rows of :func:`db4_cwt`, one scale at a time (in the order of their FFT sizes):
+    pairs (index of the scale, transform of shape ``x.shape``), so that a caller can use each
+    row while it is in the cache."""
+    n = x.shape[-1]
     for size, members in _size_groups(scales, n):
         spectrum = sfft.rfft(x, size, axis=-1)
         spectra = _filter_spectra(tuple(scales[i] for i in members), size)
         for j, i in enumerate(members):
             k = _offset(scales[i])
-            out[..., i, :] = sfft.irfft(spectrum * spectra[j], size, axis=-1)[..., k:k + n]
-    return out
+            yield i, sfft.irfft(spectrum * spectra[j], size, axis=-1)[..., k:k + n]
 
 
 @lru_cache(maxsize=8)
@@ -181,31 +189,66 @@ def _size_groups(scales: tuple, n: int, groups: int = 4) -> tuple:
     return tuple((max(need[i] for i in run), tuple(run)) for run in runs if run)
 
 
-@lru_cache(maxsize=64)
-def _window_spectrum(scale: float, size: int) -> np.ndarray:
-    spectrum = sfft.rfft(difference_filter(scale), size) * (-math.sqrt(scale))
-    spectrum.flags.writeable = False
-    return spectrum
+#: largest (outputs x input samples) for which a windowed transform is a direct convolution:
+#: below it :func:`numpy.convolve` is cheaper than two FFTs
+DIRECT_LIMIT = 100_000
+
+
+class _Window:
+    """The db4 transform at one scale over output samples ``start..stop-1`` of signals that are
+    zero outside input samples ``lo..hi-1``.
+
+    Only the stretch of the filter those outputs and inputs meet is used (zero-extended where
+    it runs past the filter's ends), so the work scales with ``(stop - start) + (hi - lo)``
+    rather than with the filter's length ``7 scale``: for long scales the filter is longer than
+    the record.  Output ``q`` is ``conv(seg, part)[q + len(seg) - 1]``, the 'valid' part of a
+    linear convolution; a circular one of size ``>= len(part)`` has it exact.
+    """
+
+    def __init__(self, scale: float, start: int, stop: int, lo: int, hi: int):
+        g = difference_filter(scale)
+        k = _offset(scale)
+        self.lo = max(lo, start + k - (g.size - 1))  # inputs the outputs see
+        self.hi = min(hi, stop + k)
+        self.width = stop - start
+        self.factor = -math.sqrt(scale)
+        size = self.hi - self.lo
+        if size <= 0:
+            self.part = None
+            return
+        first = start + k - self.hi + 1  # filter index of the first output and the last input
+        self.part = np.zeros(self.width + size - 1)
+        a, b = max(first, 0), min(first + self.part.size, g.size)
+        if b > a:
+            self.part[a - first:b - first] = g[a:b]
+        self.direct = self.width * size < DIRECT_LIMIT
+        if not self.direct:
+            self.fft_size = sfft.next_fast_len(self.part.size, real=True)
+            self.spectrum = sfft.rfft(self.part, self.fft_size) * self.factor
+
+    def __call__(self, piece: np.ndarray, at: int) -> np.ndarray:
+        """Transform of the signal equal to ``piece`` from sample ``at`` on (zero elsewhere)."""
+        if self.part is None:
+            return np.zeros(self.width)
+        a, b = max(at, self.lo), min(at + piece.size, self.hi)
+        if b <= a:
+            return np.zeros(self.width)
+        size = self.hi - self.lo
+        if a == self.lo and b == self.hi:
+            seg = piece[a - at:b - at]
+        else:
+            seg = np.zeros(size)
+            seg[a - self.lo:b - self.lo] = piece[a - at:b - at]
+        if self.direct:
+            return self.factor * np.convolve(seg, self.part, mode="valid")
+        y = sfft.irfft(sfft.rfft(seg, self.fft_size) * self.spectrum, self.fft_size)
+        return y[size - 1:size - 1 + self.width]
 
 
 def _cwt_at(x: np.ndarray, scale: float, start: int, stop: int) -> np.ndarray:
     """The db4 transform of ``x`` at one scale, samples ``start..stop-1`` only (exact: the
     convolution of the stretch of ``x`` those samples see)."""
-    g = difference_filter(scale)
-    k = _offset(scale)
-    lo, hi = start + k - (g.size - 1), stop + k  # x indices needed: lo .. hi-1
-    seg = x[max(lo, 0):min(hi, x.size)]
-    if lo < 0 or hi > x.size:
-        seg = np.concatenate([np.zeros(max(-lo, 0)), seg, np.zeros(max(hi - x.size, 0))])
-    if stop - start == 1:
-        # einsum, not a BLAS dot: a multithreaded BLAS dot on long vectors stalls on a busy machine
-        return np.array([-math.sqrt(scale) * float(np.einsum("i,i->", seg[::-1], g))])
-    if (stop - start) * g.size < 100_000:  # direct: cheaper than FFTs for few outputs
-        return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
-    # circular convolution of size >= len(seg) is exact on the 'valid' part
-    size = sfft.next_fast_len(seg.size, real=True)
-    y = sfft.irfft(sfft.rfft(seg, size) * _window_spectrum(scale, size), size)
-    return y[g.size - 1:g.size - 1 + stop - start]
+    return _Window(scale, start, stop, 0, x.size)(x, 0)
 
 
 def coarse_scales(dt: float) -> np.ndarray:
@@ -407,49 +450,41 @@ class PulseClassification:
 
 # -- the classification ----------------------------------------------------------------------
 
+#: longest dot product handed to BLAS in one call: OpenBLAS (in NumPy's and SciPy's wheels)
+#: spreads a dot product of more than 10,000 elements over threads, which stalls on a busy
+#: machine (4 ms instead of 4 us measured); shorter pieces run on the calling thread, three
+#: times faster than :func:`numpy.einsum`
+DOT_PIECE = 8192
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum(a * b)`` of two 1-D arrays, by BLAS in pieces of at most :data:`DOT_PIECE`."""
+    if a.size <= DOT_PIECE:
+        return float(np.dot(a, b))
+    return float(sum(np.dot(a[i:i + DOT_PIECE], b[i:i + DOT_PIECE]) for i in range(0, a.size, DOT_PIECE)))
+
+
 @lru_cache(maxsize=4096)
-def _reversed_filter(scale: float) -> np.ndarray:
+def _point_filter(scale: float) -> tuple[int, np.ndarray, float]:
+    """What the transform at one sample needs at ``scale``: (the :func:`_offset`, the
+    :func:`difference_filter` reversed (read-only), ``-sqrt(scale)``)."""
     g = difference_filter(scale)[::-1].copy()
     g.flags.writeable = False
-    return g
+    return _offset(scale), g, -math.sqrt(scale)
 
 
 def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
-    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each)."""
+    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each,
+    over the samples of ``x`` the filter meets)."""
     out = np.empty(len(scales))
     n = x.size
     for i, a in enumerate(scales):
-        gr = _reversed_filter(a)
-        hi = at + _offset(a) + 1  # x indices at + off - (G - 1) .. at + off
+        offset, gr, factor = _point_filter(a)
+        hi = at + offset + 1  # x indices at + offset - (G - 1) .. at + offset
         lo = hi - gr.size
-        if lo >= 0 and hi <= n:
-            seg = x[lo:hi]
-        else:
-            seg = np.zeros(gr.size)
-            seg[max(-lo, 0):gr.size - max(hi - n, 0)] = x[max(lo, 0):min(hi, n)]
-        # einsum, not a BLAS dot: a multithreaded BLAS dot on long vectors stalls on a busy machine
-        out[i] = -math.sqrt(a) * float(np.einsum("i,i->", seg, gr))
+        x_lo, x_hi = max(lo, 0), min(hi, n)
+        out[i] = factor * _dot(x[x_lo:x_hi], gr[x_lo - lo:x_hi - lo]) if x_hi > x_lo else 0.0
     return out
-
-
-def _transform_piece(piece: np.ndarray, at: int, scale: float, start: int, stop: int) -> np.ndarray:
-    """Transform over samples ``start..stop-1`` of a signal that is ``piece`` from sample ``at``
-    on and zero elsewhere (``_cwt_at`` without building the whole signal)."""
-    g = difference_filter(scale)
-    lo = start + _offset(scale) - (g.size - 1)  # first sample the outputs see
-    length = stop - start + g.size - 1
-    a, b = max(at, lo), min(at + piece.size, lo + length)
-    if b <= a:
-        return np.zeros(stop - start)
-    if (stop - start) * g.size < 100_000:
-        seg = np.zeros(length)
-        seg[a - lo:b - lo] = piece[a - at:b - at]
-        return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
-    size = sfft.next_fast_len(length, real=True)
-    seg = np.zeros(size)
-    seg[a - lo:b - lo] = piece[a - at:b - at]
-    y = sfft.irfft(sfft.rfft(seg) * _window_spectrum(scale, size), size)
-    return y[g.size - 1:g.size - 1 + stop - start]
 
 
 def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarray, energy) -> dict:
@@ -478,6 +513,7 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
     centre = -first
     span = 2 * half
     kernel = None  # transform of the unit wavelet at lags -span..span, when first needed
+    cut = None  # transform over the window of wavelets cut by the record's ends, when needed
     pulse = np.zeros(n)
     at = at0
     for i in range(N_WAVELETS):
@@ -492,10 +528,12 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
             break
         if a == start and b == start + shape.size:  # wholly inside: the shifted kernel
             if kernel is None:
-                kernel = _transform_piece(shape, span, scale, centre, centre + 2 * span + 1)
+                kernel = _Window(scale, centre, centre + 2 * span + 1, span, span + shape.size)(shape, span)
             window -= amp * kernel[lo - at + span:hi - at + span]
         else:  # cut by the record's ends: the transform of the samples kept
-            window -= _transform_piece(amp * shape[a - start:b - start], a, scale, lo, hi)
+            if cut is None:  # inputs: every sample a wavelet centred in the window can cover
+                cut = _Window(scale, lo, hi, max(0, lo - centre), min(n, hi - 1 - centre + shape.size))
+            window -= cut(amp * shape[a - start:b - start], a)
     resid = signal - pulse
     e_signal = np.cumsum(signal * signal)
     e_pulse = np.cumsum(pulse * pulse)
@@ -554,12 +592,18 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     if scales[0] < 1:
         raise RecordError(f"{record.name}: time step {dt:g} s is too long for pulses of "
                           f"{TP_MIN:g} s (at most {TP_MIN * FC:g} s)")
-    if v2 is None:
-        c1, c2 = db4_cwt(v1, scales), None
-        power = c1 * c1
-    else:
-        c1, c2 = db4_cwt(np.stack([v1, v2]), scales)
-        power = c1 * c1 + c2 * c2
+    # the (scale, time) map of C1^2 + C2^2, each row made while its transform is in the cache
+    x = v1 if v2 is None else np.stack([v1, v2])
+    c = np.empty(x.shape[:-1] + (scales.size, x.shape[-1]))
+    power = np.empty((scales.size, x.shape[-1]))
+    for i, row in _cwt_rows(x, tuple(float(a) for a in scales)):
+        c[..., i, :] = row
+        if v2 is None:
+            np.multiply(row, row, out=power[i])
+        else:
+            np.multiply(row[0], row[0], out=power[i])
+            power[i] += row[1] * row[1]
+    c1, c2 = (c, None) if v2 is None else (c[0], c[1])
     candidates = []
     for _ in range(N_CANDIDATES):
         row, col = np.unravel_index(int(np.argmax(power)), power.shape)
