@@ -553,6 +553,18 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
                 pulse=pulse / CM_PER_M, velocity=signal / CM_PER_M)
 
 
+def _strongest(power: np.ndarray, peak: np.ndarray) -> tuple[int, int]:
+    """(row, column) of the largest value of ``power`` (non-negative), given ``peak``, its
+    largest value in each column: the column from ``peak``, then the row in that column; on a
+    tie between columns, the first in row-major order, as :func:`numpy.argmax`."""
+    cols = np.flatnonzero(peak == peak.max())
+    if cols.size == 1:
+        col = int(cols[0])
+        return int(np.argmax(power[:, col])), col
+    row, col = np.unravel_index(int(np.argmax(power)), power.shape)
+    return int(row), int(col)
+
+
 def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_energy) -> PulseClassification:
     """Classify a record, or a pair of horizontal components, as pulse-like or not.
 
@@ -596,6 +608,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     x = v1 if v2 is None else np.stack([v1, v2])
     c = np.empty(x.shape[:-1] + (scales.size, x.shape[-1]))
     power = np.empty((scales.size, x.shape[-1]))
+    peak = np.zeros(x.shape[-1])  # largest power at each time (over scales)
     for i, row in _cwt_rows(x, tuple(float(a) for a in scales)):
         c[..., i, :] = row
         if v2 is None:
@@ -603,10 +616,11 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
         else:
             np.multiply(row[0], row[0], out=power[i])
             power[i] += row[1] * row[1]
+        np.maximum(peak, power[i], out=peak)
     c1, c2 = (c, None) if v2 is None else (c[0], c[1])
     candidates = []
     for _ in range(N_CANDIDATES):
-        row, col = np.unravel_index(int(np.argmax(power)), power.shape)
+        row, col = _strongest(power, peak)
         a, b = c1[row, col], (c2[row, col] if c2 is not None else 0.0)
         theta = math.atan(b / a) if a != 0.0 else (math.pi / 2 if b != 0.0 else 0.0)
         signal = v1 * math.cos(theta) + v2 * math.sin(theta) if v2 is not None else v1
@@ -617,7 +631,9 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
             arrival=record.t_start + d["arrival_index"] * dt, orientation=math.degrees(theta),
             time=record.t_start + int(col) * dt, velocity=d["velocity"], pulse=d["pulse"]))
         reach = WINDOW * scales[row]  # clear samples strictly within `reach` of the maximum
-        power[:, max(0, math.floor(col - reach) + 1):max(0, math.ceil(col + reach))] = 0.0
+        cleared = slice(max(0, math.floor(col - reach) + 1), max(0, math.ceil(col + reach)))
+        power[:, cleared] = 0.0
+        peak[cleared] = 0.0
     pulse_like = [i for i, c in enumerate(candidates) if c.is_pulse]
     chosen = pulse_like[0] if pulse_like else int(np.argmax([c.indicator for c in candidates]))
     c = candidates[chosen]
