@@ -93,7 +93,7 @@ def resampled_integral(scale: float) -> np.ndarray:
     return int_psi[j][::-1]
 
 
-@lru_cache(maxsize=4096)
+@lru_cache(maxsize=256)  # the coarse scales; the refined ones are kept by _point_filter
 def difference_filter(scale: float) -> np.ndarray:
     """Filter ``g`` with ``conv(x, g) = diff(conv(x, f))``, ``f`` the :func:`resampled_integral`
     (``g = [f0, f1 - f0, ..., -f_last]``); read-only."""
@@ -110,7 +110,12 @@ def _offset(scale: float) -> int:
     """Index in ``conv(x, g)`` of the transform's sample 0: MATLAB keeps the central ``n``
     samples of ``diff(conv(x, f))`` (``wkeep1``), i.e. from ``floor((len(f) - 2) / 2)``, and
     ``diff(y)[k] = conv(x, g)[k + 1]``."""
-    return (difference_filter(scale).size - 3) // 2 + 1
+    return _offset_of(difference_filter(scale).size)
+
+
+def _offset_of(length: int) -> int:
+    """:func:`_offset` of a filter ``g`` of ``length`` samples (``len(f) = length - 1``)."""
+    return (length - 3) // 2 + 1
 
 
 def db4_cwt_direct(x, scales) -> np.ndarray:
@@ -189,6 +194,44 @@ def _size_groups(scales: tuple, n: int, groups: int = 4) -> tuple:
     return tuple((max(need[i] for i in run), tuple(run)) for run in runs if run)
 
 
+#: longest dot product handed to BLAS in one call: OpenBLAS (in NumPy's and SciPy's wheels)
+#: spreads a dot product of more than 10,000 elements over threads, which stalls on a busy
+#: machine (4 ms instead of 4 us measured); shorter pieces run on the calling thread, three
+#: times faster than :func:`numpy.einsum`
+DOT_PIECE = 8192
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum(a * b)`` of two 1-D arrays, by BLAS in pieces of at most :data:`DOT_PIECE`."""
+    if a.size <= DOT_PIECE:
+        return float(np.dot(a, b))
+    return float(sum(np.dot(a[i:i + DOT_PIECE], b[i:i + DOT_PIECE]) for i in range(0, a.size, DOT_PIECE)))
+
+
+@lru_cache(maxsize=4096)
+def _point_filter(scale: float) -> tuple[int, np.ndarray, float]:
+    """What the transform at one sample needs at ``scale``: (the :func:`_offset`, the
+    :func:`difference_filter` reversed (read-only), ``-sqrt(scale)``)."""
+    g = difference_filter.__wrapped__(scale)  # uncached: only the reversed copy is kept
+    reverse = g[::-1].copy()
+    reverse.flags.writeable = False
+    return _offset_of(g.size), reverse, -math.sqrt(scale)
+
+
+def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
+    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each,
+    over the samples of ``x`` the filter meets)."""
+    out = np.empty(len(scales))
+    n = x.size
+    for i, a in enumerate(scales):
+        offset, gr, factor = _point_filter(a)
+        hi = at + offset + 1  # x indices at + offset - (G - 1) .. at + offset
+        lo = hi - gr.size
+        x_lo, x_hi = max(lo, 0), min(hi, n)
+        out[i] = factor * _dot(x[x_lo:x_hi], gr[x_lo - lo:x_hi - lo]) if x_hi > x_lo else 0.0
+    return out
+
+
 #: largest (outputs x input samples) for which a windowed transform is a direct convolution:
 #: below it :func:`numpy.convolve` is cheaper than two FFTs
 DIRECT_LIMIT = 100_000
@@ -206,12 +249,11 @@ class _Window:
     """
 
     def __init__(self, scale: float, start: int, stop: int, lo: int, hi: int):
-        g = difference_filter(scale)
-        k = _offset(scale)
+        k, reverse, self.factor = _point_filter(scale)
+        g = reverse[::-1]
         self.lo = max(lo, start + k - (g.size - 1))  # inputs the outputs see
         self.hi = min(hi, stop + k)
         self.width = stop - start
-        self.factor = -math.sqrt(scale)
         size = self.hi - self.lo
         if size <= 0:
             self.part = None
@@ -450,43 +492,6 @@ class PulseClassification:
 
 # -- the classification ----------------------------------------------------------------------
 
-#: longest dot product handed to BLAS in one call: OpenBLAS (in NumPy's and SciPy's wheels)
-#: spreads a dot product of more than 10,000 elements over threads, which stalls on a busy
-#: machine (4 ms instead of 4 us measured); shorter pieces run on the calling thread, three
-#: times faster than :func:`numpy.einsum`
-DOT_PIECE = 8192
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> float:
-    """``sum(a * b)`` of two 1-D arrays, by BLAS in pieces of at most :data:`DOT_PIECE`."""
-    if a.size <= DOT_PIECE:
-        return float(np.dot(a, b))
-    return float(sum(np.dot(a[i:i + DOT_PIECE], b[i:i + DOT_PIECE]) for i in range(0, a.size, DOT_PIECE)))
-
-
-@lru_cache(maxsize=4096)
-def _point_filter(scale: float) -> tuple[int, np.ndarray, float]:
-    """What the transform at one sample needs at ``scale``: (the :func:`_offset`, the
-    :func:`difference_filter` reversed (read-only), ``-sqrt(scale)``)."""
-    g = difference_filter(scale)[::-1].copy()
-    g.flags.writeable = False
-    return _offset(scale), g, -math.sqrt(scale)
-
-
-def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
-    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each,
-    over the samples of ``x`` the filter meets)."""
-    out = np.empty(len(scales))
-    n = x.size
-    for i, a in enumerate(scales):
-        offset, gr, factor = _point_filter(a)
-        hi = at + offset + 1  # x indices at + offset - (G - 1) .. at + offset
-        lo = hi - gr.size
-        x_lo, x_hi = max(lo, 0), min(hi, n)
-        out[i] = factor * _dot(x[x_lo:x_hi], gr[x_lo - lo:x_hi - lo]) if x_hi > x_lo else 0.0
-    return out
-
-
 def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarray, energy) -> dict:
     """``analyze_record.m`` for one candidate; ``signal`` in cm/s.
 
@@ -606,18 +611,18 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
                           f"{TP_MIN:g} s (at most {TP_MIN * FC:g} s)")
     # the (scale, time) map of C1^2 + C2^2, each row made while its transform is in the cache
     x = v1 if v2 is None else np.stack([v1, v2])
-    c = np.empty(x.shape[:-1] + (scales.size, x.shape[-1]))
+    coefs = np.empty(x.shape[:-1] + (scales.size, x.shape[-1]))
     power = np.empty((scales.size, x.shape[-1]))
     peak = np.zeros(x.shape[-1])  # largest power at each time (over scales)
     for i, row in _cwt_rows(x, tuple(float(a) for a in scales)):
-        c[..., i, :] = row
+        coefs[..., i, :] = row
         if v2 is None:
             np.multiply(row, row, out=power[i])
         else:
             np.multiply(row[0], row[0], out=power[i])
             power[i] += row[1] * row[1]
         np.maximum(peak, power[i], out=peak)
-    c1, c2 = (c, None) if v2 is None else (c[0], c[1])
+    c1, c2 = (coefs, None) if v2 is None else (coefs[0], coefs[1])
     candidates = []
     for _ in range(N_CANDIDATES):
         row, col = _strongest(power, peak)
