@@ -245,7 +245,7 @@ def test_weighted_fit_pins_the_edges_in_a_band_the_readme_does_not_use():
     # the band; the same records fitted both ways.  The one-sine's and rectangle's edges carry
     # energy above the band where the background has almost none: weighted by the background's
     # spectrum, their Tp is pinned (limit 0.02-0.5 % against 1-5 % plain), so the RMS Tp error
-    # must fall at least fivefold (measured: 3 %, 0.1 % against about 2 % plain: 20x).  Their ap
+    # must fall at least fivefold (measured: 0.10 % against 1.9 % plain, 19x).  Their ap
     # and the Rickers' ap and Tp stay near the plain limit (the weighting is used only where it
     # promises half the scatter), so their errors are not compared here (README)
     rng = np.random.default_rng(812)
