@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib.resources
+import pathlib
 
 from .cmd_run import add_common, options_from, parse_jobs
 
@@ -22,8 +23,15 @@ def add_parser(subparsers) -> None:
 
 @contextlib.contextmanager
 def bundled_records():
-    """Paths of the bundled example records (SAC), sorted by name."""
-    root = importlib.resources.files("pipeline.data")
+    """Paths of the bundled example records (SAC), sorted by name: the installed package's
+    ``pipeline.data``, or a source checkout's ``data/`` folder when the package is not installed."""
+    try:
+        root = importlib.resources.files("pipeline.data")
+    except ModuleNotFoundError:  # run from a source checkout: pipeline.data is data/ once installed
+        root = pathlib.Path(__file__).resolve().parents[1] / "data"
+        if not root.is_dir():
+            yield []
+            return
     with importlib.resources.as_file(root) as folder:
         yield sorted(str(p) for p in folder.iterdir() if p.name.endswith(".sac"))
 

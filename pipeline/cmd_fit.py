@@ -10,9 +10,11 @@ are those of :func:`pipeline.args.add_record_options`, shared with the other sub
 from __future__ import annotations
 
 import json
+import os
 import sys
 
-from .args import add_record_options, parse_shapes, record_options
+from .args import ArgumentError, add_record_options, output_folder, parse_shapes, record_options
+from .report import display, text_cell
 
 
 def add_parser(subparsers) -> None:
@@ -37,6 +39,12 @@ def main(args) -> int:
 
     shapes = parse_shapes(args.shapes)
     opts = record_options(args)
+    if args.plot:
+        output_folder(args.plot, "--plot")
+    if args.csv:
+        if os.path.isdir(args.csv):
+            raise ArgumentError(f"--csv {display(args.csv)} is a folder; give a file name")
+        output_folder(os.path.dirname(os.path.abspath(args.csv)), "--csv: the folder of")
     fits, rows, failures = [], [], 0
     for path in args.files:
         try:
@@ -68,7 +76,10 @@ def main(args) -> int:
     if args.csv and rows:
         import pandas as pd
 
-        pd.concat(rows, ignore_index=True).to_csv(args.csv, index=False, float_format="%.6g")
+        frame = pd.concat(rows, ignore_index=True)
+        for name in frame.columns:  # text cells a spreadsheet would evaluate: see report.text_cell
+            frame[name] = frame[name].map(lambda v: text_cell(v) if isinstance(v, str) else v)
+        frame.to_csv(args.csv, index=False, float_format="%.6g")
     return 1 if failures else 0
 
 

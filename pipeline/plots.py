@@ -93,8 +93,8 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
         raise ValueError(f"at most {MAX_PULSES} fitted pulses per record figure, got {len(fitting)}")
     width, height = 8.0, _RECORD_TOP + _RECORD_BOTTOM + (1 + len(histories)) * _PANEL + len(histories) * _GAP
     fig = _figure(width, height)
-    # margins fixed in inches (what a layout engine gives for these labels, checked by
-    # tests/test_plots.py): a layout engine measures every text before drawing it, 25 % of the cost
+    # margins fixed in inches (room for these labels, checked by tests/test_plots.py): a layout
+    # engine measures every text before drawing it, which made the figure half as costly again
     fig.subplots_adjust(left=_RECORD_LEFT / width, right=1.0 - _RECORD_RIGHT / width, top=1.0 - _RECORD_TOP / height,
                         bottom=_RECORD_BOTTOM / height, hspace=_GAP / _PANEL)
     axes = fig.subplots(1 + len(histories), 1, sharex=True, squeeze=False)[:, 0]

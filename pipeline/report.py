@@ -1,9 +1,12 @@
-"""Report files of ``pipeline run``: per-record CSV, ``summary.csv``, ``failures.csv``, ``columns.md``.
+"""Report files of ``pipeline run``: per-record CSV, ``summary.csv``, ``failures.csv``, ``columns.md``,
+and the manifest of what the run wrote.
 
-Every file is written atomically (to a hidden temporary name in the same folder, then renamed), so an
-interrupted run never leaves a half-written report, and the content depends only on the inputs (no
-time stamps, fixed number formatting, input order), so re-running into the same folder gives
-identical files.
+Every file is written atomically (to a temporary file created exclusively in the same folder, then
+renamed), so an interrupted run never leaves a half-written report, and the content depends only on
+the inputs (no time stamps, fixed number formatting, input order), so re-running into the same
+folder gives identical files.  Only files the run wrote are ever replaced or removed
+(:class:`Outputs`).  The report columns themselves are declared in :mod:`pipeline.batch`, next to
+the code that computes them (:class:`Columns`).
 """
 from __future__ import annotations
 

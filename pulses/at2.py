@@ -11,7 +11,9 @@ line, with a short last line::
 
 The older NGA/PEER header writes the fourth line as ``1991    0.0100    NPTS, DT``.  Numbers may
 lack a leading zero (``.0100``, ``-.25E-02``) and may touch (no space before a minus sign), so
-samples are read with a regular expression, never by splitting on blanks or by fixed columns.
+samples are never read by fixed columns: numpy reads blocks of lines, with a blank put before a
+sign that touches the number before it, and a block numpy stops in is read with a regular
+expression line by line (which names the line that is not numbers).
 The sample count is checked against ``NPTS``: sample ``k`` (0-based) is at ``t = k DT``, so the
 record lasts ``(NPTS - 1) DT``.
 
@@ -28,7 +30,7 @@ import numpy as np
 
 from . import formats
 from .errors import RecordError
-from .formats import MAX_SAMPLES, too_long
+from .formats import MAX_SAMPLES, join_blocks, too_long
 from .orientation import orientation, seed_orientation
 from .units import canonical_units
 
@@ -53,6 +55,8 @@ _AZIMUTH_CODED = re.compile(r"[A-Z][A-Z0-9_-]*?(\d{3})")
 _VERTICAL = re.compile(r"(?:.*[^A-Z])?(?:UP|DWN|DN|DOWN|V|VERT)|[A-Z0-9-]*?(?:UP|DWN)")
 #: horizontals that state no azimuth: fault-normal, fault-parallel, NGA-West2's H1 and H2
 _HORIZONTAL = {"FN", "FP", "H1", "H2"}
+#: compass directions, alone or after a station code and a hyphen (``TCU068-N``)
+_COMPASS = {"N": 0.0, "NS": 0.0, "N-S": 0.0, "E": 90.0, "EW": 90.0, "E-W": 90.0, "S": 180.0, "W": 270.0}
 
 
 def _float(text: str) -> float:
@@ -111,7 +115,8 @@ def _title_fields(line: str) -> dict:
 def component_orientation(component: str) -> dict:
     """``azimuth`` and ``vertical`` (see :mod:`pulses.orientation`) from an AT2 component.
 
-    ``228`` and ``PUL164`` give azimuths 228 and 164 (degrees clockwise from north); ``UP``,
+    ``228`` and ``PUL164`` give azimuths 228 and 164 (degrees clockwise from north), ``N``,
+    ``E-W`` and ``TCU068-N`` 0, 90 and 0; ``UP``,
     ``DWN``, ``V`` and ``-UP`` are vertical; ``FN``, ``FP``, ``H1`` and ``H2`` horizontal with no
     stated azimuth; anything else says nothing.
     """
@@ -122,6 +127,9 @@ def component_orientation(component: str) -> dict:
     m = _AZIMUTH_CODED.fullmatch(code)
     if m and float(m.group(1)) <= 360.0:
         return orientation(azimuth=float(m.group(1)))
+    compass = _COMPASS.get(code, _COMPASS.get(code.rsplit("-", 1)[-1]))
+    if compass is not None:
+        return orientation(azimuth=compass)
     if _VERTICAL.fullmatch(code):
         return orientation(vertical=True)
     if code in _HORIZONTAL:
@@ -194,7 +202,7 @@ def read_at2_file(path, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, flo
         raise RecordError(f"{path}: is a directory, not a record file") from None
     except OSError as exc:
         raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    data = np.concatenate(blocks) if blocks else np.zeros(0)
+    data = join_blocks(blocks)
     style = "NPTS=, DT=" if _NPTS_DT_NEW.search(lines[3]) else "NPTS, DT"
     if data.size != npts:
         what = "truncated" if data.size < npts else "longer than its header says"
@@ -211,14 +219,15 @@ def read_at2_file(path, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, flo
 
 #: characters read per block of sample lines
 _BLOCK_CHARS = 1 << 22
-#: characters of a sample block that numpy may parse directly (D exponents turned into E first)
-_FAST_CHARS = set("0123456789.+-EeDd \t\n")
+#: a character that numpy is not given directly (only numbers, D exponents turned into E first)
+_NOT_FAST = re.compile(r"[^0-9.+\-EeDd \t\n]")
 _D_TO_E = str.maketrans("Dd", "Ee")
 #: a sign that touches the number before it (``-.1E-02-.2E-02``); an exponent's sign follows E
 _TOUCHING_SIGN = re.compile(r"(?<=[\d.])(?=[-+])")
 
 
 def _rest_has_text(fh) -> bool:
+    """Whether anything but blanks follows in ``fh`` (read in blocks)."""
     while True:
         block = fh.read(_BLOCK_CHARS)
         if not block:
@@ -230,7 +239,8 @@ def _rest_has_text(fh) -> bool:
 def _from_text(text: str) -> np.ndarray | None:
     """The numbers in ``text`` (blank-separated) by numpy, or ``None`` where it stops early."""
     with warnings.catch_warnings():
-        warnings.simplefilter("error", DeprecationWarning)  # numpy < 2.? warns where it stops
+        # where numpy stops early it raises ValueError, or (older numpy) warns and returns less
+        warnings.simplefilter("error", DeprecationWarning)
         try:
             return np.fromstring(text, dtype=float, sep=" ")
         except (ValueError, DeprecationWarning):
@@ -240,7 +250,7 @@ def _from_text(text: str) -> np.ndarray | None:
 def _parse_block(path: str, lines: list, lineno: int) -> np.ndarray:
     """The samples of a block of AT2 lines (the first is line ``lineno + 1`` of the file)."""
     text = "".join(lines)
-    if _FAST_CHARS.issuperset(text):
+    if not _NOT_FAST.search(text):
         text = text.translate(_D_TO_E)
         values = _from_text(text)
         if values is None:

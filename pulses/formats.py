@@ -36,6 +36,18 @@ def too_long(path: str, limit: int, count: int | None = None) -> str:
             f"strong motion, or pass a larger max_samples")
 
 
+def join_blocks(blocks: list) -> np.ndarray:
+    """Arrays read block by block as one array, emptying ``blocks`` while copying them, so the
+    memory peak is the result plus one block rather than twice the record."""
+    out = np.empty(sum(b.size for b in blocks))
+    at = 0
+    while blocks:
+        block = blocks.pop(0)
+        out[at:at + block.size] = block
+        at += block.size
+    return out
+
+
 @dataclasses.dataclass(frozen=True)
 class ReadOptions:
     """What the caller says about the file, passed to every format's reader.
@@ -139,6 +151,15 @@ def register(fmt: RecordFormat) -> RecordFormat:
     if fmt.obspy_name:
         _OBSPY[fmt.obspy_name.upper()] = fmt
     return fmt
+
+
+def unregister(name: str) -> None:
+    """Remove the format registered as ``name`` (and its aliases and obspy name)."""
+    fmt = _FORMATS.pop(name)
+    for key in [k for k, f in _NAMES.items() if f is fmt]:
+        del _NAMES[key]
+    for key in [k for k, f in _OBSPY.items() if f is fmt]:
+        del _OBSPY[key]
 
 
 def registered() -> list[RecordFormat]:

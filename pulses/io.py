@@ -8,9 +8,9 @@ it and applies the checks every record gets.  Formats (``format=``):
 ``"text"``
     Plain text or CSV columns (see :mod:`pulses.textfile`); the user gives ``units`` and ``dt``
     (``dt`` may come from a time column instead).
-``"sac"`` (:mod:`pulses.sac`), ``"knet"`` (:mod:`pulses.knet`) and every other format obspy reads (``"mseed"``, ...)
-    Through :func:`obspy.read` (:mod:`pulses.obspyformat`).  SAC: ``idep`` states the quantity; ``iacc`` means nm/s^2 by the
-    SAC standard, honoured unless the user passes ``units``.  K-NET: obspy leaves the samples in
+``"sac"`` (:mod:`pulses.sac`), ``"knet"`` (:mod:`pulses.knet`), every other obspy format (``"mseed"``, ...)
+    Through :func:`obspy.read` (:mod:`pulses.obspyformat`).  SAC: ``idep`` states the quantity;
+    ``iacc`` means nm/s^2 by the SAC standard, honoured unless the user passes ``units``.  K-NET: obspy leaves the samples in
     counts and puts the header's scale factor, converted from gal to m/s^2, into
     ``stats.calib``; the reader multiplies by it and removes the mean (the K-NET convention), so
     the units are stated (m/s^2).  Formats that state no units (MiniSEED, ...) need ``units``.
@@ -53,7 +53,7 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
 
     Parameters
     ----------
-    path : str or path-like
+    path : str, bytes or path-like
         The record file.
     format : str, optional
         ``"at2"``, ``"text"`` (or ``"csv"``), ``"sac"``, ``"mseed"``, ``"knet"`` or any obspy
@@ -73,7 +73,9 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
     trace : int or str, optional
         obspy formats holding several traces: the index (from 0) or the trace id or channel.
     name : str, optional
-        Name of the record in reports (default: the file name, plus ``:colN`` for a chosen column).
+        Name of the record in reports (default: the file name, plus ``:colN`` for a chosen
+        column; bytes that are not UTF-8 and characters that do not print written as escapes,
+        see :func:`printable`).
     max_samples : int, optional
         A record with more samples is refused (default :data:`pulses.formats.MAX_SAMPLES`,
         10^7); text and AT2 files are refused while reading, before memory grows further.
@@ -99,7 +101,18 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
     The formats are those registered in :mod:`pulses.formats` (one module each); this function
     only dispatches to them and applies the checks every record gets.
     """
-    path = os.fspath(path)
+    path = os.fsdecode(path)  # bytes too; bytes that are not UTF-8 kept as surrogates (PEP 383)
+    shown = printable(path)
+    try:
+        return _read(path, format, units, dt, column, trace, name, max_samples)
+    except RecordError as exc:
+        if shown == path:
+            raise
+        raise RecordError(str(exc).replace(path, shown)) from None  # messages print and write safely
+
+
+def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
+    """:func:`read_record` on a ``str`` path: dispatch to the format, then the common checks."""
     p = pathlib.Path(path)
     if not p.exists():
         raise RecordError(f"{path}: no such file")
@@ -123,8 +136,25 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
         meta.setdefault(key, "")
     _validate(path, acc, reading.values, used_units, units_source, meta)
     if name is None:
-        name = p.name + (f":col{meta['column']}" if meta.get("columns", 1) > 1 else "")
+        name = printable(p.name) + (f":col{meta['column']}" if meta.get("columns", 1) > 1 else "")
     return Record(acc, dt, name=name, t_start=float(meta.pop("t_start", 0.0)), metadata=meta)
+
+
+def printable(text: str) -> str:
+    """``text`` safe to print and to write as UTF-8 (a record's default name, error messages).
+
+    Bytes of a file name that are not UTF-8 (which Python keeps as lone surrogates, PEP 383) and
+    characters that do not print (newline, tab, other controls) are written as backslash escapes
+    (``\\xff``, ``\\n``); everything else is kept.
+    """
+    try:
+        raw = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:  # a lone surrogate that did not come from a byte
+        raw = text.encode("utf-8", "backslashreplace")
+    text = raw.decode("utf-8", "backslashreplace")
+    if text.isprintable():
+        return text
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
 
 
 def _units(path, reading, units):

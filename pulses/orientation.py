@@ -15,7 +15,10 @@ from __future__ import annotations
 
 import math
 
-#: SEED channel codes: band, instrument, orientation; Z is vertical, N, E, 1, 2 horizontal
+#: SEED channel codes: band, instrument, orientation; Z is vertical, N, E, 1, 2 horizontal.
+#: Only ground-motion instruments count (H, L high and low gain seismometers, G gravimeter,
+#: N accelerometer), so that a three-letter station code is not read as a channel.
+_SEED_INSTRUMENTS = "HLGN"
 _SEED_VERTICAL = "Z"
 _SEED_HORIZONTAL = "NE12"
 
@@ -53,7 +56,7 @@ def seed_orientation(channel) -> dict:
     SEED's N and E mean north and east only within 5 degrees, so no azimuth is given.
     """
     code = str(channel or "").strip().upper()
-    if len(code) != 3 or not code.isalnum():
+    if len(code) != 3 or not code.isalnum() or code[1] not in _SEED_INSTRUMENTS:
         return {}
     if code[2] == _SEED_VERTICAL:
         return orientation(vertical=True)

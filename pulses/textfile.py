@@ -14,6 +14,7 @@ comments that seem to mention them are quoted back in the error message, never u
 """
 from __future__ import annotations
 
+import io
 import os
 import re
 
@@ -21,7 +22,7 @@ import numpy as np
 
 from . import formats
 from .errors import RecordError
-from .formats import MAX_SAMPLES, too_long
+from .formats import MAX_SAMPLES, join_blocks, too_long
 
 _SPLIT = re.compile(r"[\s,;]+")
 _COMMENT = ("%", "#", "!", "//")
@@ -108,12 +109,11 @@ def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPL
         last = " (truncated last line?)" if lineno == parsed.last_row else ""
         raise RecordError(f"{path}: line {lineno} has {count} value(s), the first data line "
                           f"has {ncols}{last}")
-    first = np.concatenate(parsed.first)
-    kept = np.concatenate(parsed.kept) if parsed.kept_index else first
+    first = join_blocks(parsed.first)
+    kept = join_blocks(parsed.kept) if parsed.kept_index else first
     names = parsed.names
     named_time = bool(names) and names[0].lower().startswith(("t", "time", "sec"))
-    time_column = ncols >= 2 and first.size >= 2 and (
-        named_time or bool(np.all(np.diff(first) > 0)))
+    time_column = ncols >= 2 and first.size >= 2 and (named_time or _increasing(first))
     if column is None:
         if ncols == 1:
             column = 1
@@ -133,9 +133,12 @@ def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPL
     if time_column:
         steps = np.diff(first)
         dt_mean = (first[-1] - first[0]) / (first.size - 1)
-        if not np.all(np.abs(steps - dt_mean) <= UNIFORM_TOLERANCE * dt_mean + 1e-12):
-            raise RecordError(f"{path}: non-uniform sampling: time steps range from {steps.min():.6g} "
-                              f"to {steps.max():.6g} s; resample to a uniform step first")
+        shortest, longest = steps.min(), steps.max()
+        steps -= dt_mean  # in place: no more arrays the record's length
+        if not np.all(np.abs(steps, out=steps) <= UNIFORM_TOLERANCE * dt_mean + 1e-12):
+            raise RecordError(f"{path}: non-uniform sampling: time steps range from {shortest:.6g} "
+                              f"to {longest:.6g} s; resample to a uniform step first")
+        del steps
         dt_from_time = float(dt_mean)
     info = {"comments": parsed.comments, "columns": ncols, "column": column, "time_column": time_column,
             "names": names}
@@ -143,8 +146,18 @@ def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPL
     return (first if column == 1 else kept), dt_from_time, info
 
 
-#: characters of a block that numpy may parse directly: numbers and separators only
-_FAST_CHARS = set("0123456789.+-eE \t\n,;")
+def _increasing(values: np.ndarray) -> bool:
+    """Every value above the one before (without an array of differences)."""
+    block = 1 << 20
+    for i in range(0, values.size - 1, block):
+        part = values[i:i + block + 1]
+        if not np.all(part[1:] > part[:-1]):
+            return False
+    return True
+
+
+#: a character that numpy is not given directly (only numbers and separators are)
+_NOT_FAST = re.compile(r"[^0-9.+\-eE \t\n,;]")
 _TO_BLANKS = str.maketrans(",;", "  ")
 #: characters read per block of lines
 _BLOCK_CHARS = 1 << 22
@@ -165,7 +178,17 @@ class _Rows:
         self.nrows, self.lineno, self.last_row, self.ragged = 0, 0, None, None
 
     def add(self, lines):
-        table = self._fast(lines) if self.ncols is not None and self.ragged is None else None
+        if self.ncols is None:  # comments and the header row, line by line up to the first row
+            for i, line in enumerate(lines):
+                table = self._slow([line])
+                if table is not None and table.shape[0]:
+                    self._keep(table)
+                if self.ncols is not None:
+                    lines = lines[i + 1:]
+                    break
+            else:
+                return
+        table = self._fast(lines) if self.ragged is None else None
         if table is None:
             table = self._slow(lines)
         else:
@@ -179,12 +202,12 @@ class _Rows:
 
     def _fast(self, lines):
         block = "".join(lines)
-        if not _FAST_CHARS.issuperset(block):
+        if _NOT_FAST.search(block):
             return None
         if not block.strip():
             return np.empty((0, self.ncols))
         try:
-            table = np.loadtxt(block.translate(_TO_BLANKS).splitlines(), ndmin=2, comments=None)
+            table = np.loadtxt(io.StringIO(block.translate(_TO_BLANKS)), ndmin=2, comments=None)
         except ValueError:
             return None
         if table.shape[0] and table.shape[1] != self.ncols:

@@ -93,7 +93,7 @@ def resampled_integral(scale: float) -> np.ndarray:
     return int_psi[j][::-1]
 
 
-@lru_cache(maxsize=4096)
+@lru_cache(maxsize=256)  # the coarse scales; the refined ones are kept by _point_filter
 def difference_filter(scale: float) -> np.ndarray:
     """Filter ``g`` with ``conv(x, g) = diff(conv(x, f))``, ``f`` the :func:`resampled_integral`
     (``g = [f0, f1 - f0, ..., -f_last]``); read-only."""
@@ -110,7 +110,12 @@ def _offset(scale: float) -> int:
     """Index in ``conv(x, g)`` of the transform's sample 0: MATLAB keeps the central ``n``
     samples of ``diff(conv(x, f))`` (``wkeep1``), i.e. from ``floor((len(f) - 2) / 2)``, and
     ``diff(y)[k] = conv(x, g)[k + 1]``."""
-    return (difference_filter(scale).size - 3) // 2 + 1
+    return _offset_of(difference_filter(scale).size)
+
+
+def _offset_of(length: int) -> int:
+    """:func:`_offset` of a filter ``g`` of ``length`` samples (``len(f) = length - 1``)."""
+    return (length - 3) // 2 + 1
 
 
 def db4_cwt_direct(x, scales) -> np.ndarray:
@@ -157,16 +162,26 @@ def db4_cwt(x, scales) -> np.ndarray:
     numpy.ndarray, shape (len(scales), n) or (m, len(scales), n)
     """
     x = np.asarray(x, dtype=float)
-    n = x.shape[-1]
     scales = tuple(float(a) for a in scales)
-    out = np.empty(x.shape[:-1] + (len(scales), n))
+    out = np.empty(x.shape[:-1] + (len(scales), x.shape[-1]))
+    for i, row in _cwt_rows(x, scales):
+        out[..., i, :] = row
+    return out
+
+
+def _cwt_rows(x: np.ndarray, scales: tuple):
+    """The rows of :func:`db4_cwt`, one scale at a time (in the order of their FFT sizes):
+    pairs (index of the scale, transform of shape ``x.shape``), so that a caller can use each
+    row while it is in the cache."""
+    n = x.shape[-1]
     for size, members in _size_groups(scales, n):
         spectrum = sfft.rfft(x, size, axis=-1)
         spectra = _filter_spectra(tuple(scales[i] for i in members), size)
+        product = np.empty_like(spectrum)
         for j, i in enumerate(members):
             k = _offset(scales[i])
-            out[..., i, :] = sfft.irfft(spectrum * spectra[j], size, axis=-1)[..., k:k + n]
-    return out
+            np.multiply(spectrum, spectra[j], out=product)
+            yield i, sfft.irfft(product, size, axis=-1)[..., k:k + n]
 
 
 @lru_cache(maxsize=8)
@@ -181,31 +196,103 @@ def _size_groups(scales: tuple, n: int, groups: int = 4) -> tuple:
     return tuple((max(need[i] for i in run), tuple(run)) for run in runs if run)
 
 
-@lru_cache(maxsize=64)
-def _window_spectrum(scale: float, size: int) -> np.ndarray:
-    spectrum = sfft.rfft(difference_filter(scale), size) * (-math.sqrt(scale))
-    spectrum.flags.writeable = False
-    return spectrum
+#: longest dot product handed to BLAS in one call: OpenBLAS (in NumPy's and SciPy's wheels)
+#: spreads a dot product of more than 10,000 elements over threads, which stalls on a busy
+#: machine (4 ms instead of 4 us measured); shorter pieces run on the calling thread, three
+#: times faster than :func:`numpy.einsum`
+DOT_PIECE = 8192
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum(a * b)`` of two 1-D arrays, by BLAS in pieces of at most :data:`DOT_PIECE`."""
+    if a.size <= DOT_PIECE:
+        return float(np.dot(a, b))
+    return float(sum(np.dot(a[i:i + DOT_PIECE], b[i:i + DOT_PIECE]) for i in range(0, a.size, DOT_PIECE)))
+
+
+@lru_cache(maxsize=4096)
+def _point_filter(scale: float) -> tuple[int, np.ndarray, float]:
+    """What the transform at one sample needs at ``scale``: (the :func:`_offset`, the
+    :func:`difference_filter` reversed (read-only), ``-sqrt(scale)``)."""
+    g = difference_filter.__wrapped__(scale)  # uncached: only the reversed copy is kept
+    reverse = g[::-1].copy()
+    reverse.flags.writeable = False
+    return _offset_of(g.size), reverse, -math.sqrt(scale)
+
+
+def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
+    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each,
+    over the samples of ``x`` the filter meets)."""
+    out = np.empty(len(scales))
+    n = x.size
+    for i, a in enumerate(scales):
+        offset, gr, factor = _point_filter(a)
+        hi = at + offset + 1  # x indices at + offset - (G - 1) .. at + offset
+        lo = hi - gr.size
+        x_lo, x_hi = max(lo, 0), min(hi, n)
+        out[i] = factor * _dot(x[x_lo:x_hi], gr[x_lo - lo:x_hi - lo]) if x_hi > x_lo else 0.0
+    return out
+
+
+#: largest (outputs x input samples) for which a windowed transform is a direct convolution:
+#: below it :func:`numpy.convolve` is cheaper than two FFTs
+DIRECT_LIMIT = 100_000
+
+
+class _Window:
+    """The db4 transform at one scale over output samples ``start..stop-1`` of signals that are
+    zero outside input samples ``lo..hi-1``.
+
+    Only the stretch of the filter those outputs and inputs meet is used (zero-extended where
+    it runs past the filter's ends), so the work scales with ``(stop - start) + (hi - lo)``
+    rather than with the filter's length ``7 scale``: for long scales the filter is longer than
+    the record.  Output ``q`` is ``conv(seg, part)[q + len(seg) - 1]``, the 'valid' part of a
+    linear convolution; a circular one of size ``>= len(part)`` has it exact.
+    """
+
+    def __init__(self, scale: float, start: int, stop: int, lo: int, hi: int):
+        k, reverse, self.factor = _point_filter(scale)
+        g = reverse[::-1]
+        self.lo = max(lo, start + k - (g.size - 1))  # inputs the outputs see
+        self.hi = min(hi, stop + k)
+        self.width = stop - start
+        size = self.hi - self.lo
+        if size <= 0:
+            self.part = None
+            return
+        first = start + k - self.hi + 1  # filter index of the first output and the last input
+        self.part = np.zeros(self.width + size - 1)
+        a, b = max(first, 0), min(first + self.part.size, g.size)
+        if b > a:
+            self.part[a - first:b - first] = g[a:b]
+        self.direct = self.width * size < DIRECT_LIMIT
+        if not self.direct:
+            self.fft_size = sfft.next_fast_len(self.part.size, real=True)
+            self.spectrum = sfft.rfft(self.part, self.fft_size) * self.factor
+
+    def __call__(self, piece: np.ndarray, at: int) -> np.ndarray:
+        """Transform of the signal equal to ``piece`` from sample ``at`` on (zero elsewhere)."""
+        if self.part is None:
+            return np.zeros(self.width)
+        a, b = max(at, self.lo), min(at + piece.size, self.hi)
+        if b <= a:
+            return np.zeros(self.width)
+        size = self.hi - self.lo
+        if a == self.lo and b == self.hi:
+            seg = piece[a - at:b - at]
+        else:
+            seg = np.zeros(size)
+            seg[a - self.lo:b - self.lo] = piece[a - at:b - at]
+        if self.direct:
+            return self.factor * np.convolve(seg, self.part, mode="valid")
+        y = sfft.irfft(sfft.rfft(seg, self.fft_size) * self.spectrum, self.fft_size)
+        return y[size - 1:size - 1 + self.width]
 
 
 def _cwt_at(x: np.ndarray, scale: float, start: int, stop: int) -> np.ndarray:
     """The db4 transform of ``x`` at one scale, samples ``start..stop-1`` only (exact: the
     convolution of the stretch of ``x`` those samples see)."""
-    g = difference_filter(scale)
-    k = _offset(scale)
-    lo, hi = start + k - (g.size - 1), stop + k  # x indices needed: lo .. hi-1
-    seg = x[max(lo, 0):min(hi, x.size)]
-    if lo < 0 or hi > x.size:
-        seg = np.concatenate([np.zeros(max(-lo, 0)), seg, np.zeros(max(hi - x.size, 0))])
-    if stop - start == 1:
-        # einsum, not a BLAS dot: a multithreaded BLAS dot on long vectors stalls on a busy machine
-        return np.array([-math.sqrt(scale) * float(np.einsum("i,i->", seg[::-1], g))])
-    if (stop - start) * g.size < 100_000:  # direct: cheaper than FFTs for few outputs
-        return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
-    # circular convolution of size >= len(seg) is exact on the 'valid' part
-    size = sfft.next_fast_len(seg.size, real=True)
-    y = sfft.irfft(sfft.rfft(seg, size) * _window_spectrum(scale, size), size)
-    return y[g.size - 1:g.size - 1 + stop - start]
+    return _Window(scale, start, stop, 0, x.size)(x, 0)
 
 
 def coarse_scales(dt: float) -> np.ndarray:
@@ -407,51 +494,6 @@ class PulseClassification:
 
 # -- the classification ----------------------------------------------------------------------
 
-@lru_cache(maxsize=4096)
-def _reversed_filter(scale: float) -> np.ndarray:
-    g = difference_filter(scale)[::-1].copy()
-    g.flags.writeable = False
-    return g
-
-
-def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
-    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each)."""
-    out = np.empty(len(scales))
-    n = x.size
-    for i, a in enumerate(scales):
-        gr = _reversed_filter(a)
-        hi = at + _offset(a) + 1  # x indices at + off - (G - 1) .. at + off
-        lo = hi - gr.size
-        if lo >= 0 and hi <= n:
-            seg = x[lo:hi]
-        else:
-            seg = np.zeros(gr.size)
-            seg[max(-lo, 0):gr.size - max(hi - n, 0)] = x[max(lo, 0):min(hi, n)]
-        # einsum, not a BLAS dot: a multithreaded BLAS dot on long vectors stalls on a busy machine
-        out[i] = -math.sqrt(a) * float(np.einsum("i,i->", seg, gr))
-    return out
-
-
-def _transform_piece(piece: np.ndarray, at: int, scale: float, start: int, stop: int) -> np.ndarray:
-    """Transform over samples ``start..stop-1`` of a signal that is ``piece`` from sample ``at``
-    on and zero elsewhere (``_cwt_at`` without building the whole signal)."""
-    g = difference_filter(scale)
-    lo = start + _offset(scale) - (g.size - 1)  # first sample the outputs see
-    length = stop - start + g.size - 1
-    a, b = max(at, lo), min(at + piece.size, lo + length)
-    if b <= a:
-        return np.zeros(stop - start)
-    if (stop - start) * g.size < 100_000:
-        seg = np.zeros(length)
-        seg[a - lo:b - lo] = piece[a - at:b - at]
-        return -math.sqrt(scale) * np.convolve(seg, g, mode="valid")
-    size = sfft.next_fast_len(length, real=True)
-    seg = np.zeros(size)
-    seg[a - lo:b - lo] = piece[a - at:b - at]
-    y = sfft.irfft(sfft.rfft(seg) * _window_spectrum(scale, size), size)
-    return y[g.size - 1:g.size - 1 + stop - start]
-
-
 def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarray, energy) -> dict:
     """``analyze_record.m`` for one candidate; ``signal`` in cm/s.
 
@@ -478,6 +520,7 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
     centre = -first
     span = 2 * half
     kernel = None  # transform of the unit wavelet at lags -span..span, when first needed
+    cut = None  # transform over the window of wavelets cut by the record's ends, when needed
     pulse = np.zeros(n)
     at = at0
     for i in range(N_WAVELETS):
@@ -492,10 +535,12 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
             break
         if a == start and b == start + shape.size:  # wholly inside: the shifted kernel
             if kernel is None:
-                kernel = _transform_piece(shape, span, scale, centre, centre + 2 * span + 1)
+                kernel = _Window(scale, centre, centre + 2 * span + 1, span, span + shape.size)(shape, span)
             window -= amp * kernel[lo - at + span:hi - at + span]
         else:  # cut by the record's ends: the transform of the samples kept
-            window -= _transform_piece(amp * shape[a - start:b - start], a, scale, lo, hi)
+            if cut is None:  # inputs: every sample a wavelet centred in the window can cover
+                cut = _Window(scale, lo, hi, max(0, lo - centre), min(n, hi - 1 - centre + shape.size))
+            window -= cut(amp * shape[a - start:b - start], a)
     resid = signal - pulse
     e_signal = np.cumsum(signal * signal)
     e_pulse = np.cumsum(pulse * pulse)
@@ -513,6 +558,18 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
                 tp=tp_of_scale(scale, dt), scale=scale, pgv=pgv / CM_PER_M, pgv_ratio=pgv_ratio,
                 energy_ratio=float(energy_ratio), late=late, arrival_index=idx,
                 pulse=pulse / CM_PER_M, velocity=signal / CM_PER_M)
+
+
+def _strongest(power: np.ndarray, peak: np.ndarray) -> tuple[int, int]:
+    """(row, column) of the largest value of ``power`` (non-negative), given ``peak``, its
+    largest value in each column: the column from ``peak``, then the row in that column; on a
+    tie between columns, the first in row-major order, as :func:`numpy.argmax`."""
+    cols = np.flatnonzero(peak == peak.max())
+    if cols.size == 1:
+        col = int(cols[0])
+        return int(np.argmax(power[:, col])), col
+    row, col = np.unravel_index(int(np.argmax(power)), power.shape)
+    return int(row), int(col)
 
 
 def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_energy) -> PulseClassification:
@@ -554,15 +611,23 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     if scales[0] < 1:
         raise RecordError(f"{record.name}: time step {dt:g} s is too long for pulses of "
                           f"{TP_MIN:g} s (at most {TP_MIN * FC:g} s)")
-    if v2 is None:
-        c1, c2 = db4_cwt(v1, scales), None
-        power = c1 * c1
-    else:
-        c1, c2 = db4_cwt(np.stack([v1, v2]), scales)
-        power = c1 * c1 + c2 * c2
+    # the (scale, time) map of C1^2 + C2^2, each row made while its transform is in the cache
+    x = v1 if v2 is None else np.stack([v1, v2])
+    coefs = np.empty(x.shape[:-1] + (scales.size, x.shape[-1]))
+    power = np.empty((scales.size, x.shape[-1]))
+    peak = np.zeros(x.shape[-1])  # largest power at each time (over scales)
+    for i, row in _cwt_rows(x, tuple(float(a) for a in scales)):
+        coefs[..., i, :] = row
+        if v2 is None:
+            np.multiply(row, row, out=power[i])
+        else:
+            np.multiply(row[0], row[0], out=power[i])
+            power[i] += row[1] * row[1]
+        np.maximum(peak, power[i], out=peak)
+    c1, c2 = (coefs, None) if v2 is None else (coefs[0], coefs[1])
     candidates = []
     for _ in range(N_CANDIDATES):
-        row, col = np.unravel_index(int(np.argmax(power)), power.shape)
+        row, col = _strongest(power, peak)
         a, b = c1[row, col], (c2[row, col] if c2 is not None else 0.0)
         theta = math.atan(b / a) if a != 0.0 else (math.pi / 2 if b != 0.0 else 0.0)
         signal = v1 * math.cos(theta) + v2 * math.sin(theta) if v2 is not None else v1
@@ -573,7 +638,9 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
             arrival=record.t_start + d["arrival_index"] * dt, orientation=math.degrees(theta),
             time=record.t_start + int(col) * dt, velocity=d["velocity"], pulse=d["pulse"]))
         reach = WINDOW * scales[row]  # clear samples strictly within `reach` of the maximum
-        power[:, max(0, math.floor(col - reach) + 1):max(0, math.ceil(col + reach))] = 0.0
+        cleared = slice(max(0, math.floor(col - reach) + 1), max(0, math.ceil(col + reach)))
+        power[:, cleared] = 0.0
+        peak[cleared] = 0.0
     pulse_like = [i for i, c in enumerate(candidates) if c.is_pulse]
     chosen = pulse_like[0] if pulse_like else int(np.argmax([c.indicator for c in candidates]))
     c = candidates[chosen]

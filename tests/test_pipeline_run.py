@@ -572,6 +572,9 @@ def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys,
         assert main(["run", str(rec), *SAFE_ARGS, "--out", str(where)]) == 2, where
         err = capsys.readouterr().err.strip()
         assert err.startswith("pipeline run: error:") and "\n" not in err, err
+    (tmp_path / "empty").mkdir()  # a folder without records: nothing to do is a wrong argument
+    assert main(["run", str(tmp_path / "empty"), *SAFE_ARGS, "--out", str(tmp_path / "o")]) == 2
+    assert "no record files in" in capsys.readouterr().err
     assert (out / "summary.csv").read_text() == "mine\n" and afile.read_text() == "x"
 
 
@@ -617,6 +620,14 @@ def test_no_write_goes_through_a_planted_symlink(tmp_path):
     (fail,) = read_csv(out / "failures.csv")
     assert fail["stage"] == "write" and "not written by pipeline run" in fail["reason"]
     assert len(read_csv(out / "summary.csv")) == 1
+    # a plots folder that is a link elsewhere: refused before any work, nothing written there
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    out2 = tmp_path / "out2"
+    out2.mkdir()
+    (out2 / "plots").symlink_to(elsewhere)
+    assert main(["run", str(rec), "--block", "7.5x1.8", "--out", str(out2), "-q"]) == 2
+    assert list(elsewhere.iterdir()) == []
 
 
 def test_text_cells_are_never_formulas(tmp_path, monkeypatch):
@@ -756,3 +767,21 @@ def test_sigterm_ends_a_pool_run_with_143(tmp_path):
     assert code == 143, err
     assert "Traceback" not in err
     _check_reports_whole(out)
+
+
+def test_fit_outputs_checked_first_and_its_csv_has_no_formula(tmp_path, monkeypatch, capsys):
+    """`pipeline fit`: --csv naming a folder and --plot naming a file are argument errors; text
+    cells of its CSV that a spreadsheet would evaluate get the leading apostrophe."""
+    t, acc = synthetic(6, ap_g=0.4)
+    monkeypatch.chdir(tmp_path)
+    pulses.write_sac(pulses.Record(acc, t[1] - t[0], name="x"), "=evil.sac")
+    (tmp_path / "afile").write_text("x")
+    for bad in (["--csv", str(tmp_path)], ["--plot", "afile"]):
+        assert main(["fit", "=evil.sac", "--shapes", "sine", *bad]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("pipeline fit: error:") and "\n" not in err
+    assert main(["fit", "=evil.sac", "--shapes", "sine", "--csv", "fit.csv"]) == 0
+    rows = read_csv(tmp_path / "fit.csv")
+    # the numbers are untouched: the fitted amplitude is the pulse written (0.4 g), within the 12 %
+    # the demo's test allows the fitter under broadband noise (here 0.03 g, smaller)
+    assert rows[0]["file"] == "'=evil.sac" and abs(float(rows[0]["ap_g"])) == pytest.approx(0.4, rel=0.12)

@@ -124,7 +124,8 @@ def test_at2_azimuth_from_header(name, azimuth):
     ("LCN260", {"azimuth": 260.0, "vertical": False}), ("360", {"azimuth": 0.0, "vertical": False}),
     ("UP", {"vertical": True}), ("DWN", {"vertical": True}), ("V", {"vertical": True}),
     ("-UP", {"vertical": True}), ("E06UP", {"vertical": True}), ("HNZ", {"vertical": True}),
-    ("FN", {"vertical": False}),
+    ("FN", {"vertical": False}), ("TCU068-N", {"azimuth": 0.0, "vertical": False}),
+    ("E", {"azimuth": 90.0, "vertical": False}), ("TMZ", {}),  # a station code, not a SEED channel
     ("", {}), ("Somewhere", {}), ("400", {}),  # nothing stated, or not an angle: nothing said
 ])
 def test_at2_component_codes(tmp_path, component, expect):
@@ -346,6 +347,125 @@ def test_public_names():
     for name in ("read_record", "RecordError", "write_sac", "fit_pulse", "PulseFit"):
         assert hasattr(pulses, name), name
     assert issubclass(RecordError, ValueError)
+
+
+# -- the format registry -------------------------------------------------------------------------
+def test_formats_are_registered_once_with_their_names():
+    from pulses import formats
+
+    names = [f.name for f in formats.registered()]
+    assert names[:2] == ["at2", "text"]  # the sniffing order: AT2 before columns of numbers
+    assert {"at2", "text", "sac", "knet", "mseed", "obspy"} <= set(names)
+    for alias, name in (("peer", "at2"), ("CSV", "text"), ("txt", "text"), ("ascii", "text"),
+                        ("SAC", "sac"), ("miniseed", "mseed"), ("KNET", "knet")):
+        assert formats.by_name(alias).name == name
+    assert formats.by_obspy_name("SAC").name == "sac" and formats.by_obspy_name("KNET").name == "knet"
+    with pytest.raises(ValueError, match="registered already"):
+        formats.register(formats.RecordFormat(name="other", aliases=("peer",), read=lambda p, o: None))
+
+
+def test_a_new_format_is_read_without_touching_read_record(tmp_path):
+    from pulses import formats
+
+    # a made-up format: "DT <s>" then one sample a line, in cm/s^2 as the (made-up) standard says
+    def detect(path):
+        with open(path, "rb") as fh:
+            return fh.read(3) == b"DT "
+
+    def read(path, options):
+        with open(path) as fh:
+            dt = float(fh.readline().split()[1])
+            values = np.array([float(v) for v in fh], dtype=float)
+        return formats.Reading(values, dt, {"format": "dtlist"}, units="cm/s2",
+                               units_rule=formats.UNITS_STATED)
+
+    path = tmp_path / "x.rec"
+    samples = [0.0, 120.0, -350.0, 80.0] * 5
+    path.write_text("DT 0.02\n" + "\n".join(str(v) for v in samples) + "\n")
+    formats.register(formats.RecordFormat(name="dtlist", detect=detect, read=read, sniff_order=5))
+    try:
+        rec = read_record(path, units="g")  # stated units win over a user's, with a warning
+        assert rec.dt == 0.02 and rec.metadata["format"] == "dtlist"
+        np.testing.assert_array_equal(rec.acc, np.array(samples) * 0.01)  # cm/s^2 -> m/s^2
+        assert rec.metadata["units"] == "cm/s2" and "file states cm/s2" in rec.metadata["warnings"][0]
+        assert read_record(path, format="dtlist").npts == 20
+    finally:
+        formats.unregister("dtlist")
+    assert formats.by_name("dtlist") is None
+
+
+# -- length limit and reading in blocks ------------------------------------------------------------
+def test_records_longer_than_max_samples_refused(tmp_path):
+    text = tmp_path / "long.txt"
+    text.write_text("\n".join(f"{0.1 * np.sin(k):.6f}" for k in range(50)))
+    assert read_record(text, units="g", dt=0.01, max_samples=50).npts == 50  # at the limit: read
+    with pytest.raises(RecordError, match="more than 49 samples; a record may have at most 49"):
+        read_record(text, units="g", dt=0.01, max_samples=49)
+    body = "  .1E-02 -.2E-02  .3E-02 -.4E-02  .5E-02\n" * 2 + "  .6E-02 -.7E-02\n"
+    at2 = _write_at2(tmp_path, body)  # NPTS = 12
+    assert read_record(at2, max_samples=12).npts == 12
+    with pytest.raises(RecordError, match="12 samples; a record may have at most 11"):
+        read_record(at2, max_samples=11)  # refused from the header, before the samples are read
+    liar = _write_at2(tmp_path, body, npts=5, name="liar.AT2")  # says 5, holds 12
+    with pytest.raises(RecordError, match="more than 10 samples; a record may have at most 10"):
+        read_record(liar, max_samples=10)
+    sac = write_sac(_record(n=400), tmp_path / "long.sac")
+    with pytest.raises(RecordError, match="400 samples; a record may have at most 399"):
+        read_record(sac, max_samples=399)
+    from pulses.formats import MAX_SAMPLES
+
+    assert MAX_SAMPLES == 10**7
+
+
+def test_reading_in_blocks_gives_every_sample(tmp_path, monkeypatch):
+    import pulses.at2
+    import pulses.textfile
+
+    rng = np.random.default_rng(3)
+    acc = rng.normal(0.0, 0.2, 1003)
+    csv = tmp_path / "blocks.csv"
+    rows = [f"{k * 0.01:.2f},{float(a)!r}" for k, a in enumerate(acc)]
+    csv.write_text("# comment\ntime,acc\n" + "\n".join(rows[:500]) + "\n% a comment mid-file\n"
+                   + "\n".join(rows[500:]) + "\n")
+    at2 = _write_at2(tmp_path, "".join(" ".join(f"{a:.7E}" for a in acc[i:i + 5]) + "\n"
+                                       for i in range(0, acc.size, 5)), npts=acc.size)
+    whole = read_record(csv, units="g"), read_record(at2)
+    # blocks of about 100 characters: block edges fall everywhere, a comment inside one
+    monkeypatch.setattr(pulses.textfile, "_BLOCK_CHARS", 100)
+    monkeypatch.setattr(pulses.at2, "_BLOCK_CHARS", 100)
+    blocks = read_record(csv, units="g"), read_record(at2)
+    # repr() and %.7E digits read back exactly (float64 parsing is correctly rounded)
+    np.testing.assert_array_equal(whole[0].acc, acc * G)
+    np.testing.assert_array_equal(blocks[0].acc, acc * G)
+    np.testing.assert_array_equal(blocks[1].acc, whole[1].acc)
+    np.testing.assert_array_equal(whole[1].acc, np.array([float(f"{a:.7E}") for a in acc]) * G)
+    assert whole[0].metadata["comments"] == blocks[0].metadata["comments"] == ["comment", "a comment mid-file"]
+
+
+# -- file names: any bytes, any length ----------------------------------------------------------
+def test_names_not_utf8_with_controls_and_long(tmp_path):
+    import os
+
+    data = shared_record("Rinaldi228.AT2").read_bytes()
+    reference = read_record(shared_record("Rinaldi228.AT2"))
+    odd = os.path.join(os.fsencode(tmp_path), b"rec-\xff\xfe.AT2")  # Latin-1 bytes, not UTF-8
+    with open(odd, "wb") as fh:
+        fh.write(data)
+    for path in (odd, os.fsdecode(odd)):  # bytes, and str with PEP 383 surrogates
+        rec = read_record(path)
+        np.testing.assert_array_equal(rec.acc, reference.acc)
+        assert rec.name == "rec-\\xff\\xfe.AT2"  # the bytes written as escapes
+        rec.name.encode("utf-8")  # safe to write to a UTF-8 report
+    with pytest.raises(RecordError) as err:
+        read_record(os.path.join(os.fsencode(tmp_path), b"gone-\xff.AT2"))
+    assert "gone-\\xff.AT2: no such file" in str(err.value)
+    str(err.value).encode("utf-8")
+    newline = tmp_path / "two\nlines.AT2"
+    newline.write_bytes(data)
+    assert read_record(newline).name == "two\\nlines.AT2"
+    long = tmp_path / ("L" * 246 + ".AT2")  # 250 bytes, near the 255 a Linux file name may have
+    long.write_bytes(data)
+    assert read_record(long).name == long.name and read_record(long).npts == 1991
 
 
 # -- pipeline convert ------------------------------------------------------------------------------
