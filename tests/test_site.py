@@ -251,3 +251,30 @@ def test_fragility_outputs(pairs, tmp_path):
     curve = _read(out / "fragility_curve.csv")
     p = [_f(c["p_overturn_scale"]) for c in curve]
     assert p == sorted(p) and p[0] < 0.01 and p[-1] > 0.99
+
+
+def test_suite_and_fragility_plots():
+    """The suite plot draws the share of records verified at each width (step curve through the
+    sorted governing widths) and marks the column; PNGs are at least 1000 px wide."""
+    import io
+
+    from matplotlib.image import imread
+
+    from pipeline.plot_site import fragility_figure_png, suite_figure, suite_figure_png
+
+    rows = [{"column": "2x0.35", "pair": p, "verified_width_m": w, "eq31_width_m": e}
+            for p, w, e in (("a", 0.30, 0.2), ("a", 0.41, 0.25), ("b", 0.22, 0.3), ("c", 0.50, 0.1))]
+    suite = [{"column": "2x0.35", "width_m": 0.35, "width_all_m": 0.50, "n_records": 3, "n_rows": 4}]
+    fig = suite_figure(rows, suite)
+    (ax,) = fig.axes
+    step = ax.lines[0]
+    # governing widths: a 0.41, b 0.22, c 0.50 -> shares 1/3, 2/3, 1 at those widths
+    np.testing.assert_allclose(step.get_xdata(), [0.0, 0.22, 0.41, 0.50])
+    np.testing.assert_allclose(step.get_ydata(), [0.0, 1 / 3, 2 / 3, 1.0])
+    assert any(np.allclose(line.get_xdata(), 0.35) for line in ax.lines[1:])  # the column's width
+    png = suite_figure_png(rows, suite)
+    assert imread(io.BytesIO(png)).shape[1] >= 1000 and b"Software" not in png
+    fs = rocking.fragility([1.0, 2.0, 4.0])
+    fp = rocking.fragility([0.5, 1.0, 2.0], measure="pga")
+    png = fragility_figure_png({"2x0.35": (fs, fp, [])})
+    assert imread(io.BytesIO(png)).shape[1] >= 1000
