@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from . import site
 from .report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 
-RESERVED_IDS = {"summary", "failures", "columns"}
+RESERVED_IDS = {"summary", "failures", "columns", "pairs", "suite", "fragility", "fragility_curve"}
 
 
 @dataclass(frozen=True)
