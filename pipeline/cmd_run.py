@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
+from . import site
 from .args import ArgumentError, add_record_options, parse_block, parse_length, parse_shapes, record_options
 
 DEFAULT_OUT = "pipeline-output"
@@ -50,6 +51,7 @@ def add_parser(subparsers) -> None:
                    help="pulse shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: "
                         "the fitter's default set)")
     add_record_options(p)
+    site.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -90,15 +92,17 @@ def main(args) -> int:
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
-    options = options_from(args, shapes=parse_shapes(args.shapes), **record_options(args))
-    if not args.records:
+    options = options_from(args, shapes=parse_shapes(args.shapes), **record_options(args),
+                           **site.options_from_args(args))
+    if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     paths = expand_inputs(args.records)
-    if not paths:
+    if not paths and not args.pair:
         from .report import display
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
+    tasks = site.tasks_from_args(args, paths, columns, options)
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
-                  quiet=args.quiet)
+                  quiet=args.quiet, tasks=tasks)
     return summary.exit_code

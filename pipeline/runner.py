@@ -13,7 +13,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import interrupts, report
+from . import interrupts, report, site
 from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
@@ -296,7 +296,7 @@ def _import_plots():
 
 
 # -- the output folder -------------------------------------------------------------------------------
-def prepare_output(out, tasks, plots: bool) -> report.Outputs:
+def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> report.Outputs:
     """Check the output folder before any work is done (:class:`ArgumentError` otherwise): a folder
     (created if needed) that can be written to; no input among the files the run would write; and
     its fixed reports (``summary.csv`` ...), where present, written by an earlier run."""
@@ -309,6 +309,7 @@ def prepare_output(out, tasks, plots: bool) -> report.Outputs:
     fixed = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.MANIFEST]
     if plots:
         fixed.append(report.SUMMARY_PLOT)
+    fixed += site.output_files(options)
     written = fixed + [report.record_csv_name(t.record_id) for t in tasks]
     if plots:
         written += [report.record_plot_name(t.record_id) for t in tasks]
@@ -362,7 +363,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
 
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
-        quiet: bool = False, progress: bool | None = None) -> RunSummary:
+        quiet: bool = False, progress: bool | None = None, tasks=None) -> RunSummary:
     """Process ``paths`` for ``columns`` and write every report into ``out``.
 
     Raises
@@ -376,8 +377,9 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         complete, no temporary file left.
     """
     out = pathlib.Path(out)
-    tasks = make_tasks(paths, columns, options)
-    outputs = prepare_output(out, tasks, options.plots)
+    if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
+        tasks = make_tasks(paths, columns, options)
+    outputs = prepare_output(out, tasks, options.plots, options)
     if progress is None:
         progress = (not quiet) and sys.stderr.isatty()
     bar = None
@@ -422,7 +424,9 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     failures = [res["failure"] for res in results if res["failure"]]
     outputs.write(report.SUMMARY, report.csv_text(FIELDS, rows))
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
-    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns))
+    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
+                  + site.columns_markdown())
+    site.write_outputs(outputs, rows, FIELDS, options)
     if options.plots:
         from .plots import summary_figure_png
 
