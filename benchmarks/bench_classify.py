@@ -4,16 +4,20 @@ Floor (issue 13): at most 50 ms per pair.  The records are synthetic and the sam
 (seeded noise with a velocity pulse), so the work is that of a real near-fault pair: 51 coarse
 scales on two components, five candidates with refinement and ten wavelets each.
 
-Run: ``PYTHONPATH=. python benchmarks/bench_classify.py [--repeat N]``.  Prints the first call
-(caches of the wavelet and of the filters' spectra are filled then) and the median and best of
-the following calls, wall-clock and process CPU time (on a machine shared with other work the
-CPU time is the fairer number).
+Run: ``PYTHONPATH=. python benchmarks/bench_classify.py [--repeat N] [--against FILE]``.  Prints
+the first call (caches of the wavelet and of the filters' spectra are filled then) and the
+median and best of the following calls, wall-clock and process CPU time (on a machine shared
+with other work the CPU time is the fairer number).  ``--against`` times another version of
+``pulses/velocity.py`` (e.g. ``git show main:pulses/velocity.py > /tmp/old_velocity.py``) in
+turn with this one, call by call, so that both see the same load.
 """
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
 import os
+import sys
 import statistics
 import time
 
@@ -55,9 +59,30 @@ def calibration() -> float:
     return best
 
 
+def load_version(path: str):
+    """Another version of ``pulses/velocity.py`` as a module of the package ``pulses`` (its
+    relative imports resolve to this checkout's modules)."""
+    spec = importlib.util.spec_from_file_location("pulses._velocity_against", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+def cpu_times(classify, pair, calls: int) -> list[float]:
+    """Process CPU time (s) of ``calls`` classifications of ``pair``."""
+    times = []
+    for _ in range(calls):
+        c0 = time.process_time()
+        classify(*pair)
+        times.append(time.process_time() - c0)
+    return times
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=21, help="timed calls after the first (default 21)")
+    parser.add_argument("--against", metavar="FILE", help="another pulses/velocity.py, timed in turn with this one")
     args = parser.parse_args(argv)
     first, second = make_pair()
     t0, c0 = time.perf_counter(), time.process_time()
@@ -77,6 +102,19 @@ def main(argv=None) -> None:
     print(f"median of {args.repeat}: {1e3 * statistics.median(walls):.1f} ms wall "
           f"(best {1e3 * min(walls):.1f}), {1e3 * statistics.median(cpus):.1f} ms CPU "
           f"(best {1e3 * min(cpus):.1f}); floor 50 ms")
+    if args.against:
+        other = load_version(args.against)
+        other_result = other.classify_pulse(first, second)  # its caches filled too
+        mine, theirs = [], []
+        for i in range(args.repeat):  # alternate which goes first
+            order = [(mine, classify_pulse), (theirs, other.classify_pulse)]
+            for times, classify in (order if i % 2 == 0 else order[::-1]):
+                times += cpu_times(classify, (first, second), 1)
+        print(f"in turn with {args.against} ({args.repeat} calls each): this version "
+              f"{1e3 * statistics.median(mine):.1f} ms CPU (best {1e3 * min(mine):.1f}), the other "
+              f"{1e3 * statistics.median(theirs):.1f} ms (best {1e3 * min(theirs):.1f}); same result: "
+              f"Tp {other_result.tp:.2f} s, PI {other_result.indicator:+.6f} "
+              f"(this: {result.indicator:+.6f})")
 
 
 if __name__ == "__main__":

@@ -4,6 +4,10 @@
 text files once per column, in cm/s^2 at dt = 0.005 s as their comments and MANIFEST.md say), its
 PGA, PGV (baseline-corrected, :mod:`pulses.baseline`), the best shape and every shape's fitted
 ``|ap|`` (g), Tp (s) and score (share of the record's energy the pulse explains).
+
+``python benchmarks/fit_records.py compare`` prints, for every record, where the weighted least
+squares (the default, ``weighting="background"``) and the plain ones (``weighting="plain"``)
+differ: the best shape, and each shape's ``|ap|`` and Tp when they move by more than 1 %.
 """
 from __future__ import annotations
 
@@ -48,5 +52,32 @@ def table():
     return "\n".join(lines)
 
 
+def compare(threshold=0.01):
+    """Markdown table of the records whose fits change from plain to weighted least squares."""
+    from pulses import G, fit_pulse, read_record
+
+    lines = ["| record | best (plain -> weighted) | changes over 1 %: shape ap (g), Tp (s) plain -> weighted |",
+             "|---|---|---|"]
+    unchanged = 0
+    for label, path, kw in records():
+        rec = read_record(path, **kw)
+        plain, weighted = fit_pulse(rec, weighting="plain"), fit_pulse(rec)
+        moves = []
+        for s in SHAPES:
+            a, b = plain[s], weighted[s]
+            if abs(b.ap / a.ap - 1) > threshold or abs(b.tp / a.tp - 1) > threshold:
+                moves.append(f"{s} {abs(a.ap) / G:.3g}, {a.tp:.2f} -> {abs(b.ap) / G:.3g}, {b.tp:.2f}")
+        best = plain.best.shape if plain.best.shape == weighted.best.shape else \
+            f"**{plain.best.shape} -> {weighted.best.shape}**"
+        if moves or plain.best.shape != weighted.best.shape:
+            lines.append(f"| {label} | {best} | {'; '.join(moves) or '-'} |")
+        else:
+            unchanged += 1
+    lines.append(f"\n{unchanged} other records: no shape's ap or Tp moves by more than {threshold:.0%}.")
+    return "\n".join(lines)
+
+
 if __name__ == "__main__":
-    print(table())
+    import sys
+
+    print(compare() if sys.argv[1:] == ["compare"] else table())

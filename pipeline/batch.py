@@ -18,9 +18,10 @@ import threading
 import time
 from dataclasses import dataclass, field
 
+from . import site
 from .report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 
-RESERVED_IDS = {"summary", "failures", "columns"}
+RESERVED_IDS = {"summary", "failures", "columns", "pairs", "suite", "fragility", "fragility_curve"}
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,10 @@ class Options:
     format: str | None = None
     trace: str | None = None
     plots: bool = True
+    #: a rocking frame's cap beam mass over the columns' (0: lone columns); see pipeline.site
+    cap_mass_ratio: float = 0.0
+    fragility: bool = False
+    up_to: float = 10.0
 
 
 @dataclass(frozen=True)
@@ -57,6 +62,13 @@ class Task:
     path: str
     columns: tuple = ()
     options: Options = field(default_factory=Options)
+    #: a direction of a pair (pipeline.site): the second file, the angle (deg) and why it was chosen
+    path2: str | None = None
+    direction: float | None = None
+    direction_kind: str = ""
+    pair: str = ""
+    scale: float = 1.0
+    pair_fields: tuple = ()
 
 
 class StageError(Exception):
@@ -101,11 +113,7 @@ def record_ids(paths) -> list[str]:
 
 # -- the work ---------------------------------------------------------------------------------------
 def _read(task: Task):
-    import pulses
-
-    opts = task.options
-    return pulses.read_record(task.path, format=opts.format, units=opts.units, dt=opts.dt,
-                              column=opts.column, trace=opts.trace)
+    return site.read_task(task)
 
 
 def _g(x):
@@ -169,8 +177,8 @@ def _process_record(task: Task) -> dict:
 FAILURE_COLUMNS = Columns(
     ("record", "-", "Record id (as in the per-record reports)."),
     ("file", "-", "The record's path as given."),
-    ("stage", "-", "Where it failed: `read` (reading the file), `fit` (pulse fitting), `design` "
-                   "(design rules), `verify` (full-record time histories), `plot`, `write` (the record "
+    ("stage", "-", "Where it failed: `read` (reading the file), `fit` (pulse fitting), `classify` "
+                   "(velocity-pulse classification), `design` (design rules), `verify` (full-record time histories), `plot`, `write` (the record "
                    "was processed and its rows are in `summary.csv`, but its own report or figure "
                    "could not be written, or a file that `pipeline run` did not write is in the way "
                    "and was left as it is), `worker` (the process running it died) or `internal` "
@@ -458,9 +466,10 @@ def _verified_fields(col: Column, ver) -> dict:
 
 
 #: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
-COLUMNS = (RECORD_COLUMNS.columns + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
+COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
            + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
-           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns)
+           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns
+           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns)
 FIELDS = [name for name, _, _ in COLUMNS]
 
 
@@ -477,10 +486,16 @@ def _process(task: Task):
     for c in candidates:  # candidates are ranked: keep the best of each shape
         by_shape.setdefault(c.shape, c)
     base = _record_fields(task, record, fit, best, fitting)
+    site_fields, warning = _stage("classify", site.site_fields, task, record)
+    if warning:
+        base["warnings"] = "; ".join(w for w in (base["warnings"], warning) if w)
+    base.update(site_fields)
 
-    blocks = {col: rocking.Block.from_dimensions(col.height, col.width)
+    gamma = opts.cap_mass_ratio
+    blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
               for col in task.columns if col.width is not None}
-    exact = _stage("design", _exact_by_shape, fitting, list(blocks.values()))
+    exact = _stage("design", _exact_by_shape, fitting, list(blocks.values()), gamma)
+    extra_cache = {}
 
     rows = []
     histories = []
@@ -493,7 +508,8 @@ def _process(task: Task):
 
         # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
         def eq31_widths():
-            return [(float(rocking.required_width(H, c.pulse, rule="eq31").width), c) for c in fitting]
+            return [(float(rocking.required_width(H, c.pulse, rule="eq31", cap_mass_ratio=gamma).width), c)
+                    for c in fitting]
 
         if H not in eq31_cache:
             eq31_cache[H] = _stage("design", eq31_widths)
@@ -516,7 +532,7 @@ def _process(task: Task):
                 curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
-        block31 = rocking.Block.from_dimensions(H, w31)
+        block31 = rocking.Block.from_dimensions(H, w31, cap_mass_ratio=gamma)
         res31 = _stage("verify", _sim, block31, record, opts.plots)
         if opts.plots:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
@@ -524,7 +540,8 @@ def _process(task: Task):
 
         # -- verified width: smallest width surviving the full record (islands respected) ---------
         if H not in verified_cache:
-            verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact")
+            verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact",
+                                       cap_mass_ratio=gamma)
 
         row = dict(base)
         row.update(_column_fields(col))
@@ -532,12 +549,13 @@ def _process(task: Task):
         row.update(_as_stands_fields(block, designed, res))
         row.update(_eq31_design_fields(H, w31, res31))
         row.update(_verified_fields(col, verified_cache[H]))
+        row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
         rows.append(row)
 
     return rows, (record, fit, fitting, histories)
 
 
-def _exact_by_shape(fitting, blocks) -> dict:
+def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
     """Exact minimum tan(alpha) of every fitting pulse for every block: ``{(shape, block): tan}``.
 
     One ``rocking.min_slenderness_batch`` call per shape covers all the blocks (the similarity law:
@@ -554,7 +572,7 @@ def _exact_by_shape(fitting, blocks) -> dict:
     for c in fitting:
         p_tp = [b.p * c.tp for b in blocks]
         res = rocking.min_slenderness_batch(c.shape, p_tp, [abs(c.ap) / G] * len(blocks),
-                                            refine="top", ksection=2)
+                                            refine="top", ksection=2, cap_mass_ratio=cap_mass_ratio)
         for b, r in zip(blocks, res):
             out[(c.shape, b)] = float(r.tan_alpha)
     return out

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
+from . import site
 from .args import ArgumentError, add_record_options, parse_block, parse_length, parse_shapes, record_options
 
 DEFAULT_OUT = "pipeline-output"
@@ -35,8 +36,10 @@ def add_parser(subparsers) -> None:
         description="For every record: read it, fit its pulse (every shape), size each column by "
                     "Eq. 31, the envelope rule and the exact criterion, and verify the designs with "
                     "time histories under the full record. Writes <record>.csv, summary.csv, "
-                    "failures.csv, columns.md and plots into --out. Exit status 0 when every record "
-                    "was processed, 1 when some failed (listed in failures.csv), 2 for bad arguments.")
+                    "failures.csv, columns.md and plots into --out, and pipeline-manifest.txt, the "
+                    "files it wrote: the only ones a later run replaces or removes. Exit status 0 when every record "
+                    "was processed, 1 when some failed (listed in failures.csv), 2 for bad arguments, "
+                    "130 (143) when stopped by Ctrl-C (SIGTERM).")
     p.add_argument("records", nargs="*", metavar="RECORD",
                    help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
                         "...) or folders of them")
@@ -54,6 +57,7 @@ def add_parser(subparsers) -> None:
                    help="append one JSON line per record to FILE (record, status, seconds, model, "
                         "worker), to watch a long batch")
     add_record_options(p)
+    site.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -94,15 +98,17 @@ def main(args) -> int:
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
-    options = options_from(args, shapes=parse_shapes(args.shapes), **record_options(args))
-    if not args.records:
+    options = options_from(args, shapes=parse_shapes(args.shapes), **record_options(args),
+                           **site.options_from_args(args))
+    if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     paths = expand_inputs(args.records)
-    if not paths:
+    if not paths and not args.pair:
         from .report import display
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
+    tasks = site.tasks_from_args(args, paths, columns, options)
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
-                  quiet=args.quiet, force=args.force, log=args.log)
+                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
     return summary.exit_code

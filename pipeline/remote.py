@@ -33,28 +33,40 @@ def read_bytes(path: str) -> bytes | None:
         return None
 
 
-def work_on_bytes(task: Task, data: bytes) -> dict:
-    """Run on a worker: :func:`pipeline.runner.work` on ``data``, written to a private file named as
-    the original; the result names the original path."""
+def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
+    """Run on a worker: :func:`pipeline.runner.work` on ``data`` (and ``data2``, the second file of
+    a pair), written to private files named as the originals; the result names the original paths."""
     from . import runner
 
     if not runner._in_worker:
         runner.init_worker()  # also in a worker the nanny restarted after a death
     folder = tempfile.mkdtemp(prefix="pipeline-record-")
+    swaps = {}
     try:
-        name = os.path.basename(task.path) or "record"
-        local = os.path.join(folder, name)
-        with open(local, "wb") as fh:
-            fh.write(data)
-        res = runner.work(dataclasses.replace(task, path=local))
+        local = {}
+        for sub, path, raw in (("1", task.path, data), ("2", task.path2, data2)):
+            if path is None:
+                continue
+            os.mkdir(os.path.join(folder, sub))  # two files of a pair may have the same name
+            local[sub] = os.path.join(folder, sub, os.path.basename(path) or "record")
+            with open(local[sub], "wb") as fh:
+                fh.write(raw)
+            swaps[local[sub]] = path
+        changes = {"path": local["1"]}
+        if "2" in local:
+            changes["path2"] = local["2"]
+        res = runner.work(dataclasses.replace(task, **changes))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     res["file"] = task.path
     for row in res["rows"]:
         row["file"] = task.path
+        if "file2" in row:
+            row["file2"] = task.path2
     if res["failure"]:
         res["failure"]["file"] = task.path
-        res["failure"]["reason"] = res["failure"]["reason"].replace(local, task.path)
+        for here, there in swaps.items():
+            res["failure"]["reason"] = res["failure"]["reason"].replace(here, there)
     return res
 
 
@@ -73,10 +85,11 @@ def run_dask(tasks, client, workers: int):
 
     def submit(task, attempt):
         data = read_bytes(task.path)
-        if data is None:
+        data2 = None if task.path2 is None else read_bytes(task.path2)
+        if data is None or (task.path2 is not None and data2 is None):
             return process_record(task)  # fails at reading, as it would anywhere
-        fut = client.submit(work_on_bytes, task, data, key=f"record-{task.index}-{attempt}-{uuid.uuid4().hex}",
-                            pure=False)
+        fut = client.submit(work_on_bytes, task, data, data2, pure=False,
+                            key=f"record-{task.index}-{attempt}-{uuid.uuid4().hex}")
         owner[fut.key] = (task, attempt)
         pending.add(fut)
         return None

@@ -1,16 +1,17 @@
 """Resuming ``pipeline run``: which records of an earlier run into the same ``--out`` can be kept.
 
-A record's report is kept when it was made from the same file content (sha256 of the bytes), the
-same columns and options, the same record id and path (both written in the report) and the same
-package version.  These make the record's *key*.  After each record's report is written, a line
+A record's report is kept when it was made from the same file content (sha256 of the bytes; both
+files of a pair), the same task (record id, path, columns, options, direction, scale ...) and the
+same package version.  These make the record's *key*.  After each record's report is written, a line
 ``<key>  <sha256 of the report>  <record id>`` is appended to :data:`RESUME` in the output folder;
 a later run keeps the record only if that line is there and the report (and its figure, with plots)
 still has the content recorded, so a report edited, removed or half-written by a killed run is
 computed again.  Records that failed have no line and are always computed again.
 
 The per-record reports hold exactly the rows of ``summary.csv`` (the same header and formatting),
-so ``summary.csv`` and the summary plot are rebuilt from the reports' text: a resumed run and an
-uninterrupted one write the same bytes.
+so ``summary.csv`` is rebuilt from the reports' text, and the files computed from the rows
+(``suite.csv``, ``pairs.csv``, the plots) from the rows read back from that text (numbers at the
+reports' 6 digits) in every run: a resumed run and an uninterrupted one write the same bytes.
 """
 from __future__ import annotations
 
@@ -59,11 +60,15 @@ def file_digest(path) -> str | None:
     return h.hexdigest()
 
 
-def task_key(task, version: str, content: str | None) -> str | None:
-    """The key of ``task`` (see the module's docstring); None when its file cannot be read."""
-    if content is None:
+def task_key(task, version: str) -> str | None:
+    """The key of ``task`` (see the module's docstring): every field of the task but its place in
+    the batch, the content of its file(s) and ``version``; None when a file cannot be read."""
+    import dataclasses
+
+    contents = [file_digest(p) for p in (task.path, getattr(task, "path2", None)) if p is not None]
+    if None in contents:
         return None
-    text = repr((version, content, task.record_id, task.path, task.columns, task.options))
+    text = repr((version, contents, dataclasses.replace(task, index=0)))
     return hashlib.sha256(text.encode("utf-8", "surrogateescape")).hexdigest()
 
 
@@ -88,15 +93,18 @@ def _fields():
 
 
 def typed(cell: str):
-    """A cell of a report as a value: blank -> None, True/False -> bool, numbers -> float."""
+    """A cell of a report as the value it was written from: blank -> None, True/False -> bool, a
+    number -> float when it is written back as the same text (so ``1e5`` or ``007`` in a name stay
+    text), else the text."""
     if cell == "":
         return None
     if cell in ("True", "False"):
         return cell == "True"
     try:
-        return float(cell)
+        value = float(cell)
     except ValueError:
         return cell
+    return value if report.fmt(value) == cell else cell
 
 
 def rows_from_text(rows_text: str) -> list[dict]:

@@ -13,7 +13,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import interrupts, joblog, report, resume
+from . import interrupts, joblog, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
@@ -101,10 +101,17 @@ def _size(task) -> int:
         return 0
 
 
-def _init_pool_worker() -> None:
+def _init_pool_worker(kill_at: str | None = None) -> None:
     """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
-    the workers itself (a worker interrupted on its own would only print a traceback)."""
+    the workers itself (a worker interrupted on its own would only print a traceback).
+    ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
+    the workers may have been started before it was set)."""
     import signal
+
+    if kill_at is None:
+        os.environ.pop(TEST_KILL_ENV, None)
+    else:
+        os.environ[TEST_KILL_ENV] = kill_at
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     init_worker()
@@ -175,7 +182,8 @@ def _pool(tasks, jobs):
     finished = False
 
     def new_pool():
-        return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker)
+        return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
+                                   initargs=(os.environ.get(TEST_KILL_ENV),))
 
     try:
         while queue or suspects:
@@ -373,7 +381,7 @@ def _import_plots():
 
 
 # -- the output folder -------------------------------------------------------------------------------
-def prepare_output(out, tasks, plots: bool) -> report.Outputs:
+def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> report.Outputs:
     """Check the output folder before any work is done (:class:`ArgumentError` otherwise): a folder
     (created if needed) that can be written to; no input among the files the run would write; and
     its fixed reports (``summary.csv`` ...), where present, written by an earlier run."""
@@ -386,6 +394,7 @@ def prepare_output(out, tasks, plots: bool) -> report.Outputs:
     fixed = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.MANIFEST]
     if plots:
         fixed.append(report.SUMMARY_PLOT)
+    fixed += site.output_files(options)
     written = fixed + [report.record_csv_name(t.record_id) for t in tasks]
     if plots:
         written += [report.record_plot_name(t.record_id) for t in tasks]
@@ -439,7 +448,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
 
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
-        quiet: bool = False, progress: bool | None = None, force: bool = False,
+        quiet: bool = False, progress: bool | None = None, tasks=None, force: bool = False,
         log=None) -> RunSummary:
     """Process ``paths`` for ``columns`` and write every report into ``out``.
 
@@ -459,14 +468,15 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         complete, no temporary file left.
     """
     out = pathlib.Path(out)
-    tasks = make_tasks(paths, columns, options)
-    outputs = prepare_output(out, tasks, options.plots)
+    if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
+        tasks = make_tasks(paths, columns, options)
+    outputs = prepare_output(out, tasks, options.plots, options)
     try:
         journal = resume.Journal(out)
     except report.NotOurs as exc:
         raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
     names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
-             resume.RESUME]
+             resume.RESUME] + site.output_files(options)
     names += [n for t in tasks for n in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id))]
     resume.remove_stale_temporaries(out, names)  # left by a run killed while writing
 
@@ -475,7 +485,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     texts: list[str] = [""] * len(tasks)
     failures: list[dict | None] = [None] * len(tasks)
     version = resume.package_version()
-    keys = [resume.task_key(t, version, resume.file_digest(t.path)) for t in tasks]
+    keys = [resume.task_key(t, version) for t in tasks]
     todo = []
     for t, key in zip(tasks, keys):
         kept = None if force else journal.reusable(t, key, options.plots)
@@ -545,15 +555,19 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
                 outputs.finish()
 
     failures = [f for f in failures if f]
-    summary_text = header + "".join(texts)
-    outputs.write(report.SUMMARY, summary_text)
+    text = "".join(texts)
+    del texts
+    outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
-    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns))
+    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
+                  + site.columns_markdown())
+    # the rows as the reports hold them, so that a resumed run writes the same files
+    rows = resume.rows_from_text(text)
+    site.write_outputs(outputs, rows, FIELDS, options)
     if options.plots:
         from .plots import summary_figure_png
 
-        # drawn from the reports' text, so that a resumed run draws the same figure
-        outputs.write(report.SUMMARY_PLOT, summary_figure_png(resume.rows_from_text("".join(texts))))
+        outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
     outputs.finish()
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)

@@ -32,6 +32,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import linalg, signal
+from scipy import fft as sfft
 
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
@@ -56,6 +58,29 @@ TP_LEASH = 1.5
 #: baseline fitted with the pulse is pinned down by the motion around it, so that it does not
 #: trade off against a short pulse
 FIT_MARGIN = 1.0
+#: length (s) of the segments over which the background's spectrum is averaged
+SEGMENT = 2.5
+#: white noise added to the background's spectrum, as a share of its mean power: bounds the
+#: weight of frequencies where the background has (almost) no power
+LOADING = 1e-3
+#: record (s) kept each side of the pulse by the weighted least squares
+GLS_MARGIN = 5.0
+#: periods scanned by the weighted least squares before its descent, within a factor
+#: GLS_SCAN_RANGE of the plain least squares' period; shifts within GLS_SHIFT Tp
+GLS_SCAN = 9
+GLS_SCAN_RANGE = 1.1
+GLS_SHIFT = 0.1
+#: the weighted descent stops when the weighted sum of squares falls by less than this share,
+#: or after GLS_MAX_CALLS evaluations (the noise limits are 1e-3 of Tp or more)
+GLS_FTOL = 1e-7
+GLS_MAX_CALLS = 12
+#: the weighted least squares replace the plain ones where they promise standard deviations of
+#: ap and Tp below this share of the plain ones (geometric mean; :func:`_weighting_pays`)
+GLS_GAIN = 0.5
+#: the weighted estimate is refused when it differs from the plain one by more than noise
+#: explains: Hausman's statistic (chi-square of 3 degrees of freedom under the model) above its
+#: 99.9 % point
+GLS_HAUSMAN = 16.27
 
 
 class FitError(ValueError):
@@ -231,7 +256,8 @@ def default_tp_range(record: Record) -> tuple[float, float]:
     return tp_min, tp_max
 
 
-def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = True) -> PulseFit:
+def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = True,
+              weighting: str = "background") -> PulseFit:
     """Fit every candidate pulse shape to a record.
 
     Parameters
@@ -245,6 +271,11 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     baseline : bool, optional
         Fit a straight-line baseline together with the pulse inside the refinement window
         (default True).
+    weighting : {"background", "plain"}, optional
+        ``"background"`` (default): after plain least squares, refine once more with the
+        residual weighted by the inverse of the background's spectrum, estimated from the record
+        itself (generalised least squares, :class:`Background`).  ``"plain"``: ordinary
+        least squares only (every frequency weighted alike).
 
     Returns
     -------
@@ -264,16 +295,31 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     n_grid = max(2, int(math.ceil(math.log(tp_max / tp_min) / math.log(GRID_RATIO))) + 1)
     tps = np.geomspace(tp_min, tp_max, n_grid)
     energy = _dot(x, x)
-    candidates = []
+    if weighting not in ("background", "plain"):
+        raise FitError(f"weighting must be 'background' or 'plain', got {weighting!r}")
+    fits = {}
     for shape in shapes:
         score = -np.inf
         for start in _coarse(matcher, shape, tps, t[-1]):
             trial = _refine(x, t, dt, shape, *start, baseline)
-            p_trial = trial[0] * unit_samples(shape, trial[1], trial[2], t, dt)
-            resid = x - p_trial
-            s = 1.0 - _dot(resid, resid) / energy if energy > 0 else 0.0
+            s, p_trial = _score(x, t, dt, shape, trial, energy)
             if s > score:
-                score, (ap, tp, t0, idx), p = s, trial, p_trial
+                score, fits[shape] = s, (start, trial, p_trial)
+    if weighting == "background":
+        best = max(fits, key=lambda k: _score(x, t, dt, k, fits[k][1], energy)[0])
+        resid = x - fits[best][2]
+        # a record the plain fit explains to round-off has no background to weight by
+        exact = _dot(resid, resid) <= 1e-24 * energy
+        background = None if exact else Background(resid, dt)
+        for shape, (match, trial, p_trial) in ([] if exact else fits.items()):
+            trial, plain_ap = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
+            if plain_ap:
+                trial = _plain_amplitude(x, t, dt, shape, trial, baseline)
+            fits[shape] = (match, trial, _score(x, t, dt, shape, trial, energy)[1])
+    candidates = []
+    for shape, (_, (ap, tp, t0, idx), p) in fits.items():
+        r = x - p
+        score = 1.0 - _dot(r, r) / energy
         lo, hi = pulse_window(shape, tp, t0)
         inside = (t >= lo) & (t <= hi)
         xw, pw = x[inside], p[inside]
@@ -290,6 +336,13 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         c.rank = k
     return PulseFit(record.name, ranked, record.pga, _pgv(record.acc, dt), record.duration,
                     significant_duration(record.acc, dt))
+
+
+def _score(x, t, dt, shape, trial, energy):
+    """Share of the record's energy a refined ``(ap, Tp, t0, window)`` explains, and its samples."""
+    p = trial[0] * unit_samples(shape, trial[1], trial[2], t, dt)
+    r = x - p
+    return 1.0 - _dot(r, r) / energy, p
 
 
 def _checked_tp_range(tp_range, record: Record) -> tuple[float, float]:
@@ -378,30 +431,17 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         if idx.stop - idx.start < 6:
             break
         tw, xw = t[idx], x[idx]
-        ramp = tw - float(tw.mean())
-        ramp_norm = _dot(ramp, ramp) or 1.0
-
-        def project(v):
-            """Remove the straight-line baseline (least squares on 1 and t - tc, orthogonal)."""
-            if not baseline:
-                return v
-            v = v - v.mean(axis=-1, keepdims=True)
-            if v.ndim == 1:
-                return v - ramp * (_dot(v, ramp) / ramp_norm)
-            return v - np.outer(np.einsum("ij,j->i", v, ramp), ramp / ramp_norm)
-
+        project = _projector(tw, baseline)
         xp = project(xw)
 
         def residual_and_jacobian(p):
             m, d_tp, d_t0 = unit_samples_and_derivatives(shape, max(p[1], 1e-9), p[2], tw, dt)
-            cols = np.empty((3, tw.size))
-            cols[0], cols[1], cols[2] = m, d_tp, d_t0
-            cols = project(cols)
+            cols = project(np.stack((m, d_tp, d_t0)))
             cols[1:] *= p[0]
             return xp - p[0] * cols[0], -cols.T
 
         try:
-            p_new, cost = _levenberg_marquardt(residual_and_jacobian, np.array([ap, tp, t0]),
+            p_new, cost = _levenberg_marquardt(_normal_equations(residual_and_jacobian), np.array([ap, tp, t0]),
                                                scale=np.array([abs(ap) or 1.0, tp, tp]),
                                                lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
                                                upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
@@ -422,30 +462,266 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
     return best
 
 
-def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-10, ftol=1e-9,
-                         max_iter=100):
-    """Minimise ``||r(p)||^2`` by Levenberg-Marquardt with Marquardt's diagonal scaling.
+class Background:
+    """The background motion's power spectrum, estimated from a residual, as least-squares weights.
 
-    ``residual_and_jacobian(p)`` returns ``r`` and ``dr/dp``.  A small dense solver (three
-    unknowns) without the per-call overhead of a general one.  Steps that leave the box
-    ``[lower, upper]`` are refused like steps that increase the sum of squares.  Stops when every
-    step is below ``xtol`` times ``scale`` or the sum of squares falls by less than ``ftol``
-    relative.  Returns ``(p, sum of squares)``.
+    Welch's average of periodograms of the residual (Hann segments of :data:`SEGMENT` s, half
+    overlapping; below two of its frequency steps no lower than there), plus :data:`LOADING`
+    times its mean: white noise that bounds the weight of
+    frequencies where the background has almost no power.  Weighting each frequency of a
+    residual by the inverse of this power is generalised least squares (the noise's covariance
+    taken as the circulant of this spectrum).
     """
-    r, J = residual_and_jacobian(p)
-    cost = _dot(r, r)
+
+    def __init__(self, resid, dt: float):
+        resid = np.asarray(resid, dtype=float)
+        self.dt = float(dt)
+        nseg = int(min(resid.size, max(16, round(SEGMENT / dt))))
+        self.freq, power = signal.welch(resid, fs=1.0 / dt, window="hann", nperseg=nseg, detrend="constant")
+        # below two frequency steps the segments (their means removed) cannot measure the
+        # power: it is taken as no lower than there
+        low = self.freq < 2.0 / (nseg * dt)
+        if np.any(low) and not np.all(low):
+            power[low] = np.maximum(power[low], power[np.argmin(low)])
+        self.power = power + LOADING * float(np.mean(power))
+
+    def weights(self, nfft: int) -> np.ndarray:
+        """Weights of the ``nfft // 2 + 1`` bins of a real FFT of ``nfft`` points such that
+        ``sum(w * Re(U conj(V)))`` is ``u' S^-1 v`` (``S`` the background's covariance, circulant)."""
+        f = np.arange(nfft // 2 + 1) / (nfft * self.dt)
+        w = 2.0 / (nfft * np.interp(f, self.freq, self.power * (0.5 / self.dt)))
+        w[0] *= 0.5
+        if nfft % 2 == 0:
+            w[-1] *= 0.5
+        return w
+
+
+def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
+    """Generalised least squares ``(ap, Tp, t0, window)`` from a plain least-squares ``start``.
+
+    The residual over the pulse and :data:`GLS_MARGIN` s of record each side is weighted by the
+    inverse of the background's spectrum (:class:`Background`), in the frequency domain; the
+    straight-line baseline is fitted alongside in the same metric.  Weighting sharpens the
+    minimum, so first the period is scanned (:data:`GLS_SCAN` periods, centre kept) with every
+    whole-sample shift of the pulse at once (one inverse FFT per period), then Levenberg-Marquardt
+    starts from the best.  ``start`` is returned when nothing beats it on the weighted objective.
+    """
+    cls = shape_class(shape)
+    ap, tp, t0, _ = start
+    lo, hi = cls.fit_tau
+    i0 = max(0, int(math.floor((t0 + lo * tp - GLS_MARGIN) / dt)))
+    i1 = min(x.size, int(math.ceil((t0 + hi * tp + GLS_MARGIN) / dt)) + 1)
+    idx = slice(i0, i1)
+    tw, xw = t[idx], x[idx]
+    nfft = sfft.next_fast_len(tw.size, real=True)
+    w = background.weights(nfft)
+    X = sfft.rfft(xw, nfft)
+    Xw = X * w  # every product is with one weighted side
+
+    def gram(U, Vw):
+        """``u' S^-1 v`` for the rows of ``U`` and of ``Vw`` (the latter already weighted): the
+        sum of ``Re(U) Re(Vw) + Im(U) Im(Vw)``, on the arrays' float views."""
+        return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
+
+    # the pulse and its derivatives vanish outside its support: computed there only
+    sup_lo, sup_hi = cls.support_tau
+
+    def support(tp_, t0_):
+        a = max(0, int(math.floor((t0_ + sup_lo * tp_ - tw[0]) / dt)) - 1)
+        b = min(tw.size, int(math.ceil((t0_ + sup_hi * tp_ - tw[0]) / dt)) + 2)
+        return slice(a, max(a, b))
+
+    # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
+    def sampled(tp_, t0_):
+        out = np.zeros((1, nfft))
+        k = support(tp_, t0_)
+        out[0, k] = cls.sampled(tp_, t0_, tw[k], dt)
+        return out
+
+    def sampled_with_derivatives(tp_, t0_):
+        out = np.zeros((3, nfft))
+        k = support(tp_, t0_)
+        out[:, k] = cls.sampled_with_derivatives(tp_, t0_, tw[k], dt)
+        return out
+
+    xx = float(gram(X[None], Xw[None])[0, 0])
+    if baseline:
+        B = sfft.rfft(np.stack((np.ones_like(tw), tw - float(tw.mean()))), nfft, axis=-1)
+        Bw = B * w
+        BB_inv = np.linalg.inv(gram(B, Bw))
+        BX = gram(B, Xw[None])[:, 0]
+        xx -= float(BX @ BB_inv @ BX)
+
+    def products(cols):
+        """Weighted ``u'v`` among the columns and with the record, the baseline projected out."""
+        U = sfft.rfft(cols, axis=-1, overwrite_x=True)
+        UU, UX = gram(U, U * w), gram(U, Xw[None])[:, 0]
+        if baseline:
+            UB = gram(U, Bw)
+            UU -= UB @ BB_inv @ UB.T
+            UX -= UB @ BB_inv @ BX
+        return UU, UX
+
+    def profiled(tp_, t0_):
+        UU, UX = products(sampled(tp_, t0_))
+        return xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
+
+    def normal(p):
+        a = p[0]
+        UU, UX = products(sampled_with_derivatives(max(p[1], 1e-9), p[2]))
+        d = np.array([1.0, a, a])
+        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
+        cost = xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
+        return cost, UU * np.outer(d, d), -d * ur
+
+    timing_gains, amplitude_gains, difference = _weighting_pays(
+        sfft.rfft(sampled_with_derivatives(tp, t0), axis=-1) * np.array([[1.0], [ap], [ap]]),
+        B if baseline else None, w, nfft, gram)
+    if not timing_gains:
+        return start, False
+    start_cost, _ = profiled(tp, t0)
+    # scan of the period about the start, the pulse's centre kept; each period's best shift in
+    # whole samples from the weighted cross-correlation (one inverse FFT; baseline left out)
+    centre = t0 + cls.centre_tau * tp
+    shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
+    near = np.abs(shifts) <= max(2, int(GLS_SHIFT * tp / dt))
+    k_near = np.flatnonzero(near)
+    # irfft counts the interior bins twice, which the weights already do
+    Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+    best_gain, tp_b, t0_b = -1.0, tp, t0
+    for f in np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN)):
+        tp_s = tp * f
+        t0_s = centre - cls.centre_tau * tp_s
+        M = sfft.rfft(sampled(tp_s, t0_s)[0], overwrite_x=True)
+        mm = float(gram(M[None], (M * w)[None])[0, 0])
+        corr = sfft.irfft(Xw_half * M.conj(), nfft)[k_near] * nfft
+        j = int(np.argmax(np.abs(corr)))
+        gain = corr[j] ** 2 / max(mm, 1e-300)
+        if gain > best_gain:
+            best_gain, tp_b, t0_b = gain, tp_s, t0_s + shifts[k_near[j]] * dt
+    _, ap_b = profiled(tp_b, t0_b)
+    _, tp0, t00 = match
+    try:
+        p_new, cost = _levenberg_marquardt(normal, np.array([ap_b, tp_b, t0_b]),
+                                           scale=np.array([abs(ap_b) or 1.0, tp_b, tp_b]),
+                                           ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS,
+                                           lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
+                                           upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
+    except np.linalg.LinAlgError:
+        return start, False
+    ap_new, tp_new, t0_new = (float(v) for v in p_new)
+    if not all(map(math.isfinite, (ap_new, tp_new, t0_new))) or tp_new <= 2 * dt or \
+            cost > start_cost * (1 + 1e-12):
+        return start, False
+    # the record must follow the pulse model where the weights look: on a record whose
+    # background was filtered away above some frequency, a rectangle's or one-sine's edges are
+    # not in the record either, and a weighted fit would shrink the pulse to hide them.  Under
+    # the model the two estimates differ only by noise of known covariance (Hausman's test)
+    d = np.array([ap_new - ap, tp_new - tp, t0_new - t0])
+    if float(d @ np.linalg.pinv(difference) @ d) > GLS_HAUSMAN:
+        return start, False
+    return (ap_new, tp_new, t0_new, idx), not amplitude_gains
+
+
+def _plain_amplitude(x, t, dt, shape, trial, baseline):
+    """``trial`` with ``ap`` re-estimated by plain least squares (pulse and line) in its fit window."""
+    ap, tp, t0, idx = trial
+    lo, hi = _fit_window(shape, tp, t0)
+    k = slice(max(0, int(math.floor(lo / dt))), min(x.size, int(math.ceil(hi / dt)) + 1))
+    project = _projector(t[k], baseline)
+    m = project(unit_samples(shape, tp, t0, t[k], dt))
+    mm = _dot(m, m)
+    if mm <= 0:
+        return trial
+    return (_dot(m, project(x[k])) / mm, tp, t0, idx)
+
+
+def _weighting_pays(U, B, w, nfft, gram):
+    """Whether weighting by the background promises a clearly smaller scatter of ``Tp`` and of
+    ``ap``, and the covariance of the difference of the two estimates of ``(ap, Tp, t0)``.
+
+    ``U``: ``nfft``-point FFT of the pulse's derivatives with respect to ``ap``, ``Tp``, ``t0``
+    at the plain estimate; ``B``: of the baseline's columns (or None); ``w``: the weights of
+    :meth:`Background.weights`, the inverse of the estimated spectrum.  Linearised, plain least
+    squares scatter as ``(J'J)^-1 J'SJ (J'J)^-1`` and weighted ones as ``(J'S^-1 J)^-1``, both
+    with the estimated spectrum ``S``.  Where the background is nearly white over the pulse's
+    band the weighted estimate gains little, and the spectrum's own estimation error can cost
+    more: each of ``Tp`` and ``ap`` is said to gain when the ratio of its standard deviations is
+    below :data:`GLS_GAIN`.  The covariance of the difference, ``C_plain - C_weighted``, lets the
+    caller tell noise from a pulse model the record does not follow (Hausman's test).
+    """
+    J = U if B is None else np.concatenate([U, B])
+    plain = np.full(w.size, 2.0 / nfft)  # the same sums unweighted: interior bins count twice
+    plain[0] = 1.0 / nfft
+    if nfft % 2 == 0:
+        plain[-1] = 1.0 / nfft
+    try:
+        weighted = np.linalg.inv(gram(J, J * w))
+        plain_inv = np.linalg.inv(gram(J, J * plain))
+    except np.linalg.LinAlgError:
+        return False, False, None
+    plain_cov = plain_inv @ gram(J, J * (plain**2 / w)) @ plain_inv
+    ratio = np.sqrt(np.diag(weighted)[:2] / np.diag(plain_cov)[:2])
+    # the two estimates differ by noise whose covariance is the difference of theirs (the
+    # weighted one being the efficient one)
+    difference = (plain_cov - weighted)[:3, :3]
+    if not (np.all(np.isfinite(ratio)) and np.all(np.isfinite(difference))):
+        return False, False, None
+    return bool(ratio[1] < GLS_GAIN), bool(ratio[0] < GLS_GAIN), difference
+
+
+def _projector(tw, baseline: bool):
+    """Removal of the straight-line baseline (least squares on 1 and t - tc, orthogonal) from
+    samples on times ``tw``, if it is fitted."""
+    ramp = tw - float(tw.mean())
+    ramp_norm = _dot(ramp, ramp) or 1.0
+
+    def project(v):
+        if not baseline:
+            return v
+        v = v - v.mean(axis=-1, keepdims=True)
+        if v.ndim == 1:
+            return v - ramp * (_dot(v, ramp) / ramp_norm)
+        return v - np.outer(np.einsum("ij,j->i", v, ramp), ramp / ramp_norm)
+
+    return project
+
+
+def _normal_equations(residual_and_jacobian):
+    """``p -> (||r||^2, J'J, J'r)`` from ``p -> (r, J)``, for :func:`_levenberg_marquardt`."""
+
+    def normal(p):
+        r, J = residual_and_jacobian(p)
+        return _dot(r, r), np.einsum("ij,ik->jk", J, J), np.einsum("ij,i->j", J, r)
+
+    return normal
+
+
+def _levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, max_iter=100,
+                         max_calls=None):
+    """Minimise a sum of squares ``||r(p)||^2`` by Levenberg-Marquardt with Marquardt's scaling.
+
+    ``normal(p)`` returns the sum of squares, ``J'J`` and ``J'r`` (``J = dr/dp``; for weighted
+    least squares the weighted products).  A small dense solver (three unknowns) without the
+    per-call overhead of a general one.  Steps that leave the box ``[lower, upper]`` are refused
+    like steps that increase the sum of squares.  Stops when every step is below ``xtol`` times
+    ``scale`` or the sum of squares falls by less than ``ftol`` relative, or after ``max_calls``
+    evaluations of ``normal``.  Returns ``(p, sum of squares)``.
+    """
+    cost, A, g = normal(p)
+    calls = 1
     lam = 1e-3
     for _ in range(max_iter):
-        A = np.einsum("ij,ik->jk", J, J)
-        g = np.einsum("ij,i->j", J, r)
         diag = np.diag(A).copy()
         diag[diag <= 0] = 1.0
         while True:
             step = np.linalg.solve(A + lam * np.diag(diag), -g)
             trial = p + step
+            if max_calls is not None and calls >= max_calls:
+                return p, cost
             if np.all(trial >= lower) and np.all(trial <= upper):
-                r_trial, J_trial = residual_and_jacobian(trial)
-                cost_trial = _dot(r_trial, r_trial)
+                cost_trial, A_trial, g_trial = normal(trial)
+                calls += 1
             else:
                 cost_trial = np.inf
             if cost_trial <= cost:
@@ -456,7 +732,7 @@ def _levenberg_marquardt(residual_and_jacobian, p, scale, lower, upper, xtol=1e-
                 return p, cost
         small_step = bool(np.all(np.abs(step) <= xtol * scale))
         small_gain = cost - cost_trial <= ftol * cost
-        p, cost, r, J = trial, cost_trial, r_trial, J_trial
+        p, cost, A, g = trial, cost_trial, A_trial, g_trial
         if small_step or small_gain:
             break
     return p, cost

@@ -135,3 +135,58 @@ def least_squares_limit(shape: str, ap: float, tp: float, t0: float, duration: f
     cov = JtJ_inv @ (J.T @ SJ) @ JtJ_inv
     sd = np.sqrt(np.diag(cov))
     return {"ap": sd[0] / abs(ap), "tp": sd[1] / tp, "t0": sd[2] / tp}
+
+
+def weighted_least_squares_limit(shape: str, ap: float, tp: float, t0: float, duration: float, dt: float,
+                                 noise: float, band=NOISE_BAND, baseline: bool = True) -> dict:
+    """Standard deviations of ``ap``, ``Tp`` and ``t0`` that the weighted (generalised) least
+    squares of :func:`pulses.fit_pulse` have under band-limited background motion, when the
+    background's spectrum is known: the noise limit of ``weighting="background"``.
+
+    As the fitter does, over the pulse and ``pulses.fit.GLS_MARGIN`` s each side, with the
+    covariance of the background taken as the circulant of its spectrum ``S`` and the weights
+    ``1 / (S + c mean(S))`` (``c = pulses.fit.LOADING``).  Linearised about the true pulse, the
+    estimate has covariance ``(J'WJ)^-1 J'WSWJ (J'WJ)^-1``; without the loading (``c = 0``) it is
+    ``(J'S^-1 J)^-1``, the Cramer-Rao bound, which no unbiased estimator beats.
+
+    Returns
+    -------
+    dict
+        ``ap``, ``tp`` (relative standard deviations) and ``t0`` (standard deviation in Tp).
+    """
+    from scipy import fft as sfft
+
+    from .fit import GLS_MARGIN, LOADING
+
+    cls = shape_class(shape)
+    n = int(round(duration / dt)) + 1
+    t = np.arange(n) * dt
+    lo, hi = cls.fit_tau
+    idx = slice(max(0, int(np.floor((t0 + lo * tp - GLS_MARGIN) / dt))),
+                min(n, int(np.ceil((t0 + hi * tp + GLS_MARGIN) / dt)) + 1))
+    tw = t[idx]
+    m, d_tp, d_t0 = cls.sampled_with_derivatives(tp, t0, tw, dt)
+    cols = [m, ap * d_tp, ap * d_t0]
+    if baseline:
+        cols += [np.ones_like(tw), tw - tw.mean()]
+    nfft = sfft.next_fast_len(tw.size, real=True)
+    U = sfft.rfft(np.stack(cols), nfft, axis=-1)
+    # eigenvalues of the circulant covariance: the noise's power at each bin, averaging to its variance
+    nyq = 0.5 / dt
+    sos = signal.butter(4, [band[0] / nyq, min(band[1] / nyq, 0.99)], btype="bandpass", output="sos")
+    _, h = signal.sosfreqz(sos, worN=np.arange(nfft // 2 + 1) / (nfft * dt), fs=1.0 / dt)
+    power = np.abs(h) ** 4
+    c = np.full(power.size, 2.0)
+    c[0] = 1.0
+    if nfft % 2 == 0:
+        c[-1] = 1.0
+    power *= (noise * abs(ap)) ** 2 / (np.sum(c * power) / nfft)
+    weighted = power + LOADING * float(np.mean(power))
+
+    def gram(w):
+        return np.real(np.einsum("ik,jk->ij", U * (c * w / nfft), U.conj()))
+
+    F_inv = np.linalg.inv(gram(1.0 / weighted))
+    cov = F_inv @ gram(power / weighted**2) @ F_inv
+    sd = np.sqrt(np.diag(cov))
+    return {"ap": sd[0] / abs(ap), "tp": sd[1] / tp, "t0": sd[2] / tp}

@@ -177,9 +177,11 @@ def _cwt_rows(x: np.ndarray, scales: tuple):
     for size, members in _size_groups(scales, n):
         spectrum = sfft.rfft(x, size, axis=-1)
         spectra = _filter_spectra(tuple(scales[i] for i in members), size)
+        product = np.empty_like(spectrum)
         for j, i in enumerate(members):
             k = _offset(scales[i])
-            yield i, sfft.irfft(spectrum * spectra[j], size, axis=-1)[..., k:k + n]
+            np.multiply(spectrum, spectra[j], out=product)
+            yield i, sfft.irfft(product, size, axis=-1)[..., k:k + n]
 
 
 @lru_cache(maxsize=8)
