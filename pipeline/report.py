@@ -206,6 +206,10 @@ _MANIFEST_HEADER = ("# pipeline run: the files it wrote into this folder (sha256
                     "it replaces or removes no other file\n")
 
 
+#: the resume journal in ``--out`` (:mod:`pipeline.resume`): which records a later run may keep
+RESUME = "pipeline-resume.txt"
+
+
 class NotOurs(OSError):
     """A file in the output folder that ``pipeline run`` did not write (left as it is)."""
 
@@ -357,6 +361,9 @@ def columns_markdown(columns, failure_columns) -> str:
         f"- `{MANIFEST}`: the files `pipeline run` wrote here (with a hash of their content). A later "
         "run into this folder replaces or removes only those, and only while their content is still "
         "what it wrote; any other file in its way is left as it is, and the run says so.",
+        f"- `{RESUME}`: for each record computed, a key of its file content, options and "
+        "package version and a hash of its report: a later run into this folder with the same "
+        "command keeps those records and computes only the others (`--force`: all).",
         "",
         "Accelerations are in g (g = 9.81 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
         "digits; a blank cell means the value does not apply (or, in `<shape>_*` columns, that the shape "

@@ -26,7 +26,7 @@ import re
 from . import report
 
 #: the resume journal in ``--out`` (written by ``pipeline run`` alone, like the manifest)
-RESUME = "pipeline-resume.txt"
+RESUME = report.RESUME
 _HEADER = ("# pipeline run: records whose reports may be kept by a later run (key of input, options "
            "and version; sha256 of the report; sha256 of the figure or -; record id)\n")
 _LINE = re.compile(r"^([0-9a-f]{64})  ([0-9a-f]{64})  ([0-9a-f]{64}|-)  (\S+)$")

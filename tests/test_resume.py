@@ -1,6 +1,8 @@
 """``pipeline run`` resumed: a batch killed halfway and run again computes only what is missing."""
 from __future__ import annotations
 
+import json
+import os
 import re
 import signal
 import subprocess
@@ -75,9 +77,17 @@ def test_stale_reports_failures_and_force_are_computed_again(batch, whole, tmp_p
     # the report of record 0 removed, record 1's file changed (same name)
     (out / "good00.csv").unlink()
     write_good(folder, 11).replace(recs[1])
-    assert main(["run", *paths, *args]) == 1
+    log = tmp_path / "log.jsonl"
+    assert main(["run", *paths, *args, "--log", str(log)]) == 1
     # 2 and 3 kept; 0 (removed), 1 (new content) and the empty file (failed) computed
     assert _counts(capsys.readouterr().out) == (4, 5, 2, 3)
+    entries = {e["record"]: e for e in map(json.loads, log.read_text().splitlines())}
+    assert {k: e["status"] for k, e in entries.items()} == {
+        "good00": "ok", "good01": "ok", "good02": "reused", "good03": "reused", "empty": "failed"}
+    assert entries["empty"]["stage"] == "read"
+    for k in ("good00", "good01"):  # computed here, in this process, with its fitted shape
+        assert entries[k]["worker"].endswith(f":{os.getpid()}") and entries[k]["seconds"] > 0
+        assert entries[k]["model"] == "sine"  # the only shape fitted (--shapes sine)
     again = tree(out)
     assert again["good00.csv"] == first["good00.csv"]
     assert again["good01.csv"] != first["good01.csv"]
