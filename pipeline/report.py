@@ -284,15 +284,7 @@ class Outputs:
         return True
 
     def _journal(self, line: str) -> None:
-        from . import interrupts
-
-        with interrupts.deferred():
-            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
-            fd = os.open(self.path, flags, 0o666)
-            with os.fdopen(fd, "a", encoding="utf-8") as fh:
-                if fh.tell() == 0:
-                    fh.write(_MANIFEST_HEADER)
-                fh.write(line)
+        append_line(self.path, _MANIFEST_HEADER, line)
 
     def finish(self) -> None:
         """Rewrite the manifest compactly: for each file still there, the content the tool wrote
@@ -309,6 +301,27 @@ class Outputs:
             lines += [f"{d}  {rel}\n" for d in sorted(digests)]
         if lines or os.path.lexists(self.path):
             write_atomic(self.path, _MANIFEST_HEADER + "".join(lines))
+
+
+def append_line(path, header: str, line: str) -> None:
+    """Append ``line`` (ending in a newline) to the journal at ``path``, starting it with ``header``.
+
+    A last line cut by a killed run is ended first, so that it spoils no other line; Ctrl-C waits
+    until the line is written."""
+    from . import interrupts
+
+    with interrupts.deferred():
+        flags = os.O_RDWR | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
+        fd = os.open(path, flags, 0o666)
+        with os.fdopen(fd, "a+b") as fh:
+            end = fh.seek(0, os.SEEK_END)
+            if end == 0:
+                fh.write(header.encode("utf-8"))
+            else:
+                fh.seek(end - 1)
+                if fh.read(1) != b"\n":
+                    fh.write(b"\n")
+            fh.write(line.encode("utf-8"))
 
 
 def _digest(raw: bytes) -> str:

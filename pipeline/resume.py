@@ -148,17 +148,9 @@ class Journal:
 
     def add(self, record_id: str, key: str, report_raw: bytes, figure_raw: bytes | None) -> None:
         """Note that ``record_id``'s report (and figure) were written from ``key``."""
-        from . import interrupts
-
         entry = (key, _digest(report_raw), _digest(figure_raw) if figure_raw is not None else "-")
         self.entries[record_id] = entry
-        with interrupts.deferred():
-            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
-            fd = os.open(self.path, flags, 0o666)
-            with os.fdopen(fd, "a", encoding="utf-8") as fh:
-                if fh.tell() == 0:
-                    fh.write(_HEADER)
-                fh.write(f"{entry[0]}  {entry[1]}  {entry[2]}  {record_id}\n")
+        report.append_line(self.path, _HEADER, f"{entry[0]}  {entry[1]}  {entry[2]}  {record_id}\n")
 
     def drop(self, record_id: str) -> None:
         self.entries.pop(record_id, None)

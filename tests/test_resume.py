@@ -111,3 +111,12 @@ def test_leftover_temporary_files_of_a_killed_run_are_removed(tmp_path):
         p.write_text("x")
     assert resume.remove_stale_temporaries(tmp_path, ["summary.csv", "plots/rec.png"]) == 2
     assert not any(p.exists() for p in left) and all(p.exists() for p in other)
+
+
+def test_a_resume_journal_not_written_by_the_tool_is_an_argument_error(batch, tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / resume.RESUME).write_text("my notes\n")
+    assert main(["run", batch[0], *BATCH_ARGS, "--out", str(out)]) == 2
+    assert "was not written by pipeline run" in capsys.readouterr().err
+    assert (out / resume.RESUME).read_text() == "my notes\n"
