@@ -10,6 +10,10 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    search over its two edges, see :func:`_refine_edges`).  A straight-line baseline is fitted
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
+3. **Weight** (``weighting="background"``, the default): the background's spectrum is estimated
+   from the residual of the best plain fit (:class:`Background`) and each shape is refit by least
+   squares weighted by its inverse (:func:`_refine_weighted`), where that promises a clearly
+   smaller scatter and the record follows the pulse model there (:func:`_weighting_pays`).
 
 A sampled pulse is the pulse evaluated at the sample times, except the rectangular pulse, whose
 point samples do not locate its edges more finely than ``dt``: it is sampled as its average over
@@ -32,7 +36,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg, signal
+from scipy import signal
 from scipy import fft as sfft
 
 from .baseline import pgv as _pgv
