@@ -77,10 +77,10 @@ GLS_MAX_CALLS = 12
 #: the weighted least squares replace the plain ones where they promise standard deviations of
 #: ap and Tp below this share of the plain ones (geometric mean; :func:`_weighting_pays`)
 GLS_GAIN = 0.5
-#: the weighted estimate is refused when it raises the plain sum of squares by more than this
-#: many times what noise alone would (:func:`_weighting_pays`): a chi-square of 3 unknowns
-#: exceeds 5 times its mean in under 0.1 % of cases
-GLS_RISE = 5.0
+#: the weighted estimate is refused when it differs from the plain one by more than noise
+#: explains: Hausman's statistic (chi-square of 3 degrees of freedom under the model) above its
+#: 99.9 % point
+GLS_HAUSMAN = 16.27
 
 
 class FitError(ValueError):
@@ -574,7 +574,7 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
         cost = xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
         return cost, UU * np.outer(d, d), -d * ur
 
-    timing_gains, amplitude_gains, expected_rise = _weighting_pays(
+    timing_gains, amplitude_gains, difference = _weighting_pays(
         sfft.rfft(sampled_with_derivatives(tp, t0), axis=-1) * np.array([[1.0], [ap], [ap]]),
         B if baseline else None, w, nfft, gram)
     if not timing_gains:
@@ -615,16 +615,10 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
         return start, False
     # the record must follow the pulse model where the weights look: on a record whose
     # background was filtered away above some frequency, a rectangle's or one-sine's edges are
-    # not in the record either, and a weighted fit would shrink the pulse to hide them.  The
-    # plain sum of squares must not rise by much more than noise alone would make it
-    project = _projector(tw, baseline)
-    xp = project(xw)
-
-    def plain_sse(a, tp_, t0_):
-        r = xp - a * project(sampled(tp_, t0_)[0, :tw.size])
-        return _dot(r, r)
-
-    if plain_sse(ap_new, tp_new, t0_new) - plain_sse(ap, tp, t0) > GLS_RISE * expected_rise:
+    # not in the record either, and a weighted fit would shrink the pulse to hide them.  Under
+    # the model the two estimates differ only by noise of known covariance (Hausman's test)
+    d = np.array([ap_new - ap, tp_new - tp, t0_new - t0])
+    if float(d @ np.linalg.pinv(difference) @ d) > GLS_HAUSMAN:
         return start, False
     return (ap_new, tp_new, t0_new, idx), not amplitude_gains
 
@@ -642,9 +636,9 @@ def _plain_amplitude(x, t, dt, shape, trial, baseline):
     return (_dot(m, project(x[k])) / mm, tp, t0, idx)
 
 
-def _weighting_pays(U, B, w, nfft, gram) -> tuple[bool, bool, float]:
+def _weighting_pays(U, B, w, nfft, gram):
     """Whether weighting by the background promises a clearly smaller scatter of ``Tp`` and of
-    ``ap``, and how much the weighted estimate is expected to raise the plain sum of squares.
+    ``ap``, and the covariance of the difference of the two estimates of ``(ap, Tp, t0)``.
 
     ``U``: ``nfft``-point FFT of the pulse's derivatives with respect to ``ap``, ``Tp``, ``t0``
     at the plain estimate; ``B``: of the baseline's columns (or None); ``w``: the weights of
@@ -653,8 +647,8 @@ def _weighting_pays(U, B, w, nfft, gram) -> tuple[bool, bool, float]:
     with the estimated spectrum ``S``.  Where the background is nearly white over the pulse's
     band the weighted estimate gains little, and the spectrum's own estimation error can cost
     more: each of ``Tp`` and ``ap`` is said to gain when the ratio of its standard deviations is
-    below :data:`GLS_GAIN`.  The expected rise of the plain sum of squares, ``trace(J'J (C_plain -
-    C_weighted))``, lets the caller tell noise from a pulse model the record does not follow.
+    below :data:`GLS_GAIN`.  The covariance of the difference, ``C_plain - C_weighted``, lets the
+    caller tell noise from a pulse model the record does not follow (Hausman's test).
     """
     J = U if B is None else np.concatenate([U, B])
     plain = np.full(w.size, 2.0 / nfft)  # the same sums unweighted: interior bins count twice
@@ -665,16 +659,15 @@ def _weighting_pays(U, B, w, nfft, gram) -> tuple[bool, bool, float]:
         weighted = np.linalg.inv(gram(J, J * w))
         plain_inv = np.linalg.inv(gram(J, J * plain))
     except np.linalg.LinAlgError:
-        return False, False, 0.0
-    plain_gram = gram(J, J * plain)
+        return False, False, None
     plain_cov = plain_inv @ gram(J, J * (plain**2 / w)) @ plain_inv
     ratio = np.sqrt(np.diag(weighted)[:2] / np.diag(plain_cov)[:2])
-    # the plain sum of squares at the weighted estimate exceeds its minimum by (d' J'J d) for
-    # d the difference of the two estimates, whose covariance is the difference of theirs
-    expected = float(np.trace(plain_gram @ (plain_cov - weighted)))
-    if not (np.all(np.isfinite(ratio)) and math.isfinite(expected)):
-        return False, False, 0.0
-    return bool(ratio[1] < GLS_GAIN), bool(ratio[0] < GLS_GAIN), max(expected, 0.0)
+    # the two estimates differ by noise whose covariance is the difference of theirs (the
+    # weighted one being the efficient one)
+    difference = (plain_cov - weighted)[:3, :3]
+    if not (np.all(np.isfinite(ratio)) and np.all(np.isfinite(difference))):
+        return False, False, None
+    return bool(ratio[1] < GLS_GAIN), bool(ratio[0] < GLS_GAIN), difference
 
 
 def _projector(tw, baseline: bool):
