@@ -238,14 +238,14 @@ def source() -> str:
         dispatch.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))")
     dispatch.append(f"    return taylor_{ORDERS[-1]}(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))")
     args = "uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low"
-    dispatch.append("\n\n@njit(cache=True, inline='always')\ndef fixed_run(order, " + args + ", low_run, eps, cf):")
+    dispatch.append("\n\n@njit(cache=True)\ndef fixed_run(order, " + args + ", low_run, eps, cf):")
     dispatch.append('    """fixed_run_N of :data:`ORDERS` order ``order`` (the highest for larger)."""')
     for i, n in enumerate(ORDERS):
         lower = "False" if i == 0 else "True"
         call = f"fixed_run_{n}({args}, {lower}, low_run, eps, cf)"
         dispatch.append(f"    if order <= {n}:\n        return {call}" if i < len(ORDERS) - 1
                         else f"    return {call}")
-    dispatch.append("\n\n@njit(cache=True, inline='always')\ndef taylor_smooth(order, U, q, theta, wh, s0, c0, eps, cf):")
+    dispatch.append("\n\n@njit(cache=True)\ndef taylor_smooth(order, U, q, theta, wh, s0, c0, eps, cf):")
     dispatch.append('    """The step of :data:`SMOOTH_ORDERS` order ``order`` (the highest for larger)."""')
     for n in SMOOTH_ORDERS[:-1]:
         dispatch.append(f"    if order <= {n}:\n        return taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf)")

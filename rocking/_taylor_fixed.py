@@ -2111,7 +2111,7 @@ def taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):
     return taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
 
 
-@njit(cache=True, inline='always')
+@njit(cache=True)
 def fixed_run(order, uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, low_run, eps, cf):
     """fixed_run_N of :data:`ORDERS` order ``order`` (the highest for larger)."""
     if order <= 4:
@@ -2129,7 +2129,7 @@ def fixed_run(order, uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs
     return fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf)
 
 
-@njit(cache=True, inline='always')
+@njit(cache=True)
 def taylor_smooth(order, U, q, theta, wh, s0, c0, eps, cf):
     """The step of :data:`SMOOTH_ORDERS` order ``order`` (the highest for larger)."""
     if order <= 8:

@@ -109,7 +109,7 @@ def abs_max(a):
     return max(max(m0, m1), max(m2, m3))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def forcing(kind, amp, tp, t0, uval, j, ta, tb, t):
     """Ground acceleration over g at time ``t`` inside interval ``j`` = ``[ta, tb]``.
 
@@ -390,7 +390,7 @@ def _stationary(c1, c2, c3):
     return r1, r2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _first_crossing(c0, c1, c2, c3, s, level):
     """First x in (0, 1] where ``s*H(x) - level`` turns non-positive, given it starts >= 0.
 
@@ -414,7 +414,7 @@ def _first_crossing(c0, c1, c2, c3, s, level):
     return -1.0, -1.0, False
 
 
-@njit(cache=True, inline="always")  # one call site
+@njit(cache=True)
 def _cubic_root(c0, c1, c2, c3, s, lo, hi):
     """The root of the cubic ``c0 + c1 x + c2 x^2 + c3 x^3`` in ``[lo, hi]``, where it is monotonic
     with ``s H(lo) > 0 >= s H(hi)`` (a bracket from :func:`_first_crossing`), to rounding.
@@ -461,7 +461,7 @@ def _sub(kind, amp, tp, t0, uval, j, ta, tb, t, h, x, theta, omega, s, p, sa, ca
                 method, kt, kw)
 
 
-@njit(cache=True, inline="always")  # one call site
+@njit(cache=True)
 def _advance(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, linear,
              method, kt, kw, U, S, C, cf, sc_known, s0, c0, n_hint):
     """One step of length ``h``: ``(theta, omega, n, s1, c1)`` at ``t + h``, with ``n`` the order
@@ -494,7 +494,7 @@ def _below(cf, n, level):
     return 1.01 * b < level
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
                s, p, sa, ca, linear, method, kt, kw, h_step, cf, n):
     """Largest ``|theta|`` at a turning point strictly inside ``[t, t + h]`` (0 if none).
@@ -580,7 +580,7 @@ def energy_verdict(theta, omega, p, alpha, eta, linear):
 
 
 # --------------------------------------------------------------------------- main loop
-@njit(cache=True, inline="always")  # one call site
+@njit(cache=True)
 def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
     """First time in ``[t, t2]`` where ``|u| > tan(alpha)`` (monotonic u), or nan."""
     ua = forcing(kind, amp, tp, t0, uval, j, ta, tb, t)
@@ -605,7 +605,7 @@ def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
     return hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _unrolled_step(fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q, theta, wh, s_phi,
                    c_phi, cf):
     """One unrolled Taylor step of ``order`` (:mod:`rocking._taylor_fixed`): forcing linear over
@@ -617,7 +617,7 @@ def _unrolled_step(fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q,
     return taylor_smooth(order, U, q, theta, wh, s_phi, c_phi, TAYLOR_EPS, cf)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omega, s, sa, ca, p2,
             max_abs, sc_known, s_phi, c_phi, order, n_low, cf, record, hist_t, hist_theta,
             hist_omega, n_hist):
