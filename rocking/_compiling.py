@@ -28,6 +28,11 @@ class _Notice(event.Listener):
         pass
 
 
+def first_call_done(entry) -> bool:
+    """Whether a first call of ``entry`` has returned in this process (nothing left to notice)."""
+    return entry in _done or _said
+
+
 @contextlib.contextmanager
 def compiling_notice(entry):
     """Around a call of the compiled ``entry``: the first time only, listen for compilation."""

@@ -7,8 +7,10 @@ Python: about 1 s per step function on this machine, most of the solver's first-
 Python too) and emits the same operations, in the same order and on the same types, as LLVM
 instructions through a numba intrinsic: the same instructions numba would emit (``fmul``,
 ``fadd``, ``fsub``, negation as ``fsub -0.0, x``, ``abs`` as ``llvm.fabs``, ordered comparisons),
-so the compiled step gives the same bits (``tests/test_solver.py`` checks it against the plain
-Python reference), in a few milliseconds of code generation.
+so the compiled step gives the same bits as numba's own compilation of that source (compared on
+2000 random steps of every order when this was written; ``tests/test_solver.py`` checks the
+compiled steps against the plain Python evaluation of their source), in a few milliseconds of
+code generation instead of about a second.
 
 The accepted subset is what ``rocking/_make_taylor.py`` writes: assignments to names of float
 expressions (``+ - *``, unary ``-``, ``abs``, float constants, the float parameters, ``U[k]`` reads

@@ -39,7 +39,7 @@ from numba import njit
 
 from ._taylor_fixed import ORDERS as FIXED_ORDERS
 from . import _dop853
-from ._compiling import compiling_notice
+from ._compiling import compiling_notice, first_call_done
 from ._taylor_fixed import SMOOTH_ORDERS, fixed_run, taylor_fixed, taylor_smooth
 
 #: Butcher tableau of the 8th-order Dormand-Prince formula (the 12 stages of DOP853; source
@@ -1024,19 +1024,23 @@ def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
     status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted, rest_until
     """
     check_kind(kind)
-    work = np.zeros(WORK_SIZE)
+    # every scalar as the one type compiled for it (an int theta0 would compile a second version)
+    args = (int(kind), float(amp), float(tp), float(t0), as_input(uval), as_input(nodes),
+            float(t_start), float(h_uniform), int(j0), int(n_int), int(n_sub), float(p),
+            float(alpha), float(eta), float(theta0), float(omega0), float(rest_until0),
+            bool(linear), float(zeno_tol), bool(stop_at_rest), hist_t, hist_theta, hist_omega,
+            impacts, bool(record), int(method), np.zeros(WORK_SIZE))
+    if first_call_done(run_core):  # the common case, without the notice's context (~10 us)
+        return run_core(*args)
     with compiling_notice(run_core):
-        return run_core(int(kind), float(amp), float(tp), float(t0), as_input(uval),
-                        as_input(nodes), float(t_start),
-                        float(h_uniform), int(j0), int(n_int), int(n_sub), float(p), float(alpha),
-                        float(eta), float(theta0), float(omega0), float(rest_until0),
-                        bool(linear), float(zeno_tol), bool(stop_at_rest), hist_t, hist_theta,
-                        hist_omega, impacts, bool(record), int(method), work)
+        return run_core(*args)
 
 
 def as_input(a):
     """``a`` as the compiled code takes arrays: float64, C-contiguous, writeable (numba compiles
     one version per array type; a read-only record would otherwise get a second one)."""
+    if a.dtype == np.float64 and a.flags.c_contiguous and a.flags.writeable:
+        return a
     return np.require(a, dtype=np.float64, requirements=("C", "W"))
 
 
