@@ -119,19 +119,21 @@ def brute_force_check() -> dict:
     return out
 
 
-#: verified-width search settings compared by :func:`record_width_check` (module constants of
-#: rocking.design, plus ``n_scan`` / ``n_zone`` of required_width); the last but one is the default
+#: verified-width search settings compared by :func:`record_width_check` (fields of
+#: :class:`rocking.search.SearchSettings`); the last but one is the default
 RECORD_WIDTH_SETTINGS = [
     ("former: 64 uniform, zone of 20 to 15 %, gaps near tipping",
-     dict(REC_SPACING="uniform", n_scan=64, n_zone=20, REC_FINE=0.0, REC_ROUNDS=6)),
-    ("128 geometric, zone of 20, gaps", dict(n_scan=128, n_zone=20, REC_FINE=0.0)),
-    ("256 geometric, zone of 20, gaps", dict(n_scan=256, n_zone=20, REC_FINE=0.0)),
-    ("128 geometric, fine 0.2 % to 30 %, gaps", dict(REC_FINE=2e-3, REC_FINE_SPAN=0.3)),
-    ("128 geometric, fine 0.1 % to 30 %, gaps", dict(REC_FINE=1e-3, REC_FINE_SPAN=0.3)),
-    ("128 geometric, fine 0.05 % to 30 %, gaps", dict(REC_FINE=5e-4, REC_FINE_SPAN=0.3)),
+     dict(record_spacing="uniform", record_scan=64, record_zone_points=20, record_fine=0.0,
+          record_rounds=6)),
+    ("128 geometric, zone of 20, gaps", dict(record_scan=128, record_zone_points=20, record_fine=0.0)),
+    ("256 geometric, zone of 20, gaps", dict(record_scan=256, record_zone_points=20, record_fine=0.0)),
+    ("128 geometric, fine 0.2 % to 30 %, gaps", dict(record_fine=2e-3, record_fine_span=0.3)),
+    ("128 geometric, fine 0.1 % to 30 %, gaps", dict(record_fine=1e-3, record_fine_span=0.3)),
+    ("128 geometric, fine 0.05 % to 30 %, gaps", dict(record_fine=5e-4, record_fine_span=0.3)),
     ("**default**: 128 geometric, fine 0.05 % to 20 %, gaps", dict()),
     ("uniform scan of 1500 widths, nothing else",
-     dict(REC_SPACING="uniform", n_scan=1500, n_zone=0, REC_FINE=0.0, REC_NEAR=2.0)),
+     dict(record_spacing="uniform", record_scan=1500, record_zone_points=0, record_fine=0.0,
+          record_near=2.0)),
 ]
 
 
@@ -169,29 +171,19 @@ def record_width_check(folder=None, heights=(6.0, 7.5)) -> dict:
     t = time.perf_counter()
     ref = {c: max(_brute_record_width(c[1], records[c[0]], n) for n in (1500, 6000)) for c in cases}
     brute_s = time.perf_counter() - t
-    saved = {k: getattr(design, k) for k in dir(design) if k.startswith("REC_")}
     rows = []
-    try:
-        for label, setting in RECORD_WIDTH_SETTINGS:
-            for k, v in saved.items():
-                setattr(design, k, v)
-            kw = {k: v for k, v in setting.items() if not k.isupper()}
-            for k, v in setting.items():
-                if k.isupper():
-                    setattr(design, k, v)
-            d, runs = [], []
-            for f, h in cases:
-                r = design.required_width(h, records[f], rule="exact", **kw)
-                d.append(r.width / ref[(f, h)] - 1.0)
-                runs.append(r.runs)
-            d = np.array(d)
-            rows.append({"setting": label, "below_0.5%": int((d < -0.005).sum()),
-                         "below_2%": int((d < -0.02).sum()), "worst": float(d.min()),
-                         "above_0.5%": int((d > 0.005).sum()),
-                         "runs_median": int(np.median(runs)), "runs_max": int(max(runs))})
-    finally:
-        for k, v in saved.items():
-            setattr(design, k, v)
+    for label, setting in RECORD_WIDTH_SETTINGS:
+        settings = design.SearchSettings(**setting)
+        d, runs = [], []
+        for f, h in cases:
+            r = design.required_width(h, records[f], rule="exact", settings=settings)
+            d.append(r.width / ref[(f, h)] - 1.0)
+            runs.append(r.runs)
+        d = np.array(d)
+        rows.append({"setting": label, "below_0.5%": int((d < -0.005).sum()),
+                     "below_2%": int((d < -0.02).sum()), "worst": float(d.min()),
+                     "above_0.5%": int((d > 0.005).sum()),
+                     "runs_median": int(np.median(runs)), "runs_max": int(max(runs))})
     print(f"{len(cases)} cases ({len(files)} records x heights {heights}); brute force {brute_s:.0f} s")
     print("| search | below by > 0.5 % | below by > 2 % | worst | above by > 0.5 % | runs, median | runs, max |")
     print("|---|---:|---:|---:|---:|---:|---:|")

@@ -29,36 +29,39 @@ NEAR = (0.3, 0.5, 0.7)
 
 def _zones(record, height):
     """Every batch of the fine zone of one verified-width search: ``(widths, failed, ratio)``
-    sorted widest first, with each width's index ``k`` on the grid ``top (1 + REC_FINE)^-k``."""
-    import rocking
-    import rocking.design as design
+    sorted widest first, with each width's index ``k`` on the grid ``top (1 + record_fine)^-k``
+    (the search run with the whole zone in one batch, ``record_chunk`` unbounded, not stopped
+    at its first failure; every batch logged)."""
     from pulses import G
+    from rocking import search, widths
 
+    settings = search.SearchSettings(record_chunk=sys.maxsize)
+    fine = settings.record_fine
     top = height * record.pga / G
     log = []
-    batch = design._batch
 
-    def logged(blocks, excitation, scales=None, **kw):
-        res = batch(blocks, excitation, scales, **kw)
-        log.append((np.array([b.width for b in blocks]), np.asarray(res.overturned, dtype=bool),
+    def evaluate(ws):
+        res = search._batch([rocking_block(height, b) for b in ws], record)
+        log.append((np.asarray(ws, dtype=float), np.asarray(res.overturned, dtype=bool),
                     np.asarray(res.max_rotation_ratio, dtype=float)))
-        return res
+        return log[-1][1], log[-1][2]
 
-    design._batch, chunk = logged, design.REC_CHUNK
-    design.REC_CHUNK = sys.maxsize     # the whole zone, not stopped at its first failure
-    try:
-        rocking.required_width(height, record, rule="exact")
-    finally:
-        design._batch, design.REC_CHUNK = batch, chunk
+    widths._record_width(height, top, evaluate, criterion="overturn", eta=None, settings=settings)
     out = []
     for w, f, r in log:
-        k = np.round(np.log(top / w) / math.log1p(design.REC_FINE)).astype(int)
-        if w.size < 40 or not np.allclose(top * (1.0 + design.REC_FINE) ** -k.astype(float), w,
+        k = np.round(np.log(top / w) / math.log1p(fine)).astype(int)
+        if w.size < 40 or not np.allclose(top * (1.0 + fine) ** -k.astype(float), w,
                                           rtol=1e-12, atol=0.0):
             continue                   # the scan, bisections and gap checks
         order = np.argsort(-w)
         out.append((w[order], f[order], r[order], k[order]))
     return out
+
+
+def rocking_block(height, width):
+    from rocking import Block
+
+    return Block.from_dimensions(height, float(width))
 
 
 def analyse(cases) -> dict:

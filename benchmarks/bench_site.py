@@ -35,11 +35,11 @@ def cost(pair, columns, n_even, fragility):
 
     opts = Options(plots=False, fragility=fragility)
     tasks = site.make_tasks([], [pair], "none", columns, opts, n_even, say=lambda m: None)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     out = [process_record(t) for t in tasks]
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     assert not any(o["failure"] for o in out), [o["failure"] for o in out if o["failure"]]
-    return seconds, len(tasks)
+    return seconds, cpu, len(tasks)
 
 
 def miss(pair, heights, n_even):
@@ -76,15 +76,15 @@ def main(argv=None):
     columns = (Column(7.5, 1.8), Column(2.5, 0.6))
     if not args.skip_cost:
         cost(pairs[0], columns, 0, False)  # warm-up: compilation caches, imports
-        print("\ncost per pair (s, one process), columns 7.5x1.8 and 2.5x0.6:")
+        print("\ncost per pair (CPU s of one process: the machine may be shared), columns 7.5x1.8 and 2.5x0.6:")
         print(f"{'pair':46s} {'default':>14s} {'N=' + str(args.n):>14s} {'fragility':>14s}")
         for pair in pairs[:args.cost_pairs]:
             cells = []
             for n_even, frag in ((0, False), (args.n, False), (0, True)):
-                s, k = cost(pair, columns, n_even, frag)
-                cells.append(f"{s:7.1f} ({k:2d} dir)")
+                s, c, k = cost(pair, columns, n_even, frag)
+                cells.append(f"{c:7.1f} ({k:2d} dir)")
                 print(f"  {'N=' + str(n_even) if n_even else 'default'}{' --fragility' if frag else ''}: "
-                      f"{s:.1f} s for {k} directions", flush=True)
+                      f"{s:.1f} s wall, {c:.1f} s CPU for {k} directions", flush=True)
             print(f"{pathlib.Path(pair[0]).name + ' + ' + pathlib.Path(pair[1]).name:46s} " + " ".join(cells))
     if args.skip_miss:
         return

@@ -606,18 +606,11 @@ def headline(quick):
         t_usual.append(timed(lambda: simulate_usual(blk, exc, **USUAL_DEFAULT))[1])
     # batch engine (rocking.lanes) against the same runs one by one, one core (< 256 runs: no
     # threads): 200 widths of the column up to 20 % wider, as a verified-width search runs them
-    from rocking import solver
-
     wide = [rocking.Block.from_dimensions(7.5, 1.8 * (1.0 + 0.2 * k / 199)) for k in range(200)]
     t_lanes, t_one = [], []
-    saved = solver.LANES_MIN_RUNS
     for _ in range(max(2, n_round // 2)):
         t_lanes.append(timed(lambda: rocking.simulate_many(wide, exc))[1] / 200)
-        solver.LANES_MIN_RUNS = 10 ** 9
-        try:
-            t_one.append(timed(lambda: rocking.simulate_many(wide, exc))[1] / 200)
-        finally:
-            solver.LANES_MIN_RUNS = saved
+        t_one.append(timed(lambda: rocking.simulate_many(wide, exc, lanes=False))[1] / 200)
     ratios = [u / f for u, f in zip(t_usual, t_fast)]
     ratios_rk8 = [u / f for u, f in zip(t_usual, t_rk8)]
     e_fast = abs(fast.max_rotation_ratio - ref.max_rotation_ratio)

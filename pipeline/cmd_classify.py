@@ -83,6 +83,7 @@ def main(args) -> int:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
     opts = record_options(args)
     files = expand_inputs(args.files)
+    _check_outputs(args, files + [p for pair in args.pair for p in pair])
     records, failures = {}, 0
     for path in files + [p for pair in args.pair for p in pair]:
         if path in records:
@@ -112,6 +113,7 @@ def main(args) -> int:
         jobs += [(p, None, False) for p in rest]
 
     rows, results = [], []
+    stems = set()  # plot file names taken: two inputs named alike never share a PNG
     for a, b, explicit in jobs:
         first, second = records.get(a), records.get(b) if b is not None else None
         if first is None or (b is not None and second is None):
@@ -139,16 +141,55 @@ def main(args) -> int:
             if args.plot:
                 from .plot_classify import plot_classification
 
-                plot_classification(result, args.plot, records[x], records[y] if y is not None else None)
+                try:
+                    plot_classification(result, args.plot, records[x],
+                                        records[y] if y is not None else None,
+                                        stem=_unique_stem(result.name, stems))
+                except OSError as exc:  # one plot that cannot be written fails its row only
+                    print(f"pipeline classify: {_message(x, exc)}", file=sys.stderr)
+                    failures += 1
     if args.json:
         print(json.dumps(rows, indent=2))
     elif rows:
         print(format_rows(rows))
     if args.csv and rows:
-        import pandas as pd
+        from .report import csv_text, write_atomic
 
-        pd.DataFrame(rows, columns=COLUMNS).to_csv(args.csv, index=False, float_format="%.6g")
+        write_atomic(args.csv, csv_text(COLUMNS, [{c: row[c] for c in COLUMNS} for row in rows]))
     return 1 if failures else 0
+
+
+def _unique_stem(name, taken) -> str:
+    """A file-system-safe stem for ``name`` not in ``taken`` (``-2``, ``-3``, ... appended)."""
+    from .batch import record_ids
+
+    base = record_ids([name])[0]
+    stem, k = base, 1
+    while stem.lower() in taken:
+        k += 1
+        stem = f"{base}-{k}"
+    taken.add(stem.lower())
+    return stem
+
+
+def _check_outputs(args, inputs) -> None:
+    """Argument errors before any work: ``--csv`` that is a folder or one of the inputs, ``--plot``
+    that is a file."""
+    import os
+
+    if args.csv:
+        if os.path.isdir(args.csv):
+            raise ArgumentError(f"--csv {args.csv}: is a folder; name a CSV file")
+        if os.path.exists(args.csv):
+            for path in inputs:
+                try:
+                    if os.path.samefile(args.csv, path):
+                        raise ArgumentError(f"--csv {args.csv}: is one of the input records; "
+                                            "name another file")
+                except OSError:
+                    continue
+    if args.plot and os.path.exists(args.plot) and not os.path.isdir(args.plot):
+        raise ArgumentError(f"--plot {args.plot}: is a file; name a folder")
 
 
 def format_rows(rows) -> str:

@@ -7,10 +7,13 @@ always gives the same file.
 """
 from __future__ import annotations
 
+import io
 import math
 import pathlib
 
 import numpy as np
+
+from .report import write_atomic
 
 #: figure size in inches and resolution: 1100 x 720 pixels
 FIGSIZE, DPI = (11.0, 7.2), 100
@@ -20,8 +23,8 @@ def _safe(name: str) -> str:
     return "".join(ch if ch.isalnum() or ch in "-_.+" else "_" for ch in name)
 
 
-def plot_classification(result, folder, first=None, second=None) -> str:
-    """Draw ``result`` (a :class:`pulses.PulseClassification`) into ``folder/<name>.png``.
+def plot_classification(result, folder, first=None, second=None, stem=None) -> str:
+    """Draw ``result`` (a :class:`pulses.PulseClassification`) into ``folder/<stem>.png``.
 
     Parameters
     ----------
@@ -30,6 +33,8 @@ def plot_classification(result, folder, first=None, second=None) -> str:
         Created if needed.
     first, second : pulses.Record, optional
         The component records, for their names and azimuths in the direction sketch.
+    stem : str, optional
+        File name without ``.png`` (default: the result's name made file-system safe).
 
     Returns
     -------
@@ -72,8 +77,10 @@ def plot_classification(result, folder, first=None, second=None) -> str:
                  f"PGV = {result.pgv * 100:.1f} cm/s, PGV ratio {result.pgv_ratio:.2f}, "
                  f"energy ratio {result.energy_ratio:.2f}", fontsize=10)
     _direction(fig.add_subplot(grid[0:2, 1]), result, first, second)
-    path = folder / f"{_safe(result.name)}.png"
-    fig.savefig(path, dpi=DPI, metadata={"Software": None})
+    path = folder / f"{stem or _safe(result.name)}.png"
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
+    write_atomic(path, buf.getvalue())  # a temporary file and a rename: never half a PNG
     return str(path)
 
 

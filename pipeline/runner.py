@@ -78,14 +78,10 @@ def _serial(tasks):
 
 
 def init_worker() -> None:
-    """Set up a worker process: one compiled-solver thread (the processes share the CPUs), and
-    the solver's batches always in its one-thread variants (the same runs, the same results; the
-    threaded variants would only add their start-up, and their compilation on a fresh install)."""
-    import rocking.engine
-
+    """Set up a worker process: one compiled-solver thread (the processes share the CPUs; the
+    solver's batches then run on one thread, with the same runs and the same results)."""
     global _in_worker
     _in_worker = True
-    rocking.engine.PARALLEL_MIN_RUNS = sys.maxsize
     try:
         import numba
 

@@ -10,6 +10,10 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    search over its two edges, see :func:`_refine_edges`).  A straight-line baseline is fitted
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
+3. **Weight** (``weighting="background"``, the default): the background's spectrum is estimated
+   from the residual of the best plain fit (:class:`Background`) and each shape is refit by least
+   squares weighted by its inverse (:func:`_refine_weighted`), where that promises a clearly
+   smaller scatter and the record follows the pulse model there (:func:`_weighting_pays`).
 
 A sampled pulse is the pulse evaluated at the sample times, except the rectangular pulse, whose
 point samples do not locate its edges more finely than ``dt``: it is sampled as its average over
@@ -32,7 +36,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg, signal
+from scipy import signal
 from scipy import fft as sfft
 
 from .baseline import pgv as _pgv
@@ -58,8 +62,10 @@ TP_LEASH = 1.5
 #: baseline fitted with the pulse is pinned down by the motion around it, so that it does not
 #: trade off against a short pulse
 FIT_MARGIN = 1.0
-#: length (s) of the segments over which the background's spectrum is averaged
+#: length (s) of the segments over which the background's spectrum is averaged: at least
+#: SEGMENT s and SEGMENT_PERIODS periods of the best plain fit
 SEGMENT = 2.5
+SEGMENT_PERIODS = 2.5
 #: white noise added to the background's spectrum, as a share of its mean power: bounds the
 #: weight of frequencies where the background has (almost) no power
 LOADING = 1e-3
@@ -310,7 +316,9 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         resid = x - fits[best][2]
         # a record the plain fit explains to round-off has no background to weight by
         exact = _dot(resid, resid) <= 1e-24 * energy
-        background = None if exact else Background(resid, dt)
+        # the segments must resolve the spectrum down to the pulse's own frequencies
+        segment = max(SEGMENT, SEGMENT_PERIODS * fits[best][1][1])
+        background = None if exact else Background(resid, dt, segment)
         for shape, (match, trial, p_trial) in ([] if exact else fits.items()):
             trial, plain_ap = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
             if plain_ap:
@@ -473,10 +481,11 @@ class Background:
     taken as the circulant of this spectrum).
     """
 
-    def __init__(self, resid, dt: float):
+    def __init__(self, resid, dt: float, segment: float = None):
         resid = np.asarray(resid, dtype=float)
         self.dt = float(dt)
-        nseg = int(min(resid.size, max(16, round(SEGMENT / dt))))
+        segment = SEGMENT if segment is None else segment
+        nseg = int(min(resid.size, max(16, round(segment / dt))))
         self.freq, power = signal.welch(resid, fs=1.0 / dt, window="hann", nperseg=nseg, detrend="constant")
         # below two frequency steps the segments (their means removed) cannot measure the
         # power: it is taken as no lower than there

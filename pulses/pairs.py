@@ -69,13 +69,18 @@ def check_pair(first: Record, second: Record) -> tuple[Record, Record]:
     Raises
     ------
     RecordError
-        Naming both files: different ``dt``, lengths more than :data:`MAX_LENGTH_DIFFERENCE`
-        samples apart, a vertical component, or azimuths more than
+        Naming both files: different ``dt``, start times more than half a sample apart, lengths
+        more than :data:`MAX_LENGTH_DIFFERENCE` samples apart, a vertical component, or azimuths more than
         :data:`ORTHOGONAL_TOLERANCE_DEG` from orthogonal.
     """
     names = f"{_label(first)} and {_label(second)}"
     if abs(first.dt - second.dt) > DT_RTOL * max(first.dt, second.dt):
         raise RecordError(f"{names}: not a pair, time steps differ ({first.dt:g} s and {second.dt:g} s)")
+    if abs(first.t_start - second.t_start) > 0.5 * first.dt:
+        # the components are combined sample by sample: records that start at different times
+        # would be added out of step
+        raise RecordError(f"{names}: not a pair, they start at different times ({first.t_start:g} s "
+                          f"and {second.t_start:g} s); cut them to a common start first")
     diff = abs(first.npts - second.npts)
     if diff > MAX_LENGTH_DIFFERENCE:
         raise RecordError(f"{names}: not a pair, lengths differ by {diff} samples ({first.npts} and "

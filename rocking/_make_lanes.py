@@ -30,49 +30,62 @@ keeps its sign, ``theta`` its side and stays below pi/2; elsewhere the state is 
 and ``bad`` says why (1: something happens in the step; 2: the order is too low).  Returns the
 number of lanes left (``bad`` > 0) and the number of kept lanes for which a lower order would
 have done.
+
+The arithmetic of a lane is ``_lane_N`` in plain Python, turned into LLVM instructions inside the
+loop by :func:`rocking._straight.straight` (the same operations in the same order, without numba
+typing each of its hundreds of statements).
 """
 from numba import njit
+
+from ._straight import straight
 '''
 
 
 def _function(n: int) -> str:
-    lines = [f"\n\n@njit(cache=True)\ndef lanes_{n}(n, uj, duj, amp, q, h, theta, omega, side, s_phi, "
-             "c_phi, peak, eps, bad):",
-             "    inv_h = 1.0 / h",
-             "    n_bad = 0",
-             "    n_low = 0",
-             "    for i in range(n):",
-             "        u0 = amp[i] * uj",
-             "        u1 = amp[i] * duj",
-             "        qi = q[i]",
-             "        th = theta[i]",
-             "        om = omega[i]",
-             "        S_0 = s_phi[i]",
-             "        C_0 = c_phi[i]",
-             "        D_1 = om * h",
-             "        c_2 = -0.5 * qi * (S_0 + u0 * C_0)",
-             "        D_2 = 2.0 * c_2"]
+    lines = [f"\n\ndef _lane_{n}(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):",
+             "    c_2 = -0.5 * qi * (S_0 + u0 * C_0)",
+             "    D_2 = 2.0 * c_2"]
     for k in range(1, n - 1):
-        lines += [f"        S_{k} = -({_chain_sum(k, 'C')}) * {1.0 / k!r}",
-                  f"        C_{k} = ({_chain_sum(k, 'S')}) * {1.0 / k!r}",
-                  f"        c_{k + 2} = -qi * (S_{k} + u0 * C_{k} + u1 * C_{k - 1}) * "
+        lines += [f"    S_{k} = -({_chain_sum(k, 'C')}) * {1.0 / k!r}",
+                  f"    C_{k} = ({_chain_sum(k, 'S')}) * {1.0 / k!r}",
+                  f"    c_{k + 2} = -qi * (S_{k} + u0 * C_{k} + u1 * C_{k - 1}) * "
                   f"{1.0 / ((k + 1) * (k + 2))!r}",
-                  f"        D_{k + 2} = {k + 2}.0 * c_{k + 2}"]
+                  f"    D_{k + 2} = {k + 2}.0 * c_{k + 2}"]
     theta = " + ".join([f"c_{k}" for k in range(n, 1, -1)] + ["D_1", "th"])
     wh = " + ".join(f"D_{k}" for k in range(n, 0, -1))
-    lines += [f"        th2 = {theta}",
-              f"        om2 = ({wh}) * inv_h",
-              "        tol = eps * (abs(th) + abs(D_1) + abs(c_2))",
-              f"        hi = max(abs(D_{n}), abs(D_{n - 1}))",
-              f"        lo = max(abs(D_{n - 2}), abs(D_{n - 3}))",
+    s1 = " + ".join(f"S_{k}" for k in range(n - 2, -1, -1))
+    c1 = " + ".join(f"C_{k}" for k in range(n - 2, -1, -1))
+    lines += [f"    th2 = {theta}",
+              f"    om2 = ({wh}) * inv_h",
+              "    tol = eps * (abs(th) + abs(D_1) + abs(c_2))",
+              f"    return (th2, om2, {s1}, {c1}, tol, abs(D_{n}), abs(D_{n - 1}), abs(D_{n - 2}), "
+              f"abs(D_{n - 3}))"]
+    lines += [f"\n\n_lane_{n}_ir = straight(_lane_{n})"]
+    lines += [f"\n\n@njit(cache=True)\ndef lanes_{n}(n, uj, duj, amp, q, h, theta, omega, side, s_phi, "
+              "c_phi, peak, eps, bad):",
+              "    inv_h = 1.0 / h",
+              "    n_bad = 0",
+              "    n_low = 0",
+              "    for i in range(n):",
+              "        u0 = amp[i] * uj",
+              "        u1 = amp[i] * duj",
+              "        th = theta[i]",
+              "        om = omega[i]",
+              "        S_0 = s_phi[i]",
+              "        C_0 = c_phi[i]",
+              "        D_1 = om * h",
+              f"        th2, om2, s1, c1, tol, a_{n}, a_{n - 1}, a_{n - 2}, a_{n - 3} = _lane_{n}_ir(",
+              "            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)",
+              f"        hi = max(a_{n}, a_{n - 1})",
+              f"        lo = max(a_{n - 2}, a_{n - 3})",
               "        converged = hi <= tol",
               "        quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)",
               "        keep = converged & quiet",
               "        # branch-free selects (they vectorise): the new state where kept",
               "        theta[i] = th2 if keep else th",
               "        omega[i] = om2 if keep else om",
-              "        s_phi[i] = (" + " + ".join(f"S_{k}" for k in range(n - 2, -1, -1)) + ") if keep else S_0",
-              "        c_phi[i] = (" + " + ".join(f"C_{k}" for k in range(n - 2, -1, -1)) + ") if keep else C_0",
+              "        s_phi[i] = s1 if keep else S_0",
+              "        c_phi[i] = c1 if keep else C_0",
               "        peak[i] = max(peak[i], abs(th2)) if keep else peak[i]",
               "        b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low",
               "        bad[i] = b",

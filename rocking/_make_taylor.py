@@ -28,8 +28,19 @@ terms before them already were below (a lower order would do), else 1.  The coef
 ``U[0 .. N - 2]`` in powers of ``x`` (smooth pulses).  ``fixed_run_N`` loops ``taylor_N`` over the
 intervals of a record while nothing happens (one loop per order: a loop holding all the orders
 cost ~4 ns a step), ``fixed_run`` picks the one of an order.
+
+Each step is written twice: ``_taylor_N`` in plain Python (the reference, and the source that
+:func:`rocking._straight.straight` turns into LLVM instructions, the same operations in the same
+order, without numba typing each of its hundreds of statements), and ``taylor_N``, the compiled
+step that calls it.
+
+Constants passed to compiled functions are written ``np.bool_(...)``: a bare ``True`` is typed as
+a literal, for which numba would compile the callee once more.
 """
+import numpy as np
 from numba import njit
+
+from ._straight import straight
 '''
 
 
@@ -43,7 +54,7 @@ def _chain_sum(k: int, other: str) -> str:
 
 def _smooth_function(n: int) -> str:
     """The step of order ``n`` for forcing given by its series ``U[0 .. n - 2]`` (smooth pulses)."""
-    lines = [f"\n\n@njit(cache=True)\ndef taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf):"]
+    lines = [f"\n\ndef _taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf):"]
     lines += [f"    U_{i} = U[{i}]" for i in range(n - 1)]
     lines += ["    S_0 = s0",
               "    C_0 = c0",
@@ -71,6 +82,9 @@ def _smooth_function(n: int) -> str:
               f"    elif abs(D_{n - 2}) <= tol and abs(D_{n - 3}) <= tol:",
               "        flag = 2",
               f"    return {theta}, {wh}, {s1}, {c1}, flag"]
+    lines += [f"\n\n_taylor_smooth_{n}_ir = straight(_taylor_smooth_{n})",
+              f"\n\n@njit(cache=True)\ndef taylor_smooth_{n}(U, q, theta, wh, s0, c0, eps, cf):",
+              f"    return _taylor_smooth_{n}_ir(U, q, theta, wh, s0, c0, eps, cf)"]
     return "\n".join(lines) + "\n"
 
 
@@ -120,7 +134,7 @@ def _fixed_function(n: int) -> str:
     add or multiply) order the sums; the compiler may fuse a multiply into the add that follows
     (``fastmath='contract'``), never reorder."""
     sc = _Sched()
-    L = [f"\n\n@njit(cache=True, fastmath={{'contract'}})\ndef taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):",
+    L = [f"\n\ndef _taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):",
          "    S_0 = s0",
          "    C_0 = c0"]
     for k in range(0, n - 1):  # c_{k+2} = Q_k S_k + A_k C_k + B_k C_{k-1}
@@ -176,6 +190,10 @@ def _fixed_function(n: int) -> str:
           f"    elif {D[n - 2]} <= tol and {D[n - 3]} <= tol:",
           "        flag = 2",
           f"    return {th}, {whn}, {s1}, {c1}, flag"]
+    L += [f"\n\n_taylor_{n}_ir = straight(_taylor_{n})",
+          f"\n\n@njit(cache=True, fastmath={{'contract'}})\n"
+          f"def taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):",
+          f"    return _taylor_{n}_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)"]
     return "\n".join(L) + "\n"
 
 
@@ -190,7 +208,7 @@ def fixed_run_{n}(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -198,7 +216,7 @@ def fixed_run_{n}(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_{n}(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -214,10 +232,11 @@ def fixed_run_{n}(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n
 def source() -> str:
     """Text of the generated module."""
     dispatch = ["\n\n@njit(cache=True, inline='always')\ndef taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):",
-                '    """The step of :data:`ORDERS` order ``order`` (the highest for larger)."""']
+                '    """The step of :data:`ORDERS` order ``order`` (the highest for larger; ``store`` passed '
+                'as fixed_run_N passes it: one compiled version of each step)."""']
     for n in ORDERS[:-1]:
-        dispatch.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf)")
-    dispatch.append(f"    return taylor_{ORDERS[-1]}(u0, u1, q, theta, wh, s0, c0, eps, cf)")
+        dispatch.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))")
+    dispatch.append(f"    return taylor_{ORDERS[-1]}(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))")
     args = "uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low"
     dispatch.append("\n\n@njit(cache=True)\ndef fixed_run(order, " + args + ", low_run, eps, cf):")
     dispatch.append('    """fixed_run_N of :data:`ORDERS` order ``order`` (the highest for larger)."""')

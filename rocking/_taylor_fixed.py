@@ -11,16 +11,26 @@ terms before them already were below (a lower order would do), else 1.  The coef
 ``U[0 .. N - 2]`` in powers of ``x`` (smooth pulses).  ``fixed_run_N`` loops ``taylor_N`` over the
 intervals of a record while nothing happens (one loop per order: a loop holding all the orders
 cost ~4 ns a step), ``fixed_run`` picks the one of an order.
+
+Each step is written twice: ``_taylor_N`` in plain Python (the reference, and the source that
+:func:`rocking._straight.straight` turns into LLVM instructions, the same operations in the same
+order, without numba typing each of its hundreds of statements), and ``taylor_N``, the compiled
+step that calls it.
+
+Constants passed to compiled functions are written ``np.bool_(...)``: a bare ``True`` is typed as
+a literal, for which numba would compile the callee once more.
 """
+import numpy as np
 from numba import njit
+
+from ._straight import straight
 
 ORDERS = (4, 6, 8, 10, 12, 14, 16)
 SMOOTH_ORDERS = (8, 10, 12, 14, 16, 18, 20, 22, 24)
 HALF_PI = 1.5707963267948966
 
 
-@njit(cache=True, fastmath={'contract'})
-def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def _taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -58,8 +68,15 @@ def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_4_ir = straight(_taylor_4)
+
+
 @njit(cache=True, fastmath={'contract'})
-def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_4_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
+def _taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -116,8 +133,15 @@ def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_6_ir = straight(_taylor_6)
+
+
 @njit(cache=True, fastmath={'contract'})
-def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_6_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
+def _taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -197,8 +221,15 @@ def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_8_ir = straight(_taylor_8)
+
+
 @njit(cache=True, fastmath={'contract'})
-def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_8_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
+def _taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -305,8 +336,15 @@ def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_10_ir = straight(_taylor_10)
+
+
 @njit(cache=True, fastmath={'contract'})
-def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_10_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
+def _taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -444,8 +482,15 @@ def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_12_ir = straight(_taylor_12)
+
+
 @njit(cache=True, fastmath={'contract'})
-def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_12_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
+def _taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -618,8 +663,15 @@ def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_14_ir = straight(_taylor_14)
+
+
 @njit(cache=True, fastmath={'contract'})
-def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+def taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_14_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
+def _taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     S_0 = s0
     C_0 = c0
     Q_0 = q * -0.5
@@ -831,6 +883,14 @@ def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
     return theta + (wh + tc), wh + tD, S_0 + tS, C_0 + tC, flag
 
 
+_taylor_16_ir = straight(_taylor_16)
+
+
+@njit(cache=True, fastmath={'contract'})
+def taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):
+    return _taylor_16_ir(u0, u1, q, theta, wh, s0, c0, eps, cf, store)
+
+
 @njit(cache=True)
 def fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, can_lower,
                 low_run, eps, cf):
@@ -840,7 +900,7 @@ def fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -848,7 +908,7 @@ def fixed_run_4(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_4(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -869,7 +929,7 @@ def fixed_run_6(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -877,7 +937,7 @@ def fixed_run_6(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_6(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -898,7 +958,7 @@ def fixed_run_8(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -906,7 +966,7 @@ def fixed_run_8(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_l
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_8(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -927,7 +987,7 @@ def fixed_run_10(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -935,7 +995,7 @@ def fixed_run_10(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_10(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -956,7 +1016,7 @@ def fixed_run_12(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -964,7 +1024,7 @@ def fixed_run_12(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_12(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -985,7 +1045,7 @@ def fixed_run_14(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -993,7 +1053,7 @@ def fixed_run_14(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_14(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -1014,7 +1074,7 @@ def fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     while j < n_int:
         u0, u1 = amp * uval[j], amp * (uval[j + 1] - uval[j])
         th2, wh2, s_next, c_next, flag = taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf,
-                                                   False)
+                                                   np.bool_(False))
         if flag == 0:
             return 1, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
         n_low = n_low + 1 if flag == 2 else 0
@@ -1022,7 +1082,7 @@ def fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
         if lower:
             n_low = 0
         if not (wh * wh2 > 0.0 and s * th2 > 0.0 and abs(th2) < HALF_PI):
-            taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, True)  # its polynomial
+            taylor_16(u0, u1, q, theta, wh, s_phi, c_phi, eps, cf, np.bool_(True))  # its polynomial
             return 3, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, lower
         if abs(th2) > max_abs:
             max_abs = abs(th2)
@@ -1034,8 +1094,7 @@ def fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_
     return 0, j, theta, wh, s_phi, c_phi, max_abs, n_low, th2, wh2, s_next, c_next, False
 
 
-@njit(cache=True)
-def taylor_smooth_8(U, q, theta, wh, s0, c0, eps, cf):
+def _taylor_smooth_8(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1090,8 +1149,15 @@ def taylor_smooth_8(U, q, theta, wh, s0, c0, eps, cf):
     return c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_8_ir = straight(_taylor_smooth_8)
+
+
 @njit(cache=True)
-def taylor_smooth_10(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_8(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_8_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_10(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1158,8 +1224,15 @@ def taylor_smooth_10(U, q, theta, wh, s0, c0, eps, cf):
     return c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_10_ir = straight(_taylor_smooth_10)
+
+
 @njit(cache=True)
-def taylor_smooth_12(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_10(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_10_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_12(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1238,8 +1311,15 @@ def taylor_smooth_12(U, q, theta, wh, s0, c0, eps, cf):
     return c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_12_ir = straight(_taylor_smooth_12)
+
+
 @njit(cache=True)
-def taylor_smooth_14(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_12(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_12_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_14(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1330,8 +1410,15 @@ def taylor_smooth_14(U, q, theta, wh, s0, c0, eps, cf):
     return c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_14_ir = straight(_taylor_smooth_14)
+
+
 @njit(cache=True)
-def taylor_smooth_16(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_14(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_14_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_16(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1434,8 +1521,15 @@ def taylor_smooth_16(U, q, theta, wh, s0, c0, eps, cf):
     return c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_16_ir = straight(_taylor_smooth_16)
+
+
 @njit(cache=True)
-def taylor_smooth_18(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_16(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_16_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_18(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1550,8 +1644,15 @@ def taylor_smooth_18(U, q, theta, wh, s0, c0, eps, cf):
     return c_18 + c_17 + c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_18 + D_17 + D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_16 + S_15 + S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_16 + C_15 + C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_18_ir = straight(_taylor_smooth_18)
+
+
 @njit(cache=True)
-def taylor_smooth_20(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_18(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_18_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_20(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1678,8 +1779,15 @@ def taylor_smooth_20(U, q, theta, wh, s0, c0, eps, cf):
     return c_20 + c_19 + c_18 + c_17 + c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_20 + D_19 + D_18 + D_17 + D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_18 + S_17 + S_16 + S_15 + S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_18 + C_17 + C_16 + C_15 + C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_20_ir = straight(_taylor_smooth_20)
+
+
 @njit(cache=True)
-def taylor_smooth_22(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_20(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_20_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_22(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1818,8 +1926,15 @@ def taylor_smooth_22(U, q, theta, wh, s0, c0, eps, cf):
     return c_22 + c_21 + c_20 + c_19 + c_18 + c_17 + c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_22 + D_21 + D_20 + D_19 + D_18 + D_17 + D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_20 + S_19 + S_18 + S_17 + S_16 + S_15 + S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_20 + C_19 + C_18 + C_17 + C_16 + C_15 + C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_22_ir = straight(_taylor_smooth_22)
+
+
 @njit(cache=True)
-def taylor_smooth_24(U, q, theta, wh, s0, c0, eps, cf):
+def taylor_smooth_22(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_22_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
+def _taylor_smooth_24(U, q, theta, wh, s0, c0, eps, cf):
     U_0 = U[0]
     U_1 = U[1]
     U_2 = U[2]
@@ -1970,22 +2085,30 @@ def taylor_smooth_24(U, q, theta, wh, s0, c0, eps, cf):
     return c_24 + c_23 + c_22 + c_21 + c_20 + c_19 + c_18 + c_17 + c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_24 + D_23 + D_22 + D_21 + D_20 + D_19 + D_18 + D_17 + D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_22 + S_21 + S_20 + S_19 + S_18 + S_17 + S_16 + S_15 + S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_22 + C_21 + C_20 + C_19 + C_18 + C_17 + C_16 + C_15 + C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag
 
 
+_taylor_smooth_24_ir = straight(_taylor_smooth_24)
+
+
+@njit(cache=True)
+def taylor_smooth_24(U, q, theta, wh, s0, c0, eps, cf):
+    return _taylor_smooth_24_ir(U, q, theta, wh, s0, c0, eps, cf)
+
+
 @njit(cache=True, inline='always')
 def taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, cf):
-    """The step of :data:`ORDERS` order ``order`` (the highest for larger)."""
+    """The step of :data:`ORDERS` order ``order`` (the highest for larger; ``store`` passed as fixed_run_N passes it: one compiled version of each step)."""
     if order <= 4:
-        return taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf)
+        return taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
     if order <= 6:
-        return taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf)
+        return taylor_6(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
     if order <= 8:
-        return taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf)
+        return taylor_8(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
     if order <= 10:
-        return taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf)
+        return taylor_10(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
     if order <= 12:
-        return taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf)
+        return taylor_12(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
     if order <= 14:
-        return taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf)
-    return taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf)
+        return taylor_14(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
+    return taylor_16(u0, u1, q, theta, wh, s0, c0, eps, cf, np.bool_(True))
 
 
 @njit(cache=True)

@@ -11,10 +11,36 @@ keeps its sign, ``theta`` its side and stays below pi/2; elsewhere the state is 
 and ``bad`` says why (1: something happens in the step; 2: the order is too low).  Returns the
 number of lanes left (``bad`` > 0) and the number of kept lanes for which a lower order would
 have done.
+
+The arithmetic of a lane is ``_lane_N`` in plain Python, turned into LLVM instructions inside the
+loop by :func:`rocking._straight.straight` (the same operations in the same order, without numba
+typing each of its hundreds of statements).
 """
 from numba import njit
 
+from ._straight import straight
+
 ORDERS = (4, 6, 8, 10, 12, 14, 16)
+
+
+def _lane_4(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    th2 = c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_2 + S_1 + S_0, C_2 + C_1 + C_0, tol, abs(D_4), abs(D_3), abs(D_2), abs(D_1))
+
+
+_lane_4_ir = straight(_lane_4)
 
 
 @njit(cache=True)
@@ -25,41 +51,57 @@ def lanes_4(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps, 
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        th2 = c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_4), abs(D_3))
-        lo = max(abs(D_2), abs(D_1))
+        th2, om2, s1, c1, tol, a_4, a_3, a_2, a_1 = _lane_4_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_4, a_3)
+        lo = max(a_2, a_1)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b
         n_bad += b > 0
         n_low += keep & (lo <= tol)
     return n_bad, n_low
+
+
+def _lane_6(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
+    C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
+    c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
+    D_5 = 5.0 * c_5
+    S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
+    C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
+    c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
+    D_6 = 6.0 * c_6
+    th2 = c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_4 + S_3 + S_2 + S_1 + S_0, C_4 + C_3 + C_2 + C_1 + C_0, tol, abs(D_6), abs(D_5), abs(D_4), abs(D_3))
+
+
+_lane_6_ir = straight(_lane_6)
 
 
 @njit(cache=True)
@@ -70,49 +112,65 @@ def lanes_6(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps, 
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
-        C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
-        c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
-        D_5 = 5.0 * c_5
-        S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
-        C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
-        c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
-        D_6 = 6.0 * c_6
-        th2 = c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_6), abs(D_5))
-        lo = max(abs(D_4), abs(D_3))
+        th2, om2, s1, c1, tol, a_6, a_5, a_4, a_3 = _lane_6_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_6, a_5)
+        lo = max(a_4, a_3)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_4 + S_3 + S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_4 + C_3 + C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b
         n_bad += b > 0
         n_low += keep & (lo <= tol)
     return n_bad, n_low
+
+
+def _lane_8(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
+    C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
+    c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
+    D_5 = 5.0 * c_5
+    S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
+    C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
+    c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
+    D_6 = 6.0 * c_6
+    S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
+    C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
+    c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
+    D_7 = 7.0 * c_7
+    S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
+    C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
+    c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
+    D_8 = 8.0 * c_8
+    th2 = c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, tol, abs(D_8), abs(D_7), abs(D_6), abs(D_5))
+
+
+_lane_8_ir = straight(_lane_8)
 
 
 @njit(cache=True)
@@ -123,57 +181,73 @@ def lanes_8(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps, 
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
-        C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
-        c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
-        D_5 = 5.0 * c_5
-        S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
-        C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
-        c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
-        D_6 = 6.0 * c_6
-        S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
-        C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
-        c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
-        D_7 = 7.0 * c_7
-        S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
-        C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
-        c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
-        D_8 = 8.0 * c_8
-        th2 = c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_8), abs(D_7))
-        lo = max(abs(D_6), abs(D_5))
+        th2, om2, s1, c1, tol, a_8, a_7, a_6, a_5 = _lane_8_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_8, a_7)
+        lo = max(a_6, a_5)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b
         n_bad += b > 0
         n_low += keep & (lo <= tol)
     return n_bad, n_low
+
+
+def _lane_10(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
+    C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
+    c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
+    D_5 = 5.0 * c_5
+    S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
+    C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
+    c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
+    D_6 = 6.0 * c_6
+    S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
+    C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
+    c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
+    D_7 = 7.0 * c_7
+    S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
+    C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
+    c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
+    D_8 = 8.0 * c_8
+    S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
+    C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
+    c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
+    D_9 = 9.0 * c_9
+    S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
+    C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
+    c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
+    D_10 = 10.0 * c_10
+    th2 = c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, tol, abs(D_10), abs(D_9), abs(D_8), abs(D_7))
+
+
+_lane_10_ir = straight(_lane_10)
 
 
 @njit(cache=True)
@@ -184,65 +258,81 @@ def lanes_10(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps,
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
-        C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
-        c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
-        D_5 = 5.0 * c_5
-        S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
-        C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
-        c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
-        D_6 = 6.0 * c_6
-        S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
-        C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
-        c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
-        D_7 = 7.0 * c_7
-        S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
-        C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
-        c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
-        D_8 = 8.0 * c_8
-        S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
-        C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
-        c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
-        D_9 = 9.0 * c_9
-        S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
-        C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
-        c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
-        D_10 = 10.0 * c_10
-        th2 = c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_10), abs(D_9))
-        lo = max(abs(D_8), abs(D_7))
+        th2, om2, s1, c1, tol, a_10, a_9, a_8, a_7 = _lane_10_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_10, a_9)
+        lo = max(a_8, a_7)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b
         n_bad += b > 0
         n_low += keep & (lo <= tol)
     return n_bad, n_low
+
+
+def _lane_12(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
+    C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
+    c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
+    D_5 = 5.0 * c_5
+    S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
+    C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
+    c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
+    D_6 = 6.0 * c_6
+    S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
+    C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
+    c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
+    D_7 = 7.0 * c_7
+    S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
+    C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
+    c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
+    D_8 = 8.0 * c_8
+    S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
+    C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
+    c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
+    D_9 = 9.0 * c_9
+    S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
+    C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
+    c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
+    D_10 = 10.0 * c_10
+    S_9 = -(D_4 * C_5 + D_5 * C_4 + D_3 * C_6 + D_6 * C_3 + D_2 * C_7 + D_7 * C_2 + D_1 * C_8 + D_8 * C_1 + D_9 * C_0) * 0.1111111111111111
+    C_9 = (D_4 * S_5 + D_5 * S_4 + D_3 * S_6 + D_6 * S_3 + D_2 * S_7 + D_7 * S_2 + D_1 * S_8 + D_8 * S_1 + D_9 * S_0) * 0.1111111111111111
+    c_11 = -qi * (S_9 + u0 * C_9 + u1 * C_8) * 0.00909090909090909
+    D_11 = 11.0 * c_11
+    S_10 = -(D_5 * C_5 + D_4 * C_6 + D_6 * C_4 + D_3 * C_7 + D_7 * C_3 + D_2 * C_8 + D_8 * C_2 + D_1 * C_9 + D_9 * C_1 + D_10 * C_0) * 0.1
+    C_10 = (D_5 * S_5 + D_4 * S_6 + D_6 * S_4 + D_3 * S_7 + D_7 * S_3 + D_2 * S_8 + D_8 * S_2 + D_1 * S_9 + D_9 * S_1 + D_10 * S_0) * 0.1
+    c_12 = -qi * (S_10 + u0 * C_10 + u1 * C_9) * 0.007575757575757576
+    D_12 = 12.0 * c_12
+    th2 = c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, tol, abs(D_12), abs(D_11), abs(D_10), abs(D_9))
+
+
+_lane_12_ir = straight(_lane_12)
 
 
 @njit(cache=True)
@@ -253,73 +343,89 @@ def lanes_12(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps,
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
-        C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
-        c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
-        D_5 = 5.0 * c_5
-        S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
-        C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
-        c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
-        D_6 = 6.0 * c_6
-        S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
-        C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
-        c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
-        D_7 = 7.0 * c_7
-        S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
-        C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
-        c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
-        D_8 = 8.0 * c_8
-        S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
-        C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
-        c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
-        D_9 = 9.0 * c_9
-        S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
-        C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
-        c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
-        D_10 = 10.0 * c_10
-        S_9 = -(D_4 * C_5 + D_5 * C_4 + D_3 * C_6 + D_6 * C_3 + D_2 * C_7 + D_7 * C_2 + D_1 * C_8 + D_8 * C_1 + D_9 * C_0) * 0.1111111111111111
-        C_9 = (D_4 * S_5 + D_5 * S_4 + D_3 * S_6 + D_6 * S_3 + D_2 * S_7 + D_7 * S_2 + D_1 * S_8 + D_8 * S_1 + D_9 * S_0) * 0.1111111111111111
-        c_11 = -qi * (S_9 + u0 * C_9 + u1 * C_8) * 0.00909090909090909
-        D_11 = 11.0 * c_11
-        S_10 = -(D_5 * C_5 + D_4 * C_6 + D_6 * C_4 + D_3 * C_7 + D_7 * C_3 + D_2 * C_8 + D_8 * C_2 + D_1 * C_9 + D_9 * C_1 + D_10 * C_0) * 0.1
-        C_10 = (D_5 * S_5 + D_4 * S_6 + D_6 * S_4 + D_3 * S_7 + D_7 * S_3 + D_2 * S_8 + D_8 * S_2 + D_1 * S_9 + D_9 * S_1 + D_10 * S_0) * 0.1
-        c_12 = -qi * (S_10 + u0 * C_10 + u1 * C_9) * 0.007575757575757576
-        D_12 = 12.0 * c_12
-        th2 = c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_12), abs(D_11))
-        lo = max(abs(D_10), abs(D_9))
+        th2, om2, s1, c1, tol, a_12, a_11, a_10, a_9 = _lane_12_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_12, a_11)
+        lo = max(a_10, a_9)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b
         n_bad += b > 0
         n_low += keep & (lo <= tol)
     return n_bad, n_low
+
+
+def _lane_14(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
+    C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
+    c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
+    D_5 = 5.0 * c_5
+    S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
+    C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
+    c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
+    D_6 = 6.0 * c_6
+    S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
+    C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
+    c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
+    D_7 = 7.0 * c_7
+    S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
+    C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
+    c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
+    D_8 = 8.0 * c_8
+    S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
+    C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
+    c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
+    D_9 = 9.0 * c_9
+    S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
+    C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
+    c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
+    D_10 = 10.0 * c_10
+    S_9 = -(D_4 * C_5 + D_5 * C_4 + D_3 * C_6 + D_6 * C_3 + D_2 * C_7 + D_7 * C_2 + D_1 * C_8 + D_8 * C_1 + D_9 * C_0) * 0.1111111111111111
+    C_9 = (D_4 * S_5 + D_5 * S_4 + D_3 * S_6 + D_6 * S_3 + D_2 * S_7 + D_7 * S_2 + D_1 * S_8 + D_8 * S_1 + D_9 * S_0) * 0.1111111111111111
+    c_11 = -qi * (S_9 + u0 * C_9 + u1 * C_8) * 0.00909090909090909
+    D_11 = 11.0 * c_11
+    S_10 = -(D_5 * C_5 + D_4 * C_6 + D_6 * C_4 + D_3 * C_7 + D_7 * C_3 + D_2 * C_8 + D_8 * C_2 + D_1 * C_9 + D_9 * C_1 + D_10 * C_0) * 0.1
+    C_10 = (D_5 * S_5 + D_4 * S_6 + D_6 * S_4 + D_3 * S_7 + D_7 * S_3 + D_2 * S_8 + D_8 * S_2 + D_1 * S_9 + D_9 * S_1 + D_10 * S_0) * 0.1
+    c_12 = -qi * (S_10 + u0 * C_10 + u1 * C_9) * 0.007575757575757576
+    D_12 = 12.0 * c_12
+    S_11 = -(D_5 * C_6 + D_6 * C_5 + D_4 * C_7 + D_7 * C_4 + D_3 * C_8 + D_8 * C_3 + D_2 * C_9 + D_9 * C_2 + D_1 * C_10 + D_10 * C_1 + D_11 * C_0) * 0.09090909090909091
+    C_11 = (D_5 * S_6 + D_6 * S_5 + D_4 * S_7 + D_7 * S_4 + D_3 * S_8 + D_8 * S_3 + D_2 * S_9 + D_9 * S_2 + D_1 * S_10 + D_10 * S_1 + D_11 * S_0) * 0.09090909090909091
+    c_13 = -qi * (S_11 + u0 * C_11 + u1 * C_10) * 0.00641025641025641
+    D_13 = 13.0 * c_13
+    S_12 = -(D_6 * C_6 + D_5 * C_7 + D_7 * C_5 + D_4 * C_8 + D_8 * C_4 + D_3 * C_9 + D_9 * C_3 + D_2 * C_10 + D_10 * C_2 + D_1 * C_11 + D_11 * C_1 + D_12 * C_0) * 0.08333333333333333
+    C_12 = (D_6 * S_6 + D_5 * S_7 + D_7 * S_5 + D_4 * S_8 + D_8 * S_4 + D_3 * S_9 + D_9 * S_3 + D_2 * S_10 + D_10 * S_2 + D_1 * S_11 + D_11 * S_1 + D_12 * S_0) * 0.08333333333333333
+    c_14 = -qi * (S_12 + u0 * C_12 + u1 * C_11) * 0.005494505494505495
+    D_14 = 14.0 * c_14
+    th2 = c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, tol, abs(D_14), abs(D_13), abs(D_12), abs(D_11))
+
+
+_lane_14_ir = straight(_lane_14)
 
 
 @njit(cache=True)
@@ -330,81 +436,97 @@ def lanes_14(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps,
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
-        C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
-        c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
-        D_5 = 5.0 * c_5
-        S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
-        C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
-        c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
-        D_6 = 6.0 * c_6
-        S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
-        C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
-        c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
-        D_7 = 7.0 * c_7
-        S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
-        C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
-        c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
-        D_8 = 8.0 * c_8
-        S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
-        C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
-        c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
-        D_9 = 9.0 * c_9
-        S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
-        C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
-        c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
-        D_10 = 10.0 * c_10
-        S_9 = -(D_4 * C_5 + D_5 * C_4 + D_3 * C_6 + D_6 * C_3 + D_2 * C_7 + D_7 * C_2 + D_1 * C_8 + D_8 * C_1 + D_9 * C_0) * 0.1111111111111111
-        C_9 = (D_4 * S_5 + D_5 * S_4 + D_3 * S_6 + D_6 * S_3 + D_2 * S_7 + D_7 * S_2 + D_1 * S_8 + D_8 * S_1 + D_9 * S_0) * 0.1111111111111111
-        c_11 = -qi * (S_9 + u0 * C_9 + u1 * C_8) * 0.00909090909090909
-        D_11 = 11.0 * c_11
-        S_10 = -(D_5 * C_5 + D_4 * C_6 + D_6 * C_4 + D_3 * C_7 + D_7 * C_3 + D_2 * C_8 + D_8 * C_2 + D_1 * C_9 + D_9 * C_1 + D_10 * C_0) * 0.1
-        C_10 = (D_5 * S_5 + D_4 * S_6 + D_6 * S_4 + D_3 * S_7 + D_7 * S_3 + D_2 * S_8 + D_8 * S_2 + D_1 * S_9 + D_9 * S_1 + D_10 * S_0) * 0.1
-        c_12 = -qi * (S_10 + u0 * C_10 + u1 * C_9) * 0.007575757575757576
-        D_12 = 12.0 * c_12
-        S_11 = -(D_5 * C_6 + D_6 * C_5 + D_4 * C_7 + D_7 * C_4 + D_3 * C_8 + D_8 * C_3 + D_2 * C_9 + D_9 * C_2 + D_1 * C_10 + D_10 * C_1 + D_11 * C_0) * 0.09090909090909091
-        C_11 = (D_5 * S_6 + D_6 * S_5 + D_4 * S_7 + D_7 * S_4 + D_3 * S_8 + D_8 * S_3 + D_2 * S_9 + D_9 * S_2 + D_1 * S_10 + D_10 * S_1 + D_11 * S_0) * 0.09090909090909091
-        c_13 = -qi * (S_11 + u0 * C_11 + u1 * C_10) * 0.00641025641025641
-        D_13 = 13.0 * c_13
-        S_12 = -(D_6 * C_6 + D_5 * C_7 + D_7 * C_5 + D_4 * C_8 + D_8 * C_4 + D_3 * C_9 + D_9 * C_3 + D_2 * C_10 + D_10 * C_2 + D_1 * C_11 + D_11 * C_1 + D_12 * C_0) * 0.08333333333333333
-        C_12 = (D_6 * S_6 + D_5 * S_7 + D_7 * S_5 + D_4 * S_8 + D_8 * S_4 + D_3 * S_9 + D_9 * S_3 + D_2 * S_10 + D_10 * S_2 + D_1 * S_11 + D_11 * S_1 + D_12 * S_0) * 0.08333333333333333
-        c_14 = -qi * (S_12 + u0 * C_12 + u1 * C_11) * 0.005494505494505495
-        D_14 = 14.0 * c_14
-        th2 = c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_14), abs(D_13))
-        lo = max(abs(D_12), abs(D_11))
+        th2, om2, s1, c1, tol, a_14, a_13, a_12, a_11 = _lane_14_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_14, a_13)
+        lo = max(a_12, a_11)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b
         n_bad += b > 0
         n_low += keep & (lo <= tol)
     return n_bad, n_low
+
+
+def _lane_16(u0, u1, qi, th, D_1, S_0, C_0, eps, inv_h):
+    c_2 = -0.5 * qi * (S_0 + u0 * C_0)
+    D_2 = 2.0 * c_2
+    S_1 = -(D_1 * C_0) * 1.0
+    C_1 = (D_1 * S_0) * 1.0
+    c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
+    D_3 = 3.0 * c_3
+    S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
+    C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
+    c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
+    D_4 = 4.0 * c_4
+    S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
+    C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
+    c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
+    D_5 = 5.0 * c_5
+    S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
+    C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
+    c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
+    D_6 = 6.0 * c_6
+    S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
+    C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
+    c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
+    D_7 = 7.0 * c_7
+    S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
+    C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
+    c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
+    D_8 = 8.0 * c_8
+    S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
+    C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
+    c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
+    D_9 = 9.0 * c_9
+    S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
+    C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
+    c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
+    D_10 = 10.0 * c_10
+    S_9 = -(D_4 * C_5 + D_5 * C_4 + D_3 * C_6 + D_6 * C_3 + D_2 * C_7 + D_7 * C_2 + D_1 * C_8 + D_8 * C_1 + D_9 * C_0) * 0.1111111111111111
+    C_9 = (D_4 * S_5 + D_5 * S_4 + D_3 * S_6 + D_6 * S_3 + D_2 * S_7 + D_7 * S_2 + D_1 * S_8 + D_8 * S_1 + D_9 * S_0) * 0.1111111111111111
+    c_11 = -qi * (S_9 + u0 * C_9 + u1 * C_8) * 0.00909090909090909
+    D_11 = 11.0 * c_11
+    S_10 = -(D_5 * C_5 + D_4 * C_6 + D_6 * C_4 + D_3 * C_7 + D_7 * C_3 + D_2 * C_8 + D_8 * C_2 + D_1 * C_9 + D_9 * C_1 + D_10 * C_0) * 0.1
+    C_10 = (D_5 * S_5 + D_4 * S_6 + D_6 * S_4 + D_3 * S_7 + D_7 * S_3 + D_2 * S_8 + D_8 * S_2 + D_1 * S_9 + D_9 * S_1 + D_10 * S_0) * 0.1
+    c_12 = -qi * (S_10 + u0 * C_10 + u1 * C_9) * 0.007575757575757576
+    D_12 = 12.0 * c_12
+    S_11 = -(D_5 * C_6 + D_6 * C_5 + D_4 * C_7 + D_7 * C_4 + D_3 * C_8 + D_8 * C_3 + D_2 * C_9 + D_9 * C_2 + D_1 * C_10 + D_10 * C_1 + D_11 * C_0) * 0.09090909090909091
+    C_11 = (D_5 * S_6 + D_6 * S_5 + D_4 * S_7 + D_7 * S_4 + D_3 * S_8 + D_8 * S_3 + D_2 * S_9 + D_9 * S_2 + D_1 * S_10 + D_10 * S_1 + D_11 * S_0) * 0.09090909090909091
+    c_13 = -qi * (S_11 + u0 * C_11 + u1 * C_10) * 0.00641025641025641
+    D_13 = 13.0 * c_13
+    S_12 = -(D_6 * C_6 + D_5 * C_7 + D_7 * C_5 + D_4 * C_8 + D_8 * C_4 + D_3 * C_9 + D_9 * C_3 + D_2 * C_10 + D_10 * C_2 + D_1 * C_11 + D_11 * C_1 + D_12 * C_0) * 0.08333333333333333
+    C_12 = (D_6 * S_6 + D_5 * S_7 + D_7 * S_5 + D_4 * S_8 + D_8 * S_4 + D_3 * S_9 + D_9 * S_3 + D_2 * S_10 + D_10 * S_2 + D_1 * S_11 + D_11 * S_1 + D_12 * S_0) * 0.08333333333333333
+    c_14 = -qi * (S_12 + u0 * C_12 + u1 * C_11) * 0.005494505494505495
+    D_14 = 14.0 * c_14
+    S_13 = -(D_6 * C_7 + D_7 * C_6 + D_5 * C_8 + D_8 * C_5 + D_4 * C_9 + D_9 * C_4 + D_3 * C_10 + D_10 * C_3 + D_2 * C_11 + D_11 * C_2 + D_1 * C_12 + D_12 * C_1 + D_13 * C_0) * 0.07692307692307693
+    C_13 = (D_6 * S_7 + D_7 * S_6 + D_5 * S_8 + D_8 * S_5 + D_4 * S_9 + D_9 * S_4 + D_3 * S_10 + D_10 * S_3 + D_2 * S_11 + D_11 * S_2 + D_1 * S_12 + D_12 * S_1 + D_13 * S_0) * 0.07692307692307693
+    c_15 = -qi * (S_13 + u0 * C_13 + u1 * C_12) * 0.004761904761904762
+    D_15 = 15.0 * c_15
+    S_14 = -(D_7 * C_7 + D_6 * C_8 + D_8 * C_6 + D_5 * C_9 + D_9 * C_5 + D_4 * C_10 + D_10 * C_4 + D_3 * C_11 + D_11 * C_3 + D_2 * C_12 + D_12 * C_2 + D_1 * C_13 + D_13 * C_1 + D_14 * C_0) * 0.07142857142857142
+    C_14 = (D_7 * S_7 + D_6 * S_8 + D_8 * S_6 + D_5 * S_9 + D_9 * S_5 + D_4 * S_10 + D_10 * S_4 + D_3 * S_11 + D_11 * S_3 + D_2 * S_12 + D_12 * S_2 + D_1 * S_13 + D_13 * S_1 + D_14 * S_0) * 0.07142857142857142
+    c_16 = -qi * (S_14 + u0 * C_14 + u1 * C_13) * 0.004166666666666667
+    D_16 = 16.0 * c_16
+    th2 = c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
+    om2 = (D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
+    tol = eps * (abs(th) + abs(D_1) + abs(c_2))
+    return (th2, om2, S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, tol, abs(D_16), abs(D_15), abs(D_14), abs(D_13))
+
+
+_lane_16_ir = straight(_lane_16)
 
 
 @njit(cache=True)
@@ -415,83 +537,23 @@ def lanes_16(n, uj, duj, amp, q, h, theta, omega, side, s_phi, c_phi, peak, eps,
     for i in range(n):
         u0 = amp[i] * uj
         u1 = amp[i] * duj
-        qi = q[i]
         th = theta[i]
         om = omega[i]
         S_0 = s_phi[i]
         C_0 = c_phi[i]
         D_1 = om * h
-        c_2 = -0.5 * qi * (S_0 + u0 * C_0)
-        D_2 = 2.0 * c_2
-        S_1 = -(D_1 * C_0) * 1.0
-        C_1 = (D_1 * S_0) * 1.0
-        c_3 = -qi * (S_1 + u0 * C_1 + u1 * C_0) * 0.16666666666666666
-        D_3 = 3.0 * c_3
-        S_2 = -(D_1 * C_1 + D_2 * C_0) * 0.5
-        C_2 = (D_1 * S_1 + D_2 * S_0) * 0.5
-        c_4 = -qi * (S_2 + u0 * C_2 + u1 * C_1) * 0.08333333333333333
-        D_4 = 4.0 * c_4
-        S_3 = -(D_1 * C_2 + D_2 * C_1 + D_3 * C_0) * 0.3333333333333333
-        C_3 = (D_1 * S_2 + D_2 * S_1 + D_3 * S_0) * 0.3333333333333333
-        c_5 = -qi * (S_3 + u0 * C_3 + u1 * C_2) * 0.05
-        D_5 = 5.0 * c_5
-        S_4 = -(D_2 * C_2 + D_1 * C_3 + D_3 * C_1 + D_4 * C_0) * 0.25
-        C_4 = (D_2 * S_2 + D_1 * S_3 + D_3 * S_1 + D_4 * S_0) * 0.25
-        c_6 = -qi * (S_4 + u0 * C_4 + u1 * C_3) * 0.03333333333333333
-        D_6 = 6.0 * c_6
-        S_5 = -(D_2 * C_3 + D_3 * C_2 + D_1 * C_4 + D_4 * C_1 + D_5 * C_0) * 0.2
-        C_5 = (D_2 * S_3 + D_3 * S_2 + D_1 * S_4 + D_4 * S_1 + D_5 * S_0) * 0.2
-        c_7 = -qi * (S_5 + u0 * C_5 + u1 * C_4) * 0.023809523809523808
-        D_7 = 7.0 * c_7
-        S_6 = -(D_3 * C_3 + D_2 * C_4 + D_4 * C_2 + D_1 * C_5 + D_5 * C_1 + D_6 * C_0) * 0.16666666666666666
-        C_6 = (D_3 * S_3 + D_2 * S_4 + D_4 * S_2 + D_1 * S_5 + D_5 * S_1 + D_6 * S_0) * 0.16666666666666666
-        c_8 = -qi * (S_6 + u0 * C_6 + u1 * C_5) * 0.017857142857142856
-        D_8 = 8.0 * c_8
-        S_7 = -(D_3 * C_4 + D_4 * C_3 + D_2 * C_5 + D_5 * C_2 + D_1 * C_6 + D_6 * C_1 + D_7 * C_0) * 0.14285714285714285
-        C_7 = (D_3 * S_4 + D_4 * S_3 + D_2 * S_5 + D_5 * S_2 + D_1 * S_6 + D_6 * S_1 + D_7 * S_0) * 0.14285714285714285
-        c_9 = -qi * (S_7 + u0 * C_7 + u1 * C_6) * 0.013888888888888888
-        D_9 = 9.0 * c_9
-        S_8 = -(D_4 * C_4 + D_3 * C_5 + D_5 * C_3 + D_2 * C_6 + D_6 * C_2 + D_1 * C_7 + D_7 * C_1 + D_8 * C_0) * 0.125
-        C_8 = (D_4 * S_4 + D_3 * S_5 + D_5 * S_3 + D_2 * S_6 + D_6 * S_2 + D_1 * S_7 + D_7 * S_1 + D_8 * S_0) * 0.125
-        c_10 = -qi * (S_8 + u0 * C_8 + u1 * C_7) * 0.011111111111111112
-        D_10 = 10.0 * c_10
-        S_9 = -(D_4 * C_5 + D_5 * C_4 + D_3 * C_6 + D_6 * C_3 + D_2 * C_7 + D_7 * C_2 + D_1 * C_8 + D_8 * C_1 + D_9 * C_0) * 0.1111111111111111
-        C_9 = (D_4 * S_5 + D_5 * S_4 + D_3 * S_6 + D_6 * S_3 + D_2 * S_7 + D_7 * S_2 + D_1 * S_8 + D_8 * S_1 + D_9 * S_0) * 0.1111111111111111
-        c_11 = -qi * (S_9 + u0 * C_9 + u1 * C_8) * 0.00909090909090909
-        D_11 = 11.0 * c_11
-        S_10 = -(D_5 * C_5 + D_4 * C_6 + D_6 * C_4 + D_3 * C_7 + D_7 * C_3 + D_2 * C_8 + D_8 * C_2 + D_1 * C_9 + D_9 * C_1 + D_10 * C_0) * 0.1
-        C_10 = (D_5 * S_5 + D_4 * S_6 + D_6 * S_4 + D_3 * S_7 + D_7 * S_3 + D_2 * S_8 + D_8 * S_2 + D_1 * S_9 + D_9 * S_1 + D_10 * S_0) * 0.1
-        c_12 = -qi * (S_10 + u0 * C_10 + u1 * C_9) * 0.007575757575757576
-        D_12 = 12.0 * c_12
-        S_11 = -(D_5 * C_6 + D_6 * C_5 + D_4 * C_7 + D_7 * C_4 + D_3 * C_8 + D_8 * C_3 + D_2 * C_9 + D_9 * C_2 + D_1 * C_10 + D_10 * C_1 + D_11 * C_0) * 0.09090909090909091
-        C_11 = (D_5 * S_6 + D_6 * S_5 + D_4 * S_7 + D_7 * S_4 + D_3 * S_8 + D_8 * S_3 + D_2 * S_9 + D_9 * S_2 + D_1 * S_10 + D_10 * S_1 + D_11 * S_0) * 0.09090909090909091
-        c_13 = -qi * (S_11 + u0 * C_11 + u1 * C_10) * 0.00641025641025641
-        D_13 = 13.0 * c_13
-        S_12 = -(D_6 * C_6 + D_5 * C_7 + D_7 * C_5 + D_4 * C_8 + D_8 * C_4 + D_3 * C_9 + D_9 * C_3 + D_2 * C_10 + D_10 * C_2 + D_1 * C_11 + D_11 * C_1 + D_12 * C_0) * 0.08333333333333333
-        C_12 = (D_6 * S_6 + D_5 * S_7 + D_7 * S_5 + D_4 * S_8 + D_8 * S_4 + D_3 * S_9 + D_9 * S_3 + D_2 * S_10 + D_10 * S_2 + D_1 * S_11 + D_11 * S_1 + D_12 * S_0) * 0.08333333333333333
-        c_14 = -qi * (S_12 + u0 * C_12 + u1 * C_11) * 0.005494505494505495
-        D_14 = 14.0 * c_14
-        S_13 = -(D_6 * C_7 + D_7 * C_6 + D_5 * C_8 + D_8 * C_5 + D_4 * C_9 + D_9 * C_4 + D_3 * C_10 + D_10 * C_3 + D_2 * C_11 + D_11 * C_2 + D_1 * C_12 + D_12 * C_1 + D_13 * C_0) * 0.07692307692307693
-        C_13 = (D_6 * S_7 + D_7 * S_6 + D_5 * S_8 + D_8 * S_5 + D_4 * S_9 + D_9 * S_4 + D_3 * S_10 + D_10 * S_3 + D_2 * S_11 + D_11 * S_2 + D_1 * S_12 + D_12 * S_1 + D_13 * S_0) * 0.07692307692307693
-        c_15 = -qi * (S_13 + u0 * C_13 + u1 * C_12) * 0.004761904761904762
-        D_15 = 15.0 * c_15
-        S_14 = -(D_7 * C_7 + D_6 * C_8 + D_8 * C_6 + D_5 * C_9 + D_9 * C_5 + D_4 * C_10 + D_10 * C_4 + D_3 * C_11 + D_11 * C_3 + D_2 * C_12 + D_12 * C_2 + D_1 * C_13 + D_13 * C_1 + D_14 * C_0) * 0.07142857142857142
-        C_14 = (D_7 * S_7 + D_6 * S_8 + D_8 * S_6 + D_5 * S_9 + D_9 * S_5 + D_4 * S_10 + D_10 * S_4 + D_3 * S_11 + D_11 * S_3 + D_2 * S_12 + D_12 * S_2 + D_1 * S_13 + D_13 * S_1 + D_14 * S_0) * 0.07142857142857142
-        c_16 = -qi * (S_14 + u0 * C_14 + u1 * C_13) * 0.004166666666666667
-        D_16 = 16.0 * c_16
-        th2 = c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + D_1 + th
-        om2 = (D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1) * inv_h
-        tol = eps * (abs(th) + abs(D_1) + abs(c_2))
-        hi = max(abs(D_16), abs(D_15))
-        lo = max(abs(D_14), abs(D_13))
+        th2, om2, s1, c1, tol, a_16, a_15, a_14, a_13 = _lane_16_ir(
+            u0, u1, q[i], th, D_1, S_0, C_0, eps, inv_h)
+        hi = max(a_16, a_15)
+        lo = max(a_14, a_13)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (side[i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
         # branch-free selects (they vectorise): the new state where kept
         theta[i] = th2 if keep else th
         omega[i] = om2 if keep else om
-        s_phi[i] = (S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0) if keep else S_0
-        c_phi[i] = (C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0) if keep else C_0
+        s_phi[i] = s1 if keep else S_0
+        c_phi[i] = c1 if keep else C_0
         peak[i] = max(peak[i], abs(th2)) if keep else peak[i]
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         bad[i] = b

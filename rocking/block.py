@@ -17,7 +17,7 @@ def eta_housner(alpha: float) -> float:
 
     Clipped at 0 beyond ``alpha = 54.7 deg`` (no rocking, the impact is perfectly plastic).
     """
-    return max(0.0, 1.0 - 1.5 * math.sin(alpha) ** 2)
+    return eta_frame(alpha, 0.0)  # the frame's formula at gamma = 0: one place for Eq. 5
 
 
 @dataclass(frozen=True)

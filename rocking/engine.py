@@ -35,17 +35,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
-from scipy.integrate._ivp import dop853_coefficients as _dop853
+from numba import njit
 
 from ._taylor_fixed import ORDERS as FIXED_ORDERS
+from . import _dop853
+from ._compiling import compiling_notice, first_call_done
 from ._taylor_fixed import SMOOTH_ORDERS, fixed_run, taylor_fixed, taylor_smooth
 
-#: Butcher tableau of the 8th-order Dormand-Prince formula (the 12 stages of DOP853)
+#: Butcher tableau of the 8th-order Dormand-Prince formula (the 12 stages of DOP853; source
+#: named in :mod:`rocking._dop853`)
 N_STAGES = _dop853.N_STAGES
-RK8_A = np.ascontiguousarray(_dop853.A[:N_STAGES, :N_STAGES])
-RK8_B = np.ascontiguousarray(_dop853.B[:N_STAGES])
-RK8_C = np.ascontiguousarray(_dop853.C[:N_STAGES])
+RK8_A = np.ascontiguousarray(_dop853.A)
+RK8_B = np.ascontiguousarray(_dop853.B)
+RK8_C = np.ascontiguousarray(_dop853.C)
 
 HALF_PI = 0.5 * math.pi
 TWO_PI = 2.0 * math.pi
@@ -57,6 +59,9 @@ BETA = abs((3.0 - math.sqrt(6.0) - 3.0) * math.sqrt(3.0 - math.sqrt(6.0))
 FREE = -1
 NODAL = 0  # piecewise linear between node values (records; sampled pulses for the linear model)
 RECT, SINE, RICKER_SYM, RICKER_ANTI = 1, 2, 3, 4
+#: the forcing kinds the engine computes, with their names
+KINDS = {FREE: "free", NODAL: "nodal", RECT: "rect", SINE: "sine", RICKER_SYM: "ricker-sym",
+         RICKER_ANTI: "ricker-anti"}
 
 # stepping methods of the nonlinear equation
 TAYLOR, RK8, RK4 = 0, 1, 2
@@ -104,7 +109,7 @@ def abs_max(a):
     return max(max(m0, m1), max(m2, m3))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def forcing(kind, amp, tp, t0, uval, j, ta, tb, t):
     """Ground acceleration over g at time ``t`` inside interval ``j`` = ``[ta, tb]``.
 
@@ -122,8 +127,10 @@ def forcing(kind, amp, tp, t0, uval, j, ta, tb, t):
     if kind == RICKER_SYM:
         x2 = (math.pi * tau) ** 2
         return amp * (1.0 - 2.0 * x2) * math.exp(-x2)
-    x = TWO_PI * tau / SQRT3
-    return amp * (x * x - 3.0) * x * math.exp(-0.5 * x * x) / BETA
+    if kind == RICKER_ANTI:
+        x = TWO_PI * tau / SQRT3
+        return amp * (x * x - 3.0) * x * math.exp(-0.5 * x * x) / BETA
+    return math.nan  # no other kind reaches here (check_kind), and none is guessed
 
 
 # --------------------------------------------------------------------------- steppers
@@ -186,7 +193,7 @@ def step(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p, sa, ca, l
             omega + h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # one call site
 def _step_rk8(kind, amp, tp, t0, uval, j, ta, tb, t, h, theta, omega, s, p2, sa, ca, kt, kw):
     """One fixed step of the 8th-order Dormand-Prince formula (DOP853's 12 stages).
 
@@ -383,7 +390,7 @@ def _stationary(c1, c2, c3):
     return r1, r2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _first_crossing(c0, c1, c2, c3, s, level):
     """First x in (0, 1] where ``s*H(x) - level`` turns non-positive, given it starts >= 0.
 
@@ -487,7 +494,7 @@ def _below(cf, n, level):
     return 1.01 * b < level
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _step_peak(kind, amp, tp, t0, uval, j, ta, tb, t, h, th_a, om_a, th_b, om_b,
                s, p, sa, ca, linear, method, kt, kw, h_step, cf, n):
     """Largest ``|theta|`` at a turning point strictly inside ``[t, t + h]`` (0 if none).
@@ -598,7 +605,7 @@ def _uplift_time(kind, amp, tp, t0, uval, j, ta, tb, t, t2, tan_a):
     return hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _unrolled_step(fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q, theta, wh, s_phi,
                    c_phi, cf):
     """One unrolled Taylor step of ``order`` (:mod:`rocking._taylor_fixed`): forcing linear over
@@ -610,7 +617,7 @@ def _unrolled_step(fixed, order, kind, amp, tp, t0, uval, j, ta, tb, t, h, U, q,
     return taylor_smooth(order, U, q, theta, wh, s_phi, c_phi, TAYLOR_EPS, cf)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omega, s, sa, ca, p2,
             max_abs, sc_known, s_phi, c_phi, order, n_low, cf, record, hist_t, hist_theta,
             hist_omega, n_hist):
@@ -702,39 +709,7 @@ def _cruise(kind, amp, uval, nodes, t_start, h_uniform, j, n_int, t, theta, omeg
             pending, th2, om2, s_next, c_next, n_used)
 
 
-@njit(cache=True)
-def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
-        p, alpha, eta, theta0, omega0, linear, zeno_tol, stop_at_rest,
-        hist_t, hist_theta, hist_omega, impacts, record, method=TAYLOR):
-    """Integrate the rocking block over ``n_int`` intervals of the grid.
-
-    Parameters
-    ----------
-    kind, amp, tp, t0, uval : forcing (see :func:`forcing`); ``uval`` holds node values of
-        ``ug''/g`` for ``kind == NODAL``.
-    nodes : float array; when empty the grid is uniform, ``t_start + j * h_uniform``.
-    n_int, n_sub : number of intervals, and RK4 (or exact) sub-steps per interval.
-    p, alpha, eta : block (rad/s, rad, -).
-    theta0, omega0 : initial state (rad, rad/s).
-    linear : use the linearised equation (exact stepping) instead of the nonlinear one.
-    method : nonlinear stepping: ``TAYLOR`` (default), ``RK8`` or ``RK4``.
-    zeno_tol : Zeno sequences are summed once ``|omega| < zeno_tol * p * alpha``.
-    stop_at_rest : stop as soon as the block is at rest (free motion only).
-    hist_t, hist_theta, hist_omega : output arrays of length ``n_int + 1`` (when ``record``).
-    impacts : output array of impact times; impacts beyond its length are counted only.
-
-    Returns
-    -------
-    status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted
-    """
-    work = np.zeros(WORK_SIZE)
-    out = run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, 0, n_int, n_sub, p, alpha,
-                   eta, theta0, omega0, -np.inf, linear, zeno_tol, stop_at_rest, hist_t,
-                   hist_theta, hist_omega, impacts, record, method, work)
-    return out[0], out[1], out[2], out[3], out[4], out[5], out[6], out[7]
-
-
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_sub, p, alpha,
              eta, theta0, omega0, rest_until0, linear, zeno_tol, stop_at_rest, hist_t, hist_theta,
              hist_omega, impacts, record, method, work):
@@ -762,10 +737,12 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
     fixed = method == TAYLOR and not linear and (kind == NODAL or kind == RECT or kind == FREE)
     # smooth pulses: the same with the forcing's own series (unrolled up to SMOOTH_ORDERS[-1])
     unrolled = method == TAYLOR and not linear
+    # (constants passed on to compiled functions as np.int64: a bare constant is typed as a
+    # literal, and numba would compile the callee once more for it)
     if fixed:
-        lowest, highest, order = FIXED_ORDERS[0], FIXED_ORDERS[-1], FIXED_ORDERS[2]
+        lowest, highest, order = FIXED_ORDERS[0], FIXED_ORDERS[-1], np.int64(FIXED_ORDERS[2])
     else:
-        lowest, highest, order = SMOOTH_ORDERS[0], SMOOTH_ORDERS[-1], SMOOTH_ORDERS[2]
+        lowest, highest, order = SMOOTH_ORDERS[0], SMOOTH_ORDERS[-1], np.int64(SMOOTH_ORDERS[2])
     low_run = LOW_RUN_FIXED if fixed else 16  # steps in a row a lower order must have sufficed
     n_low = 0
     n_general = FIXED_ORDERS[-1]  # order of the last step of the general Taylor loop
@@ -1018,62 +995,60 @@ def run_core(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, j0, n_end, n_su
     return status, theta, omega, t, max_abs, n_imp, n_hist, uplifted, rest_until
 
 
-@njit(cache=True)
-def _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
-             linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted):
-    """Run ``i`` of a batch (no history), then the energy rule; results written at index ``i``."""
-    empty = np.zeros(0)
-    st, th, om, te, mx, ni, nh, up = run(
-        kind, amp[i], tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub[i],
-        p[i], alpha[i], eta[i], 0.0, 0.0, linear, zeno_tol, False,
-        empty, empty, empty, empty, False, method)
-    if st == OVERTURNED:
-        over = True
-    elif st == ROCKING:
-        over, peak = energy_verdict(th, om, p[i], alpha[i], eta[i], linear)
-        if peak > mx:
-            mx = peak
-    else:
-        over = False
-    overturned[i] = over
-    max_abs[i] = HALF_PI if over else mx
-    n_impacts[i] = ni
-    uplifted[i] = up
+def run(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub,
+        p, alpha, eta, theta0, omega0, linear, zeno_tol, stop_at_rest,
+        hist_t, hist_theta, hist_omega, impacts, record, method=TAYLOR, j0=0,
+        rest_until0=-math.inf):
+    """Integrate the rocking block over ``n_int`` intervals of the grid.
 
+    Parameters
+    ----------
+    kind, amp, tp, t0, uval : forcing (see :func:`forcing`); ``uval`` holds node values of
+        ``ug''/g`` for ``kind == NODAL``.
+    nodes : float array; when empty the grid is uniform, ``t_start + j * h_uniform``.
+    n_int, n_sub : number of intervals, and RK4 (or exact) sub-steps per interval.
+    p, alpha, eta : block (rad/s, rad, -).
+    theta0, omega0 : initial state (rad, rad/s).
+    linear : use the linearised equation (exact stepping) instead of the nonlinear one.
+    method : nonlinear stepping: ``TAYLOR`` (default), ``RK8`` or ``RK4``.
+    zeno_tol : Zeno sequences are summed once ``|omega| < zeno_tol * p * alpha``.
+    stop_at_rest : stop as soon as the block is at rest (free motion only).
+    hist_t, hist_theta, hist_omega : output arrays of length ``n_int + 1`` (when ``record``).
+    impacts : output array of impact times; impacts beyond its length are counted only.
+    j0 : first interval (its start time, and the state ``theta0``, ``omega0``); the history
+        starts there.
+    rest_until0 : the block is at rest until then (after a Zeno sequence), ``-inf`` if not.
 
-@njit(cache=True)
-def _batch_serial(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                  eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted):
-    for i in range(p.shape[0]):
-        _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                 eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted)
-
-
-@njit(cache=True, parallel=True)
-def _batch_parallel(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                    eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted):
-    for i in prange(p.shape[0]):
-        _run_one(i, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha,
-                 eta, linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted)
-
-
-#: batches at least this large use threads: on small batches (and on a busy machine, or inside
-#: worker processes) waking the thread pool costs more than the work itself (~30 ms measured
-#: under load, against 0.1 ms per pulse run)
-PARALLEL_MIN_RUNS = 256
-
-
-def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
-             linear, zeno_tol, method=TAYLOR):
-    """:func:`run` for many blocks/amplitudes at once (arrays ``amp``, ``p``, ``alpha``, ``eta``,
-    ``n_sub`` of equal length), then the energy rule; no histories are kept.
-
-    Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted``.
+    Returns
+    -------
+    status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist, uplifted, rest_until
     """
-    n = p.shape[0]
-    out = (np.zeros(n, dtype=np.bool_), np.zeros(n), np.zeros(n, dtype=np.int64),
-           np.zeros(n, dtype=np.bool_))
-    batch = _batch_parallel if n >= PARALLEL_MIN_RUNS else _batch_serial
-    batch(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
-          linear, zeno_tol, method, *out)
-    return out
+    check_kind(kind)
+    # every scalar as the one type compiled for it (an int theta0 would compile a second version)
+    args = (int(kind), float(amp), float(tp), float(t0), as_input(uval), as_input(nodes),
+            float(t_start), float(h_uniform), int(j0), int(n_int), int(n_sub), float(p),
+            float(alpha), float(eta), float(theta0), float(omega0), float(rest_until0),
+            bool(linear), float(zeno_tol), bool(stop_at_rest), hist_t, hist_theta, hist_omega,
+            impacts, bool(record), int(method), np.zeros(WORK_SIZE))
+    if first_call_done(run_core):  # the common case, without the notice's context (~10 us)
+        return run_core(*args)
+    with compiling_notice(run_core):
+        return run_core(*args)
+
+
+def as_input(a):
+    """``a`` as the compiled code takes arrays: float64, C-contiguous, writeable (numba compiles
+    one version per array type; a read-only record would otherwise get a second one)."""
+    if a.dtype == np.float64 and a.flags.c_contiguous and a.flags.writeable:
+        return a
+    return np.require(a, dtype=np.float64, requirements=("C", "W"))
+
+
+def check_kind(kind):
+    """Raise :class:`rocking.errors.RockingInputError` unless ``kind`` is one of :data:`KINDS`
+    (the engine computes only the forcing it knows: an unknown kind is never guessed)."""
+    if kind not in KINDS:
+        from .errors import RockingInputError
+
+        raise RockingInputError(f"the engine has no forcing of kind {kind!r}; it knows "
+                                f"{', '.join(f'{k} ({n})' for k, n in KINDS.items())}")

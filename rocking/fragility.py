@@ -24,6 +24,7 @@ import numpy as np
 from pulses import G
 
 from .block import Block
+from .search import _peak
 
 #: default largest scale factor examined
 UP_TO = 10.0
@@ -91,12 +92,6 @@ class CriticalScale:
     def critical_pga(self) -> float | None:
         """PGA of the critically scaled record, m/s^2 (None when nothing overturned)."""
         return None if self.scale is None else self.scale * self.pga
-
-
-def _peak(excitation) -> float:
-    if hasattr(excitation, "pga"):
-        return float(excitation.pga)
-    return abs(float(excitation.ap))
 
 
 def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,

@@ -15,21 +15,28 @@ operations, at the same or a higher order).
 
 For records (forcing linear between samples) on a uniform grid with one Taylor step per sample
 (``p dt`` within :data:`rocking.solver.PH_MAX`); :func:`rocking.simulate_many` uses it for those
-(``rocking.solver._run_batch``) and the per-run engine, :func:`rocking.engine.run_many`, for
-everything else.
+(``rocking.solver._run_batch``) and the runs one by one, :func:`run_many`, for everything else.
+
+Both ways are one compiled function, :func:`_kernel` (the engine's code is generated once for
+every batch), which runs without the GIL: :func:`run_batch` spreads a large batch over threads
+(``numba.get_num_threads()`` of them) instead of compiling ``parallel=True`` variants of it.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from numba import njit, prange
+from concurrent.futures import ThreadPoolExecutor
 
+import numba
+from numba import njit
+
+from ._compiling import compiling_notice
 from ._taylor_fixed import taylor_fixed
 from ._taylor_lanes import ORDERS, lanes_step
 from .engine import (HALF_PI, N_STAGES, NMAX, NODAL, OVERTURNED, REST, ROCKING, TAYLOR,
                      TAYLOR_EPS, WORK_SIZE, _first_crossing, _hermite, _step_peak,
-                     corner_sincos, energy_verdict, run_core)
+                     as_input, check_kind, corner_sincos, energy_verdict, run_core)
 
 #: runs stepped together at most (a chunk; the rocking ones are kept first, so that one loop over
 #: the first ``n_rocking`` lanes steps them all).  Measured per run and step at order 8: 45 ns for
@@ -109,12 +116,13 @@ def _turn(order, a, uval, j, ta, h, theta, omega, side, sa, ca, p, cf, kt, kw):
     lo, _, _ = _first_crossing(c0, c1h, c2, c3, side, 0.0)
     if lo >= 0.0:
         return False, 0.0, 0.0, 0.0, 1.0, 0.0
-    peak = _step_peak(NODAL, a, 1.0, 0.0, uval, j, ta, ta + h, ta, h, theta, omega, th2, om2,
-                      side, p, sa, ca, False, TAYLOR, kt, kw, h, cf, order)
+    peak = _step_peak(np.int64(NODAL), a, 1.0, 0.0, uval, j, ta, ta + h, ta, h, theta, omega,
+                      th2, om2, side, p, sa, ca, np.bool_(False), np.int64(TAYLOR), kt, kw, h,
+                      cf, order)
     return True, th2, om2, s1, c1, max(peak, abs(th2))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # one caller, _kernel: compiled once, there
 def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overturned, max_abs,
            n_impacts, uplifted, stats):
     """Runs ``i0 .. i1-1`` (at most :data:`LANES`) from rest over the whole record; results
@@ -146,9 +154,11 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
     kw = work[N_STAGES:2 * N_STAGES]
     cf = np.zeros(NMAX + 3)
     empty = np.zeros(0)
-    order = ORDERS[2]
+    # constants passed to compiled functions as np.int64 / np.bool_: a bare constant is typed as
+    # a literal, and numba would compile those functions once more for it
+    order = np.int64(ORDERS[2])
     n_low = 0
-    n_rocking, n_live = 0, n
+    n_rocking, n_live = np.int64(0), n
     next_wake = 0  # no lane at rest can uplift before this interval
     for j in range(n_int):
         if n_live == 0:
@@ -204,9 +214,10 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
                 # something happens in this interval: the engine takes this lane through it
                 stats[2 if st == ROCKING else 3] += 1
                 (st2, th, om, _, m, ni, _, u, r) = run_core(
-                    NODAL, a[i], 1.0, 0.0, uval, empty, t_start, h, j, j + 1, 1, F[_P, i],
-                    F[_ALPHA, i], F[_ETA, i], theta[i], omega[i], F[_REST, i], False, zeno_tol,
-                    False, empty, empty, empty, empty, False, TAYLOR, work)
+                    np.int64(NODAL), a[i], 1.0, 0.0, uval, empty, t_start, h, j, j + 1,
+                    np.int64(1), F[_P, i], F[_ALPHA, i], F[_ETA, i], theta[i], omega[i],
+                    F[_REST, i], np.bool_(False), zeno_tol, np.bool_(False), empty, empty, empty,
+                    empty, np.bool_(False), np.int64(TAYLOR), work)
                 if m > peak[i]:
                     peak[i] = m
                 I[_NIMP, i] += ni
@@ -252,7 +263,7 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
         pk = peak[i]
         if st == ROCKING:
             over, pk2 = energy_verdict(theta[i], omega[i], F[_P, i], F[_ALPHA, i], F[_ETA, i],
-                                       False)
+                                       np.bool_(False))
             if pk2 > pk:
                 pk = pk2
         overturned[k] = over
@@ -261,39 +272,125 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
         uplifted[k] = I[_UP, i] != 0
 
 
-@njit(cache=True)
-def _lanes_serial(amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overturned, max_abs,
-                  n_impacts, uplifted, stats):
-    n = p.shape[0]
-    for c in range((n + LANES - 1) // LANES):
-        _chunk(c * LANES, min(n, (c + 1) * LANES), amp, uval, t_start, h, n_int, p, alpha, eta,
-               zeno_tol, overturned, max_abs, n_impacts, uplifted, stats[c])
+@njit(cache=True, nogil=True)
+def _kernel(lanes, i0, i1, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p, alpha, eta,
+            linear, zeno_tol, method, overturned, max_abs, n_impacts, uplifted, stats):
+    """Runs ``i0 .. i1-1`` of a batch from rest, then the energy rule; results written at their
+    indices.  ``lanes``: stepped together (:func:`_chunk`, at most :data:`LANES` runs; a record
+    on a uniform grid, one Taylor step per sample), else one by one with
+    :func:`rocking.engine.run_core`.
 
-
-@njit(cache=True, parallel=True)
-def _lanes_parallel(amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overturned, max_abs,
-                      n_impacts, uplifted, stats):
-    n = p.shape[0]
-    for c in prange((n + LANES - 1) // LANES):
-        _chunk(c * LANES, min(n, (c + 1) * LANES), amp, uval, t_start, h, n_int, p, alpha, eta,
-               zeno_tol, overturned, max_abs, n_impacts, uplifted, stats[c])
-
-
-def run_lanes(amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, parallel=False, stats=None):
-    """Runs from rest of blocks ``p``, ``alpha``, ``eta`` (arrays) under the record ``amp * uval``
-    (node values of ``ug''/g`` every ``h`` s from ``t_start``, ``n_int`` intervals), one Taylor
-    step per interval, then the energy rule; no histories.
-
-    Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted`` (as
-    :func:`rocking.engine.run_many`).
+    The one compiled entry of every batch (both ways in one function: the engine's code is
+    generated once for both), without the GIL: :func:`run_batch` spreads calls over threads.
     """
+    if lanes:
+        _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overturned, max_abs,
+               n_impacts, uplifted, stats)
+        return
+    work = np.zeros(WORK_SIZE)
+    empty = np.zeros(0)
+    for i in range(i0, i1):
+        st, th, om, _, mx, ni, _, up, _ = run_core(
+            kind, amp[i], tp, t0, uval, nodes, t_start, h, np.int64(0), n_int, n_sub[i], p[i],
+            alpha[i], eta[i], 0.0, 0.0, -np.inf, linear, zeno_tol, np.bool_(False), empty, empty,
+            empty, empty, np.bool_(False), method, work)
+        if st == OVERTURNED:
+            over = True
+        elif st == ROCKING:
+            over, peak = energy_verdict(th, om, p[i], alpha[i], eta[i], linear)
+            if peak > mx:
+                mx = peak
+        else:
+            over = False
+        overturned[i] = over
+        max_abs[i] = HALF_PI if over else mx
+        n_impacts[i] = ni
+        uplifted[i] = up
+
+
+#: batches at least this large are spread over threads (:func:`run_batch`): on small batches (and
+#: on a busy machine) starting the work on other threads costs more than the work itself
+PARALLEL_MIN_RUNS = 256
+#: runs per task of a batch run one by one over threads (a task is one call of :func:`_kernel`)
+TASK_RUNS = 16
+
+_pools = {}
+
+
+def _pool(threads):
+    if threads not in _pools:
+        _pools[threads] = ThreadPoolExecutor(max_workers=threads,
+                                             thread_name_prefix="rocking-batch")
+    return _pools[threads]
+
+
+def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p, alpha, eta,
+              linear, zeno_tol, method=TAYLOR, threads=None, stats=None):
+    """Runs from rest of blocks ``p``, ``alpha``, ``eta`` (arrays) scaled by ``amp`` (array), then
+    the energy rule; no histories.  ``lanes``: stepped together (records on a uniform grid with one
+    Taylor step per sample, ``n_sub == 1``), else one by one (any grid, model or method).
+
+    ``threads``: how many threads share the batch (default ``numba.get_num_threads()`` for
+    batches of at least :data:`PARALLEL_MIN_RUNS` runs, else 1; 1 runs it on the calling thread,
+    as worker processes that already share the cores want: ``numba.set_num_threads(1)`` there
+    sets the default).  ``stats`` (4 integers, lanes only) is incremented as in :func:`_chunk`.
+
+    Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted``.
+    """
+    check_kind(kind)
     n = p.shape[0]
     out = (np.zeros(n, dtype=np.bool_), np.zeros(n), np.zeros(n, dtype=np.int64),
            np.zeros(n, dtype=np.bool_))
-    fn = _lanes_parallel if parallel else _lanes_serial
-    counts = np.zeros(((n + LANES - 1) // LANES, 4), dtype=np.int64)
-    fn(np.ascontiguousarray(amp, dtype=float), uval, float(t_start), float(h), int(n_int),
-       p, alpha, eta, float(zeno_tol), *out, counts)
+    if threads is None:
+        threads = numba.get_num_threads() if n >= PARALLEL_MIN_RUNS else 1
+    threads = max(1, int(threads))
+    if lanes:
+        size = LANES
+    else:
+        size = n if threads == 1 else TASK_RUNS
+    starts = range(0, n, max(size, 1))
+    counts = np.zeros((len(starts), 4), dtype=np.int64)
+    f64 = as_input
+    args = (int(kind), f64(amp), float(tp), float(t0), f64(uval), f64(nodes), float(t_start),
+            float(h), int(n_int), np.ascontiguousarray(n_sub, dtype=np.int64), f64(p), f64(alpha),
+            f64(eta), bool(linear), float(zeno_tol), int(method)) + out
+
+    def task(k):
+        i0 = starts[k]
+        _kernel(bool(lanes), i0, min(n, i0 + size), *args, counts[k])
+
+    if n:
+        with compiling_notice(_kernel):
+            task(0)
+        if threads == 1 or len(starts) <= 2:
+            for k in range(1, len(starts)):
+                task(k)
+        else:
+            list(_pool(min(threads, len(starts) - 1)).map(task, range(1, len(starts))))
     if stats is not None:
         stats += counts.sum(axis=0)
     return out
+
+
+def run_lanes(amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, threads=None, stats=None):
+    """Runs from rest of blocks ``p``, ``alpha``, ``eta`` (arrays) under the record ``amp * uval``
+    (node values of ``ug''/g`` every ``h`` s from ``t_start``, ``n_int`` intervals), one Taylor
+    step per interval, then the energy rule; no histories (:func:`run_batch` in lanes).
+
+    Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted`` (as :func:`run_many`).
+    """
+    n_sub = np.ones(np.shape(p)[0], dtype=np.int64)
+    return run_batch(True, NODAL, amp, 1.0, 0.0, uval, np.zeros(0), t_start, h, n_int, n_sub, p,
+                     alpha, eta, False, zeno_tol, TAYLOR, threads, stats)
+
+
+def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,
+             linear, zeno_tol, method=TAYLOR, threads=None):
+    """:func:`rocking.engine.run` for many blocks/amplitudes at once (arrays ``amp``, ``p``,
+    ``alpha``, ``eta``, ``n_sub`` of equal length), one by one, then the energy rule; no
+    histories (:func:`run_batch`).
+
+    Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted``.
+    """
+    return run_batch(False, kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p,
+                     alpha, eta, linear, zeno_tol, method, threads)

@@ -19,6 +19,7 @@ from scipy.optimize import brentq
 from pulses import G, Record
 
 from . import engine
+from ._common import _free_rocking_horizon, _pulse_extrema, _result
 from .block import Block
 
 RTOL = 1e-12
@@ -40,7 +41,6 @@ def _segments(excitation, duration):
             slope = (ub - ua) / (tb - ta)
             segs.append((ta, tb, (lambda x, ua=ua, ta=ta, slope=slope: ua + slope * (x - ta))))
         return segs
-    from .solver import _pulse_extrema
 
     start, end = excitation.support
     if duration is not None:
@@ -176,7 +176,6 @@ def simulate_reference(block: Block, excitation=None, *, theta0=0.0, omega0=0.0,
                        zeno_tol=1e-7):
     """Rocking response by the reference model (see module docstring); same result type as
     :func:`rocking.simulate`."""
-    from .solver import _free_rocking_horizon, _result
 
     state = _State(block, theta0, omega0, zeno_tol)
     hist = [(0.0 if excitation is None else excitation.support[0], state.theta, state.omega)]

@@ -16,7 +16,7 @@ integration (unless a longer ``duration`` is asked for, to draw the free rocking
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -24,7 +24,10 @@ from pulses import G, Pulse, Record
 
 from . import engine
 from .block import Block
-from .lanes import run_lanes
+from ._common import (ZENO_TOL, BatchResult, RockingResult, _free_rocking_horizon,
+                      _pulse_extrema, _result)
+from .errors import RockingInputError
+from .lanes import run_lanes, run_many
 
 #: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
 #: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  The Taylor
@@ -49,117 +52,48 @@ STEPS_PER_TP = 16
 #: ``tol = 1e-6`` that means alpha < 1e-4: the linearised model is there for comparison and for
 #: users who accept a coarser ``tol``.
 LINEAR_ERROR_COEFF = 100.0
-#: post-impact angular velocity, over ``p * alpha``, below which a Zeno sequence is summed
-ZENO_TOL = 1e-7
 #: steps of the linearised model per pulse period (its forcing is the chord of each step)
 LINEAR_STEPS_PER_TP = 4000
 
-MODELS = ("auto", "fast", "linear", "reference")
-
-
-@dataclass
-class RockingResult:
-    """The response of one block to one excitation.
-
-    Attributes
-    ----------
-    overturned : bool
-        ``|theta|`` reached ``pi/2`` (during the excitation, or as the energy rule decides after).
-    exceeded_alpha : bool
-        ``|theta|`` exceeded ``alpha`` at some time.
-    max_rotation : float
-        ``max |theta|`` (rad), including the free rocking after the excitation (energy rule).
-    max_rotation_ratio : float
-        ``max |theta| / alpha``.
-    impacts : ndarray
-        Impact times (s) during the integrated part.
-    n_impacts : int
-        Number of impacts (the integrated part; a Zeno tail summed in closed form counts once).
-    t, theta, omega : ndarray
-        History at the grid nodes: time (s), rotation (rad), angular velocity (rad/s).
-    model : str
-        Which model answered: ``"rest"``, ``"linear"``, ``"fast"`` or ``"reference"``.
-    verdict_by : str
-        ``"no uplift"``, ``"integration"`` (overturned while integrating, or at rest at the end)
-        or ``"energy rule"`` (decided from the state when the excitation ended).
-    uplifted : bool
-        The block left its rest position at least once.
-    t_overturn : float
-        Time (s) at which ``|theta|`` reached ``pi/2`` during the integration, else nan.
-    """
-
-    overturned: bool
-    exceeded_alpha: bool
-    max_rotation: float
-    max_rotation_ratio: float
-    impacts: np.ndarray
-    n_impacts: int
-    t: np.ndarray
-    theta: np.ndarray
-    omega: np.ndarray
-    model: str
-    verdict_by: str
-    uplifted: bool
-    t_overturn: float = math.nan
-    block: Block | None = field(default=None, repr=False)
-
-    def summary(self) -> dict:
-        """Scalar results as a plain dict (for JSON and CSV)."""
-        return {
-            "overturned": bool(self.overturned),
-            "exceeded_alpha": bool(self.exceeded_alpha),
-            "max_rotation_rad": float(self.max_rotation),
-            "max_rotation_ratio": float(self.max_rotation_ratio),
-            "n_impacts": int(self.n_impacts),
-            "uplifted": bool(self.uplifted),
-            "t_overturn_s": None if math.isnan(self.t_overturn) else float(self.t_overturn),
-            "model": self.model,
-            "verdict_by": self.verdict_by,
-        }
-
-
-@dataclass
-class BatchResult:
-    """Scalar results of :func:`simulate_many`, one array entry per run."""
-
-    overturned: np.ndarray
-    exceeded_alpha: np.ndarray
-    max_rotation: np.ndarray
-    max_rotation_ratio: np.ndarray
-    n_impacts: np.ndarray
-    uplifted: np.ndarray
-    model: str
+MODELS = ("auto", "fast", "linear", "reference")  # "auto", then the keys of MODEL_RUNNERS
 
 
 # --------------------------------------------------------------------------- grids
-def _pulse_extrema(pulse: Pulse) -> list[float]:
-    """Times (s) of the extrema of the pulse's acceleration inside its support."""
-    if pulse.shape == "sine":
-        taus = [0.25, 0.75]
-    elif pulse.shape == "ricker-sym":
-        x = math.sqrt(1.5) / math.pi
-        taus = [-x, 0.0, x]
-    elif pulse.shape == "ricker-anti":
-        c = math.sqrt(3.0) / (2.0 * math.pi)
-        taus = [sgn * math.sqrt(3.0 + d * math.sqrt(6.0)) * c for sgn in (-1, 1) for d in (-1, 1)]
-    else:
-        taus = []
-    return [pulse.t0 + tau * pulse.tp for tau in taus]
-
-
-def _pulse_grid(pulse: Pulse, h_max: float, t_end: float | None = None) -> np.ndarray:
-    """Nodes over the pulse's support: breakpoints and extrema, subdivided into steps <= h_max."""
+def _pulse_pieces(pulse: Pulse, h_max: float, t_end: float | None):
+    """The pieces of a pulse's grid: breakpoints and extrema ``a -> b``, each cut into ``n`` equal
+    steps no longer than ``h_max``; and the grid's end time."""
     start, end = pulse.support
     if t_end is not None:
         end = min(end, t_end)
     marks = np.array(sorted({start, end, *[x for x in _pulse_extrema(pulse) if start < x < end]}))
     a, b = marks[:-1], marks[1:]
     n = np.maximum(1, np.ceil((b - a) / h_max - 1e-9)).astype(np.int64)
-    piece = np.repeat(np.arange(n.size), n)  # piece of each node but the last
-    k = np.arange(piece.size) - np.repeat(np.cumsum(n) - n, n)  # its index inside the piece
-    nodes = np.empty(piece.size + 1)
+    return a, b, n, end
+
+
+def _pulse_grid_size(pulse: Pulse, h_max: float, t_end: float | None = None) -> int:
+    """Number of intervals of :func:`_pulse_grid` (without building it)."""
+    return int(_pulse_pieces(pulse, h_max, t_end)[2].sum())
+
+
+def _pulse_grid(pulse: Pulse, h_max: float, t_end: float | None = None, first: int = 0,
+                last: int | None = None) -> np.ndarray:
+    """Nodes over the pulse's support: breakpoints and extrema, subdivided into steps <= h_max;
+    nodes ``first .. last`` of it only when given (a long pulse is run a part at a time)."""
+    a, b, n, end = _pulse_pieces(pulse, h_max, t_end)
+    total = int(n.sum())
+    last = total if last is None else min(int(last), total)
+    idx = np.arange(first, last)                      # every node but the last
+    ends = np.cumsum(n)
+    piece = np.searchsorted(ends, idx, side="right")  # piece of each node
+    k = idx - (ends - n)[piece]                       # its index inside the piece
+    nodes = np.empty(idx.size + 1)
     nodes[:-1] = a[piece] + (b - a)[piece] * (k / n[piece])
-    nodes[-1] = end
+    if last == total:
+        nodes[-1] = end
+    else:
+        pl = int(np.searchsorted(ends, last, side="right"))
+        nodes[-1] = a[pl] + (b - a)[pl] * ((last - (ends - n)[pl]) / n[pl])
     return nodes
 
 
@@ -183,6 +117,9 @@ class _Grid:
     h: float
     n_int: int
     u_peak: float  # max |ug''|/g over the excitation (before scaling)
+    #: a pulse grid too long to build at once (more than :data:`PART_INTERVALS` intervals):
+    #: ``(pulse, h_max, t_end, h_longest)``, its nodes made a part at a time (``nodes`` empty)
+    lazy: tuple | None = None
 
 
 def _grid(excitation, p_max: float, linear: bool, duration: float | None,
@@ -204,6 +141,12 @@ def _grid(excitation, p_max: float, linear: bool, duration: float | None,
         else:
             h_max = min(excitation.tp / STEPS_PER_TP, ph_max / p_eff)
         t_end = None if duration is None else excitation.support[0] + duration
+        n_int = _pulse_grid_size(excitation, h_max, t_end)
+        if n_int > PART_INTERVALS:
+            a, b, n, _ = _pulse_pieces(excitation, h_max, t_end)
+            return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
+                         empty, float(a[0]), 0.0, n_int, u_peak,
+                         lazy=(excitation, h_max, t_end, float(np.max((b - a) / n))))
         nodes = _pulse_grid(excitation, h_max, t_end)
         return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
                      nodes, nodes[0], 0.0, nodes.size - 1, u_peak)
@@ -274,6 +217,12 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         raise ValueError(f"theta0 must lie inside (-pi/2, pi/2), got {theta0!r}")
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be positive and finite, got {duration!r}")
+    if excitation is None and theta0 == 0.0 and omega0 == 0.0:
+        raise RockingInputError("simulate: no excitation and the block at rest: pass a "
+                                "pulses.Pulse or pulses.Record, or theta0/omega0 for free rocking")
+    if excitation is not None and not isinstance(excitation, (Pulse, Record)):
+        raise RockingInputError("simulate: excitation must be a pulses.Pulse, a pulses.Record or "
+                                f"None (free rocking), got {type(excitation).__name__}")
     stepper = _check_method(method)
     if ph_max is None:
         ph_max = _default_ph_max(method)
@@ -286,13 +235,35 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
     if excitation is not None and at_rest and model in ("auto", "fast", "linear"):
         if peak / G <= block.tan_alpha:
             return _never_uplifts(block, excitation, duration, history)
-    if chosen == "reference":
-        from .reference import simulate_reference
+    return MODEL_RUNNERS[chosen](block, excitation, theta0, omega0, duration, history, zeno_tol,
+                                 stepper, ph_max, peak)
 
-        return simulate_reference(block, excitation, theta0=theta0, omega0=omega0,
-                                  duration=duration, zeno_tol=zeno_tol)
-    return _simulate_compiled(block, excitation, theta0, omega0, duration, chosen == "linear",
-                              history, zeno_tol, stepper, ph_max, peak)
+
+def _run_fast(block, excitation, theta0, omega0, duration, history, zeno_tol, stepper, ph_max,
+              peak):
+    return _simulate_compiled(block, excitation, theta0, omega0, duration, False, history,
+                              zeno_tol, stepper, ph_max, peak)
+
+
+def _run_linear(block, excitation, theta0, omega0, duration, history, zeno_tol, stepper, ph_max,
+                peak):
+    return _simulate_compiled(block, excitation, theta0, omega0, duration, True, history,
+                              zeno_tol, stepper, ph_max, peak)
+
+
+def _run_reference(block, excitation, theta0, omega0, duration, history, zeno_tol, stepper,
+                   ph_max, peak):
+    from .reference import simulate_reference
+
+    return simulate_reference(block, excitation, theta0=theta0, omega0=omega0, duration=duration,
+                              zeno_tol=zeno_tol)
+
+
+#: the models :func:`simulate` answers with, by name (``"auto"`` chooses among them); each takes
+#: ``(block, excitation, theta0, omega0, duration, history, zeno_tol, stepper, ph_max, peak)``
+#: (``stepper``: an engine method code, :data:`rocking.engine.METHODS`; ``peak``: the
+#: excitation's peak acceleration, m/s^2, or None) and returns a :class:`RockingResult`
+MODEL_RUNNERS = {"fast": _run_fast, "linear": _run_linear, "reference": _run_reference}
 
 
 def _check_method(method: str) -> int:
@@ -317,10 +288,16 @@ def _never_uplifts(block, excitation, duration, history):
 
 def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_tol,
               stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX):
-    h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
+    if grid.lazy is not None:
+        h = grid.lazy[3]
+    else:
+        h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
     n_sub = _n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else ph_max)
     if linear and grid.kind in (engine.NODAL, engine.RECT, engine.FREE):
         n_sub = 1  # exact for forcing linear on each interval
+    if grid.lazy is not None or (grid.kind == engine.FREE and grid.n_int > PART_INTERVALS):
+        return _run_in_parts(grid, block, theta0, omega0, linear, history, zeno_tol,
+                             stop_at_rest, method, n_sub)
     size = grid.n_int + 1 if history else 0
     hist_t, hist_th, hist_om = np.empty(size), np.empty(size), np.empty(size)
     impacts = np.empty(4096)
@@ -328,18 +305,82 @@ def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_t
                      grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta, theta0, omega0,
                      linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om, impacts, history,
                      method)
-    status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted = out
+    status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
         out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes,
                          grid.t_start, grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta,
                          theta0, omega0, linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om,
                          impacts, history, method)
-        status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted = out
+        status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if history:
         hist_t, hist_th, hist_om = hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist]
     return (status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts[:n_imp],
             hist_t, hist_th, hist_om)
+
+
+#: longest stretch of intervals integrated at once: longer grids (a pulse of a very long period,
+#: free rocking of a block that hardly loses energy) are built and run a part at a time, so that
+#: memory stays bounded (a part's nodes and history: 32 MB), and the run stops as soon as the
+#: answer is known (overturned, or at rest with no forcing left that could uplift the block)
+PART_INTERVALS = 1 << 20
+
+
+def _can_uplift_after(grid: _Grid, t: float, tan_alpha: float) -> bool:
+    """Whether the forcing after ``t`` reaches the uplift threshold anywhere."""
+    if grid.lazy is None:
+        return False  # free rocking: no forcing
+    pulse, _, t_end, _ = grid.lazy
+    start, end = pulse.support
+    end = end if t_end is None else min(end, t_end)
+    times = [max(t, start), end] + [x for x in _pulse_extrema(pulse) if t < x < end]
+    return max(abs(float(pulse(x))) for x in times) / G > tan_alpha
+
+
+def _run_in_parts(grid, block, theta0, omega0, linear, history, zeno_tol, stop_at_rest, method,
+                  n_sub):
+    """:func:`_run_grid` a part of :data:`PART_INTERVALS` intervals at a time, each part starting
+    from the state the previous one ended in."""
+    theta, omega, rest_until = theta0, omega0, -math.inf
+    max_abs, uplifted, status = abs(theta0), False, engine.REST
+    impacts, hists, n_imp, t_end = [], [], 0, grid.t_start
+    for j0 in range(0, grid.n_int, PART_INTERVALS):
+        j1 = min(j0 + PART_INTERVALS, grid.n_int)
+        if grid.lazy is not None:
+            pulse, h_max, t_stop, _ = grid.lazy
+            nodes = _pulse_grid(pulse, h_max, t_stop, j0, j1)
+            first, n_end, t_start = 0, j1 - j0, nodes[0]
+        else:
+            nodes, first, n_end, t_start = grid.nodes, j0, j1, grid.t_start
+        size = j1 - j0 + 1 if history else 0
+        hist = np.empty(size), np.empty(size), np.empty(size)
+        imp = np.empty(4096)
+        out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, nodes, t_start, grid.h,
+                         n_end, n_sub, block.p, block.alpha, block.eta, theta, omega, linear,
+                         zeno_tol, stop_at_rest, *hist, imp, history, method, first, rest_until)
+        status, theta, omega, t_end, mx, ni, n_hist, up, rest_until = out
+        max_abs, uplifted = max(max_abs, mx), uplifted or up
+        impacts.append(imp[:min(ni, imp.size)])
+        n_imp += ni
+        if history:
+            hists.append(tuple(a[:n_hist] if not hists else a[1:n_hist] for a in hist))
+        if status == engine.OVERTURNED or (stop_at_rest and status == engine.REST):
+            break
+        if (status == engine.REST and rest_until <= t_end
+                and not _can_uplift_after(grid, t_end, block.tan_alpha)):
+            # at rest, and nothing left that could move the block: the rest is known
+            last = _pulse_grid(*grid.lazy[:3], grid.n_int, grid.n_int)[-1] if grid.lazy else \
+                grid.t_start + grid.n_int * grid.h
+            if history:
+                hists.append((np.array([last]), np.zeros(1), np.zeros(1)))
+            t_end = last
+            break
+    impacts = np.concatenate(impacts) if impacts else np.zeros(0)
+    if history:
+        t, th, om = (np.concatenate([h[i] for h in hists]) for i in range(3))
+    else:
+        t = th = om = np.zeros(0)
+    return status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om
 
 
 #: ``p * h`` of the free-rocking grid (no forcing to resolve; RK4 energy drift ~1e-12 per cycle)
@@ -406,43 +447,25 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
                    t_over)
 
 
-def _free_rocking_horizon(block: Block) -> float:
-    """An upper bound (s) on how long free rocking lasts before it comes to rest.
-
-    Each half-cycle lasts less than ``~ (2/p) * acosh(...)``; with the energy falling by ``r`` at
-    every impact, ``log(zeno)/log(r)`` impacts reach the Zeno threshold.  Generous by design:
-    ``stop_at_rest`` ends the integration as soon as the block settles.
-    """
-    n_impacts = math.log(ZENO_TOL) / math.log(max(block.eta, 1e-3)) + 10 if block.eta > 0 else 10
-    return min(50.0 / block.p * n_impacts, 1e7 / block.p)
-
-
-def _result(block, over, max_abs, impacts, n_imp, t, th, om, model, verdict_by, uplifted, t_over):
-    max_abs = float(max_abs)
-    return RockingResult(bool(over), bool(max_abs > block.alpha), max_abs, max_abs / block.alpha,
-                         np.asarray(impacts, dtype=float), int(n_imp), t, th, om, model,
-                         verdict_by, bool(uplifted), float(t_over), block=block)
-
-
 # --------------------------------------------------------------------------- batch
 #: smaller batches run one by one (the engine's own loop over a single run is tighter)
 LANES_MIN_RUNS = 4
 
 
-def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper):
+def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lanes=True):
     """The engine over a batch: runs under a record with one Taylor step per sample go through the
-    batch engine (:mod:`rocking.lanes`, several runs per core at once), the rest run one by one
-    (:func:`rocking.engine.run_many`); the same model either way."""
+    batch engine in lanes (:mod:`rocking.lanes`, several runs per core at once), the rest run one
+    by one (:func:`rocking.lanes.run_many`); the same model either way."""
     def one_by_one(m):
-        return engine.run_many(g.kind, amp[m], g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h,
-                               g.n_int, n_sub[m], p[m], alpha[m], eta[m], linear, ZENO_TOL, stepper)
+        return run_many(g.kind, amp[m], g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h, g.n_int,
+                        n_sub[m], p[m], alpha[m], eta[m], linear, ZENO_TOL, stepper, threads)
 
     def in_lanes(m):
         return run_lanes(amp[m], g.uval, g.t_start, g.h, g.n_int, p[m], alpha[m], eta[m], ZENO_TOL,
-                         parallel=p[m].size >= engine.PARALLEL_MIN_RUNS)
+                         threads)
 
     use = np.zeros(p.size, dtype=bool)
-    if (g.kind == engine.NODAL and g.nodes.size == 0 and not linear
+    if (lanes and g.kind == engine.NODAL and g.nodes.size == 0 and not linear
             and stepper == engine.TAYLOR and p.size >= LANES_MIN_RUNS):
         use = n_sub == 1
     if not use.any():
@@ -457,7 +480,8 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper):
 
 
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
-                  model: str = "fast", method: str = "taylor") -> BatchResult:
+                  model: str = "fast", method: str = "taylor",
+                  threads: int | None = None, lanes: bool = True) -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
 
     Parameters
@@ -472,6 +496,13 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     model : {"fast", "linear"}
     method : {"taylor", "rk8", "rk4"}
         Stepping formula of the fast engine (see :func:`simulate`).
+    threads : int, optional
+        Threads sharing the batch (default: ``numba.get_num_threads()`` for batches of 256 runs
+        or more, else 1; worker processes that already share the cores call
+        ``numba.set_num_threads(1)`` or pass 1).
+    lanes : bool
+        True: runs under a record go through the batch engine's lanes where they apply; False:
+        every run one by one (the same answers; to compare their speed).
 
     Returns
     -------
@@ -501,13 +532,18 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     stepper = _check_method(method)
     ph_max = _default_ph_max(method)
     g = _grid(excitation, float(p.max()), linear, None, ph_max)
+    if g.lazy is not None:
+        raise RockingInputError(
+            f"simulate_many: the pulse needs {g.n_int} steps (Tp = {excitation.tp:g} s), more "
+            f"than a batch holds ({PART_INTERVALS}); run its blocks one by one with simulate")
     amp = g.amp * scales
     h = g.h if g.nodes.size == 0 else float(np.max(np.diff(g.nodes)))
     p_eff = p * np.sqrt(1.0 + g.u_peak * np.abs(scales))
     n_sub = _n_sub(h, p_eff, 0.05 if linear else ph_max)
     if linear and g.kind in (engine.NODAL, engine.RECT):
         n_sub[:] = 1
-    over, max_abs, n_imp, up = _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper)
+    over, max_abs, n_imp, up = _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads,
+                                          lanes)
     ratio = max_abs / alpha
     return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
                        max_abs.reshape(shape), ratio.reshape(shape), n_imp.reshape(shape),

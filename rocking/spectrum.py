@@ -14,7 +14,9 @@ import numpy as np
 from pulses import G, SHAPES, make_pulse
 
 from .block import Block
-from .design import N_SCAN, RTOL, _batch, eq31, min_slenderness_batch
+from .closed_forms import eq31
+from .search import DEFAULT_SETTINGS, _batch
+from .slenderness import min_slenderness_batch
 
 
 @dataclass
@@ -60,17 +62,16 @@ class OverturningSpectrum:
         })
 
     def plot(self, path=None, ax=None):
-        """Draw the spectrum as in Fig. 5 (x: ``omega_p/p``, y: ``ap/(g tan alpha)``)."""
-        import matplotlib
-
-        if ax is None:
-            matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        """Draw the spectrum as in Fig. 5 (x: ``omega_p/p``, y: ``ap/(g tan alpha)``) on ``ax``, or
+        on a new figure (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is
+        chosen for the caller) saved to ``path`` when given."""
         from matplotlib.colors import ListedColormap
+        from matplotlib.figure import Figure
 
         fig = None
         if ax is None:
-            fig, ax = plt.subplots(figsize=(5.5, 4.5))
+            fig = Figure(figsize=(5.5, 4.5))
+            ax = fig.subplots()
         state = np.where(self.overturned, 2, np.where(self.exceeded_alpha, 1, 0)).T
         cmap = ListedColormap(["#9fd89f", "#f3d37a", "#d9534f"])
         ax.pcolormesh(self.wp_over_p, self.ap_over_gtan, state, cmap=cmap, vmin=0, vmax=2,
@@ -83,7 +84,6 @@ class OverturningSpectrum:
             fig.tight_layout()
             if path is not None:
                 fig.savefig(path, dpi=110)
-            plt.close(fig)
         return ax
 
 
@@ -141,9 +141,9 @@ CHART_PTP = (0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 20.0)
 CHART_APG = tuple(np.round(np.linspace(0.075, 1.5, 20), 6))
 
 
-def slenderness_chart(shapes=("rect", "sine", "ricker-sym", "ricker-anti"), p_tp=CHART_PTP,
-                      ap_over_g=CHART_APG, *, criterion="overturn", n_scan=N_SCAN, rtol=RTOL,
-                      model="fast"):
+def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
+                      ap_over_g=CHART_APG, *, criterion="overturn", n_scan=None, rtol=None,
+                      model="fast", settings=DEFAULT_SETTINGS):
     """Fig. 8: exact minimum ``tan(alpha)`` against ``ap/g`` for several ``pTp``, beside Eq. 31.
 
     Returns a :class:`pandas.DataFrame` with columns ``shape, pTp, ap_over_g, exact, eq31,
@@ -159,7 +159,8 @@ def slenderness_chart(shapes=("rect", "sine", "ricker-sym", "ricker-anti"), p_tp
     rows = []
     for shape in shapes:
         results = min_slenderness_batch(shape, pt.ravel(), ag.ravel(), criterion=criterion,
-                                        n_scan=n_scan, rtol=rtol, model=model)
+                                        n_scan=n_scan, rtol=rtol, model=model,
+                                        settings=settings)
         for x, a, r in zip(pt.ravel(), ag.ravel(), results):
             e31 = float(eq31(a * G, 1.0, x))
             rows.append({"shape": shape, "pTp": float(x), "ap_over_g": float(a),
@@ -169,19 +170,19 @@ def slenderness_chart(shapes=("rect", "sine", "ricker-sym", "ricker-anti"), p_tp
 
 
 def plot_chart(frame, path=None, dpi=110):
-    """Draw Fig. 8 from :func:`slenderness_chart`: one panel per shape, Eq. 31 dashed over it."""
+    """Draw Fig. 8 from :func:`slenderness_chart`: one panel per shape, Eq. 31 dashed over it
+    (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is chosen for the caller)."""
     import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     shapes = list(dict.fromkeys(frame["shape"]))
     n = len(shapes)
     ncol = 2 if n > 1 else 1
     nrow = int(math.ceil(n / ncol))
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow), squeeze=False)
+    fig = Figure(figsize=(5.2 * ncol, 4.2 * nrow))
+    axes = fig.subplots(nrow, ncol, squeeze=False)
     ptps = sorted(set(frame["pTp"]))
-    colors = plt.cm.viridis(np.linspace(0, 0.9, len(ptps)))
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, len(ptps)))
     for ax, shape in zip(axes.ravel(), shapes):
         sub = frame[frame["shape"] == shape]
         for c, x in zip(colors, ptps):
@@ -198,5 +199,4 @@ def plot_chart(frame, path=None, dpi=110):
     fig.tight_layout()
     if path is not None:
         fig.savefig(path, dpi=dpi)
-    plt.close(fig)
     return fig

@@ -246,6 +246,9 @@ def test_pair_checks():
         check_pair(a, _rec(121, name="b.AT2"))
     with pytest.raises(pulses.RecordError, match="vertical"):
         check_pair(a, _rec(100, name="b.AT2", vertical=True))
+    late = pulses.Record(np.sin(np.arange(100) * 0.1), 0.01, "b.AT2", t_start=3.0)
+    with pytest.raises(pulses.RecordError, match=r"a\.AT2 and b\.AT2.*different times"):
+        check_pair(a, late)  # added sample by sample, they would be 3 s out of step
     one, two = check_pair(a, _rec(120, name="b.AT2", azimuth=275.0))  # 85 deg apart: accepted
     assert one.npts == two.npts == 100
     assert isinstance(pulses.RecordError("x"), ValueError)
@@ -337,3 +340,25 @@ def test_pipeline_classify_refuses_an_explicit_bad_pair(capsys):
     assert main(["classify", "--pair", str(a), str(b)]) == 1
     err = capsys.readouterr().err
     assert "RSN6_IMPVALL.I_I-ELC180.AT2" in err and "RSN6_2.AT2" in err and "26 samples" in err
+
+
+def test_pipeline_classify_keeps_the_users_files(tmp_path, capsys):
+    """--csv naming an input is refused before any work (exit 2, the input intact); two inputs of
+    the same name in different folders get a PNG each, not one over the other."""
+    import shutil
+
+    from pipeline.cli import main
+
+    src = shared_record("Rinaldi228.AT2")
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    one, two = tmp_path / "a" / "rec.AT2", tmp_path / "b" / "rec.AT2"
+    shutil.copy(src, one)
+    shutil.copy(src, two)
+    before = one.read_bytes()
+    assert main(["classify", str(one), "--csv", str(one)]) == 2
+    assert "one of the input records" in capsys.readouterr().err
+    assert one.read_bytes() == before
+    plots = tmp_path / "plots"
+    assert main(["classify", str(one), str(two), "--pairs", "none", "--plot", str(plots)]) == 0
+    assert sorted(p.name for p in plots.glob("*.png")) == ["rec-2.png", "rec.png"]

@@ -339,9 +339,8 @@ def test_record_width_search_matches_brute_force_synthetic(height):
     assert fast.runs < 600
     # the fine zone run from its top down, stopping at the first batch with a failure, answers as
     # the whole zone run at once (widths below the widest failure cannot move the answer)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(rocking.design, "REC_CHUNK", 10**9)
-        whole = rocking.required_width(height, rec, rule="exact")
+    whole = rocking.required_width(height, rec, rule="exact",
+                                   settings=rocking.design.SearchSettings(record_chunk=10**9))
     assert whole.width == fast.width and whole.runs >= fast.runs
     # and it is a transition: fails just below, survives just above (fast solver and reference)
     for f, expect in [(1 + 1e-6, False), (1 - 1e-6, True)]:
@@ -390,3 +389,16 @@ def test_min_slenderness_top_bisection_same_answer():
         fast = rocking.min_slenderness_batch(shape, ptp, apg, refine="top", ksection=2)
         for a, b in zip(full, fast):
             assert b.tan_alpha == pytest.approx(a.tan_alpha, rel=2e-9)
+
+
+def test_verified_width_never_zero_for_a_very_tall_column(shared_records):
+    """Issue 19: a 1000 m x 1 m column under Rinaldi 228 was reported at width 0 ("adequate"):
+    every width of the scan survived (its floor is the no-uplift width / 1024, 0.8 m).  The
+    search now goes on below the scan until a failure is bracketed: the answer is positive and
+    a transition, checked directly with the solver (fails just below, survives just above)."""
+    rec = pulses.read_record(shared_records / "Rinaldi228.AT2")
+    res = rocking.required_width(1000.0, rec, rule="exact")
+    assert res.width > 0.0 and not res.below_scan
+    for f, expect in [(1 + 1e-6, False), (1 - 1e-6, True)]:
+        blk = Block.from_dimensions(1000.0, res.width * f)
+        assert rocking.simulate(blk, rec, model="fast", history=False).overturned is expect

@@ -481,3 +481,96 @@ def test_unrolled_smooth_pulse_steps_match_the_general_series(shape):
             assert th == pytest.approx(want[0], abs=1e-14 * scale)
             assert wh == pytest.approx(want[1] * h, abs=1e-14 * scale)
     assert checked > 20
+
+
+# ----------------------------------------------------------------------------- bad input, long pulses
+def test_api_rejects_what_it_cannot_use_with_a_value_error():
+    from rocking.errors import RockingInputError
+
+    block = Block.from_dimensions(7.5, 1.8)
+    with pytest.raises(RockingInputError, match="no excitation and the block at rest"):
+        simulate(block, None)
+    with pytest.raises(RockingInputError, match="excitation must be"):
+        simulate(block, "Rinaldi228.AT2")
+    with pytest.raises(RockingInputError, match="p must be positive"):
+        rocking.eq31(0.71 * G, 0.8, -1.381)
+    with pytest.raises(RockingInputError, match="tp must be finite"):
+        rocking.eq20(0.71 * G, math.nan, 1.381)
+    # the engine computes only the forcing kinds it knows: another kind is never guessed
+    from rocking import engine
+
+    e = np.zeros(0)
+    with pytest.raises(RockingInputError, match="no forcing of kind 7"):
+        engine.run(7, 1.0, 1.0, 0.0, e, np.array([0.0, 1.0]), 0.0, 0.0, 1, 1, 1.0, 0.2, 0.9,
+                   0.0, 0.0, False, 1e-7, False, e, e, e, np.zeros(4), False)
+    assert issubclass(RockingInputError, ValueError)
+
+
+def test_a_pulse_of_a_huge_period_runs_in_bounded_memory():
+    """A one-sine of Tp = 1e6 s with ap = 2 g tan(alpha): the grid would hold ~7e6 nodes (the
+    engine's steps are bounded by p h), built and run a part at a time instead.  Quasi-static
+    loading: the block uplifts when ug'' reaches g tan(alpha), at Tp asin(1/2) / (2 pi) = Tp / 12,
+    and, the ground pushing ever harder, overturns at once (a few s of 8.3e4 s)."""
+    import tracemalloc
+
+    block = Block.from_dimensions(7.5, 1.8)
+    tp = 1e6
+    pulse = pulses.OneSine(2.0 * G * block.tan_alpha, tp)
+    tracemalloc.start()
+    res = simulate(block, pulse, history=False)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    # one part's nodes and work arrays (2^20 intervals: ~50 MB), not the ~300 MB of the whole grid
+    assert peak < 80e6
+    assert res.overturned and res.uplifted
+    t_up = tp / 12.0
+    assert t_up < res.t_overturn < t_up + 60.0
+
+
+def test_dop853_tableau_meets_the_order_conditions():
+    """The engine's RK8 tableau (rocking/_dop853.py, data in the project): consistent rows
+    (c_i = sum_j a_ij) and the quadrature conditions sum b_i c_i^k = 1/(k+1) of order 8, to
+    rounding (the coefficients are 16-digit decimals: 1e-15)."""
+    from rocking import _dop853
+
+    assert np.allclose(_dop853.A.sum(axis=1), _dop853.C, rtol=0, atol=4e-15)  # sums of terms up to ~30
+    for k in range(8):
+        assert abs(np.sum(_dop853.B * _dop853.C**k) - 1.0 / (k + 1)) < 1e-15
+
+
+def test_compiled_steps_compute_their_python_source():
+    """The unrolled steps are compiled from their Python source by rocking._straight (LLVM
+    instructions emitted statement by statement).  Without fused multiply-adds (the smooth-pulse
+    steps, the lanes) the compiled step must give the plain Python evaluation's bits exactly; the
+    record steps may fuse a multiply into the add that follows (fastmath 'contract'), which
+    changes each operation by at most half an ulp: 1e-15 relative over a step's sums."""
+    from rocking import _taylor_fixed as tf
+    from rocking import _taylor_lanes as tl
+
+    rng = np.random.default_rng(5)
+    kept = 0
+    for _ in range(50):
+        q, theta, wh = rng.uniform(0.0, 0.04), rng.uniform(0.01, 0.3), rng.uniform(0.001, 0.05)
+        s0, c0 = math.sin(0.2 - theta), math.cos(0.2 - theta)
+        U = rng.uniform(-1.0, 1.0, 30) * 0.3 ** np.arange(30)
+        cf1, cf2 = np.zeros(30), np.zeros(30)
+        got = tf.taylor_smooth_24(U, q, theta, wh, s0, c0, 1e-15, cf1)
+        want = tf._taylor_smooth_24(U, q, theta, wh, s0, c0, 1e-15, cf2)
+        assert got == want and np.array_equal(cf1, cf2)
+        # one lane of lanes_16 against its Python source
+        u0, u1, h = rng.uniform(-1.0, 1.0), rng.uniform(-0.1, 0.1), 0.01
+        om = wh / h
+        th_a, om_a, side = np.array([theta]), np.array([om]), np.array([1.0])
+        sp, cp, pk, bad = np.array([s0]), np.array([c0]), np.zeros(1), np.zeros(1, dtype=np.int64)
+        tl.lanes_16(1, u0, u1, np.ones(1), np.array([q]), h, th_a, om_a, side, sp, cp, pk, 1e-15,
+                    bad)
+        want = tl._lane_16(1.0 * u0, 1.0 * u1, q, theta, om * h, s0, c0, 1e-15, 1.0 / h)
+        if bad[0] == 0:  # kept: the lane's new state is the Python source's, bit for bit
+            kept += 1
+            assert (th_a[0], om_a[0], sp[0], cp[0]) == (want[0], want[1], want[2], want[3])
+        got = tf.taylor_16(u0, u1, q, theta, wh, s0, c0, 1e-15, cf1, True)
+        want = tf._taylor_16(u0, u1, q, theta, wh, s0, c0, 1e-15, cf2, True)
+        assert got[4] == want[4]
+        for a, b in zip(got[:4], want[:4]):
+            assert a == pytest.approx(b, rel=1e-15, abs=1e-17)
+    assert kept > 10

@@ -1,0 +1,272 @@
+"""What the exact design searches share: their settings, the batch solver call, and the generic
+transition finder (scan, then bracketed refinement of every verdict change).
+
+Overturning is not monotonic in either the amplitude or the slenderness, so every exact answer is
+found by a scan fine enough to see the islands (denser just above the highest failure) followed by
+bracketed refinement of every verdict change found (vectorised: all brackets of all problems are
+cut together, one batch-solver call per step).
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .block import Block
+
+#: failure criteria: which verdict of the solver counts as failure
+CRITERIA = ("overturn", "exceed")
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """Settings of the exact design searches (a value: pass a changed copy, ``replace(...)``).
+
+    Pulses (minimum slenderness, critical amplitudes, a pulse's verified width): ``n_scan``
+    uniformly spaced scan points plus a geometric tail of ``n_tail`` points towards zero (the
+    smallest uniform point divided by 2, 4, ... ``2**n_tail``); above the highest failing point
+    found, ``zone_points`` more points over ``zone_fraction`` of its value, repeated while failures
+    keep turning up in the zone's upper half (at most ``zone_rounds`` times: failure slivers just
+    above the main boundary of long pulses are thinner than the coarse step; ``python
+    benchmarks/bench_design.py --brute`` checks the result against a 3000-point brute-force scan,
+    agreement 5e-4 relative on 240 hard cases); brackets cut in ``ksection`` parts per step
+    (fewer batch calls than bisection) until narrower than ``rtol`` relative.
+
+    Records (the verified width, :func:`rocking.widths.record_width`): ``record_scan`` widths
+    geometric from ``top record_low`` to the no-uplift width ``top`` (neighbours 3.3 % apart with
+    the defaults), plus a tail of ``record_tail`` widths halving towards zero
+    (``record_spacing="uniform"``: ``record_scan`` uniform widths up to ``top``, the former scan,
+    kept to compare in benchmarks/bench_design.py).  The fine zone above each candidate answer
+    ``w``: every width of the fixed grid ``top (1 + record_fine)^-k`` in
+    ``(w, w (1 + record_fine_span)]`` is run (0.05 % apart: failing slivers of real records are
+    often thinner than 0.2 %, and lie up to ~25 % above the main transition; README "Design" has
+    the measurements), from its widest width down in batches of ``record_chunk`` (one batch of the
+    batch engine's lanes per core), stopping at the first batch with a failure.  An optional extra
+    zone (``record_zone_points``, off by default: the fine zone covers it) of widths ``w (1 + d)``,
+    ``d`` geometric from ``record_zone_first`` to ``record_zone_fraction``;
+    ``record_zone_first / 4`` is also the bisection tolerance of candidates.  Above the
+    candidate, every gap between scanned widths wider than ``record_gap`` (relative) is halved
+    while either end came within ``record_near`` of tipping (``max|theta|/alpha >=
+    record_near``: isolated failing bands of real records sit where the block nearly overturns);
+    at most ``record_rounds`` rounds (a failure found above the candidate moves it up).
+    """
+
+    n_scan: int = 64
+    n_tail: int = 10
+    zone_points: int = 160
+    zone_fraction: float = 0.15
+    zone_rounds: int = 4
+    ksection: int = 8
+    rtol: float = 1e-9
+    record_scan: int = 128
+    record_low: float = 1.0 / 64
+    record_tail: int = 4
+    record_spacing: str = "geometric"
+    record_fine: float = 5e-4
+    record_fine_span: float = 0.2
+    record_zone_points: int = 0
+    record_zone_first: float = 1e-3
+    record_zone_fraction: float = 0.15
+    record_gap: float = 0.01
+    record_near: float = 0.6
+    record_rounds: int = 12
+    record_chunk: int = 32
+
+    def __post_init__(self):
+        for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
+            if getattr(self, name) < 1 + (name == "ksection"):
+                raise ValueError(f"SearchSettings.{name} is too small: {getattr(self, name)!r}")
+        if not self.rtol > 0:
+            raise ValueError(f"SearchSettings.rtol must be positive, got {self.rtol!r}")
+        if self.record_spacing not in ("geometric", "uniform"):
+            raise ValueError("SearchSettings.record_spacing must be 'geometric' or 'uniform', "
+                             f"got {self.record_spacing!r}")
+
+    def replace(self, **changes) -> "SearchSettings":
+        """A copy with ``changes``; ``None`` values are ignored (keyword arguments left unset)."""
+        changes = {k: v for k, v in changes.items() if v is not None}
+        return dataclasses.replace(self, **changes) if changes else self
+
+
+#: the settings used when none are given
+DEFAULT_SETTINGS = SearchSettings()
+
+
+def _batch(blocks, excitation, scales=None, *, grid=False, model="fast"):
+    """Call :func:`rocking.simulate_many` (looked up at call time: the solver is a sibling module)."""
+    import rocking
+
+    if model in ("fast", "linear"):
+        return rocking.simulate_many(blocks, excitation, scales, grid=grid, model=model)
+    # any other model (the slow "reference" yardstick): one simulate() per run
+    blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
+    scales = np.atleast_1d(np.asarray(1.0 if scales is None else scales, dtype=float))
+    if grid:
+        shape = (len(blocks), scales.size)
+        pairs = [(b, s) for b in blocks for s in scales]
+    else:
+        idx_b, idx_s = np.broadcast_arrays(np.arange(len(blocks)), np.arange(scales.size))
+        shape = idx_b.shape
+        pairs = [(blocks[i], scales[j]) for i, j in zip(idx_b.ravel(), idx_s.ravel())]
+    runs = [rocking.simulate(b, excitation.scaled(float(s)), model=model, history=False)
+            for b, s in pairs]
+
+    class _Result:
+        pass
+
+    res = _Result()
+    for name in ("overturned", "exceeded_alpha", "max_rotation", "max_rotation_ratio"):
+        res.__dict__[name] = np.array([getattr(r, name) for r in runs]).reshape(shape)
+    return res
+
+
+def _failed(result, criterion):
+    if criterion == "overturn":
+        return np.asarray(result.overturned, dtype=bool)
+    return np.asarray(result.exceeded_alpha, dtype=bool) | np.asarray(result.overturned, dtype=bool)
+
+
+def _check_criterion(criterion):
+    if criterion not in CRITERIA:
+        raise ValueError(f"criterion must be one of {CRITERIA}, got {criterion!r}")
+
+
+def _peak(excitation) -> float:
+    """Peak absolute ground acceleration of a pulse or a record, m/s^2."""
+    if hasattr(excitation, "pga"):
+        return float(excitation.pga)
+    return abs(float(excitation.ap))
+
+
+@dataclass
+class _Scan:
+    """Outcome of a scan-and-refine over many independent 1-D problems."""
+
+    brackets: list         # per problem: list of (lo, hi, fail_lo, fail_hi), refined, ascending
+    runs: int              # number of solver runs
+    calls: int             # number of batch-solver calls
+
+
+def _scan_refine(evaluate, x, settings, known=None, zone=True, refine="all", max_iter=100):
+    """Scan every problem on its abscissae ``x`` and refine every verdict change.
+
+    ``evaluate(idx, xs)`` returns the failure verdicts of problems ``idx`` at abscissae ``xs``
+    (1-D arrays of equal length) in one batch.  ``known`` is an optional boolean mask of scan
+    points whose verdict is known to be "survive" without running (e.g. above the uplift limit).
+    With ``zone`` the region just above each problem's highest failing point is scanned densely
+    (``settings.zone_points`` points over ``settings.zone_fraction``).  Brackets are then cut in
+    ``settings.ksection`` parts per step, all together, until narrower than ``settings.rtol``
+    relative; where a step reveals more than one change inside a bracket the highest is followed
+    (so the top fail-to-survive transition is always the highest one found).  ``refine="top"``
+    refines only each problem's top fail-to-survive bracket (``pipeline run``, which needs only
+    the answer); the other changes are then reported at scan resolution.  ``ksection=2``
+    (bisection) needs about half the runs of the default in twice as many batch calls: cheaper
+    when only a few problems are refined at once.
+    """
+    n_zone, rtol = int(settings.zone_points), settings.rtol
+    x = np.asarray(x, dtype=float)
+    n_prob, n_pts = x.shape
+    fail = np.zeros(x.shape, dtype=bool)
+    run = np.ones(x.shape, dtype=bool) if known is None else ~np.asarray(known, dtype=bool)
+    idx, col = np.nonzero(run)
+    runs, calls = int(idx.size), 0
+    if idx.size:
+        fail[idx, col] = evaluate(idx, x[idx, col])
+        calls += 1
+    xs = [x[i] for i in range(n_prob)]
+    fs = [fail[i] for i in range(n_prob)]
+    if zone:
+        top = x[:, -1]
+        todo = [i for i in range(n_prob) if fs[i].any()]
+        prev = {i: -np.inf for i in todo}
+        for _ in range(settings.zone_rounds):
+            pi, px = [], []
+            for i in todo:
+                xf = xs[i][np.nonzero(fs[i])[0][-1]]
+                hi = min(top[i], xf * (1.0 + settings.zone_fraction))
+                z = xf + (hi - xf) * np.arange(1, n_zone + 1) / n_zone
+                z = z[z < top[i]]
+                prev[i] = (xf, hi)
+                pi.append(np.full(z.size, i))
+                px.append(z)
+            if not pi:
+                break
+            pi, px = np.concatenate(pi), np.concatenate(px)
+            if not px.size:
+                break
+            pf = np.asarray(evaluate(pi, px), dtype=bool)
+            runs += int(px.size)
+            calls += 1
+            nxt = []
+            for i in todo:
+                sel = pi == i
+                xx = np.concatenate([xs[i], px[sel]])
+                ff = np.concatenate([fs[i], pf[sel]])
+                order = np.argsort(xx, kind="stable")
+                xs[i], fs[i] = xx[order], ff[order]
+                xf0, hi = prev[i]
+                new_top = xs[i][np.nonzero(fs[i])[0][-1]]
+                if new_top > xf0 + 0.5 * (hi - xf0) and hi < top[i]:
+                    nxt.append(i)
+            todo = nxt
+    # brackets: every change of verdict between neighbouring scan points
+    prob, lo, hi, flo, fhi = [], [], [], [], []
+    for i in range(n_prob):
+        ch = np.nonzero(fs[i][1:] != fs[i][:-1])[0]
+        prob.extend([i] * ch.size)
+        lo.extend(xs[i][ch]), hi.extend(xs[i][ch + 1])
+        flo.extend(fs[i][ch]), fhi.extend(fs[i][ch + 1])
+    prob, lo, hi = np.array(prob, dtype=int), np.array(lo, dtype=float), np.array(hi, dtype=float)
+    flo, fhi = np.array(flo, dtype=bool), np.array(fhi, dtype=bool)
+    if refine == "top":
+        # only the last fail->survive change of each problem; the rest stay at scan resolution
+        top_mask = np.zeros(prob.size, dtype=bool)
+        for i in np.unique(prob):
+            cand = np.nonzero((prob == i) & flo & ~fhi)[0]
+            if cand.size:
+                top_mask[cand[-1]] = True
+        rough = ~top_mask
+        done_p, done_lo, done_hi = [prob[rough]], [lo[rough]], [hi[rough]]
+        done_flo, done_fhi = [flo[rough]], [fhi[rough]]
+        prob, lo, hi, flo, fhi = prob[top_mask], lo[top_mask], hi[top_mask], flo[top_mask], fhi[top_mask]
+    else:
+        done_p, done_lo, done_hi, done_flo, done_fhi = [], [], [], [], []
+    k = int(settings.ksection)
+    frac = np.arange(1, k) / k
+    for _ in range(max_iter):
+        narrow = (hi - lo) <= rtol * np.abs(hi)
+        done_p.append(prob[narrow]), done_lo.append(lo[narrow]), done_hi.append(hi[narrow])
+        done_flo.append(flo[narrow]), done_fhi.append(fhi[narrow])
+        keep = ~narrow
+        prob, lo, hi, flo, fhi = prob[keep], lo[keep], hi[keep], flo[keep], fhi[keep]
+        if not prob.size:
+            break
+        mids = lo[:, None] + (hi - lo)[:, None] * frac[None, :]          # (n, k-1)
+        vm = np.asarray(evaluate(np.repeat(prob, k - 1), mids.ravel()), dtype=bool)
+        runs += int(vm.size)
+        calls += 1
+        pts = np.concatenate([lo[:, None], mids, hi[:, None]], axis=1)   # (n, k+1)
+        ver = np.concatenate([flo[:, None], vm.reshape(-1, k - 1), fhi[:, None]], axis=1)
+        change = ver[:, 1:] != ver[:, :-1]                              # (n, k)
+        bi = np.arange(prob.size)
+        bj = (k - 1) - np.argmax(change[:, ::-1], axis=1)               # highest change
+        lo, hi = pts[bi, bj], pts[bi, bj + 1]
+        flo, fhi = ver[bi, bj], ver[bi, bj + 1]
+    cat = lambda parts, dt: np.concatenate(parts).astype(dt) if parts else np.zeros(0, dt)
+    prob, lo, hi = cat(done_p + [prob], int), cat(done_lo + [lo], float), cat(done_hi + [hi], float)
+    flo, fhi = cat(done_flo + [flo], bool), cat(done_fhi + [fhi], bool)
+    order = np.lexsort((lo, prob))
+    brackets = [[] for _ in range(n_prob)]
+    for m in order:
+        brackets[prob[m]].append((float(lo[m]), float(hi[m]), bool(flo[m]), bool(fhi[m])))
+    return _Scan(brackets=brackets, runs=runs, calls=calls)
+
+
+def _scan_points(top, n_scan, n_tail):
+    """Scan abscissae on ``(0, top]``: a geometric tail towards 0, then ``n_scan`` uniform points."""
+    top = np.asarray(top, dtype=float)[:, None]
+    uniform = np.arange(1, n_scan + 1) / n_scan
+    tail = uniform[0] * 2.0 ** -np.arange(n_tail, 0, -1)
+    return top * np.concatenate([tail, uniform])[None, :]
+

@@ -1,0 +1,388 @@
+"""Sizing a column of given height (SPEC section 5): the width it needs by a closed-form rule
+(solved as a fixed point in the width, since ``p`` depends on it) or by time-history analysis
+(the *verified width*, under a pulse or a whole record)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pulses import G, SHAPES
+
+from .block import Block
+from .frame import check_cap_mass_ratio, frame_p
+from .closed_forms import envelope_rule, eq20, eq31
+from .search import (DEFAULT_SETTINGS, _batch, _check_criterion, _failed, _peak, _scan_points,
+                     _scan_refine)
+
+
+@dataclass
+class RequiredWidth:
+    """Width a column of given height needs.
+
+    ``p`` depends on the width (``R = sqrt(H^2 + B^2)/2``), so the closed-form rules are solved
+    as a fixed point in ``B`` (:attr:`iterations` steps); ``rule="exact"`` is the *verified
+    width*: the smallest width that survives at that width and at every larger one, found by a
+    scan over widths and bracketed refinement of every verdict change (:attr:`transitions`).
+    """
+
+    width: float
+    height: float
+    rule: str
+    iterations: int
+    method: str
+    criterion: str = "overturn"
+    transitions: tuple = ()
+    runs: int = 0
+    eta: float | None = None
+    cap_mass_ratio: float = 0.0
+    #: every width examined survived, down to :attr:`width` (the narrowest examined): the
+    #: answer is at most that width (the search halves the width down to ``2**-DOWN_HALVINGS``
+    #: of the scan's narrowest before it gives up looking for a failure)
+    below_scan: bool = False
+
+    @property
+    def tan_alpha(self) -> float:
+        return self.width / self.height
+
+    @property
+    def block(self) -> Block:
+        return Block.from_dimensions(self.height, self.width, self.eta,
+                                     cap_mass_ratio=self.cap_mass_ratio)
+
+    @property
+    def p(self) -> float:
+        return self.block.p
+
+    @property
+    def alpha(self) -> float:
+        return math.atan2(self.width, self.height)
+
+
+def _p_of(height, width, gamma=0.0):
+    return frame_p(math.sqrt(3.0 * G / (4.0 * math.hypot(height / 2.0, width / 2.0))), gamma)
+
+
+RULES = ("eq31", "envelope", "eq20", "exact")
+
+
+def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
+                   shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
+                   settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0):
+    """The width (m) a column of full ``height`` (m) needs against ``excitation``.
+
+    Parameters
+    ----------
+    height : float
+        Full height H of the column, m.
+    excitation : pulses.Pulse or pulses.Record
+        The design pulse, or (``rule="exact"`` only) a whole record.
+    rule : {"eq31", "envelope", "eq20", "exact"}
+        ``"eq31"``/``"envelope"``/``"eq20"``: the closed form, solved as a fixed point in the
+        width because ``p`` depends on it (``B = H tan(alpha_min(p(B)))``, a contraction; the
+        iteration count is reported).  ``"exact"``: time-history analysis across widths (the
+        *verified width*, see :class:`RequiredWidth`); works for pulses and records.
+    criterion : {"overturn", "exceed"}
+        Failure criterion of ``rule="exact"``.
+    eta : float, optional
+        Restitution for the exact rule (default Eq. 5 at each width).
+    shape : str, optional
+        Shape whose envelope factor to use with ``rule="envelope"`` (default: every shape).
+    lam : float
+        The lambda of Eq. 20 for ``rule="eq20"``.
+    n_scan, n_zone, rtol : int, int, float, optional
+        ``rule="exact"``: scan points up to the no-uplift width ``H peak/g`` (pulse:
+        ``settings.n_scan`` uniform; record: ``settings.record_scan`` geometric), points of the
+        dense zone just above the widest failing width (pulse: ``settings.zone_points`` uniform,
+        0 switches it off; record: an optional extra zone of ``settings.record_zone_points``
+        geometric widths, off by default, next to the fine zone, see :func:`_record_width`), and
+        the relative width of the final bracket; each overrides its field of ``settings``.  For a record only the top transition is refined
+        (its verdicts may change hundreds of times with the width) and the widths scanned are
+        chosen adaptively; the answer holds at the resolution stated in :func:`_record_width`.
+    settings : rocking.search.SearchSettings
+        Settings of the exact searches (default :data:`rocking.search.DEFAULT_SETTINGS`).
+    cap_mass_ratio : float
+        The width of the columns of a rocking frame whose beam has this mass over the columns'
+        total mass (SPEC section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
+
+    Returns
+    -------
+    RequiredWidth
+        ``.width``, ``.tan_alpha``, ``.p``, ``.rule``, ``.iterations``.
+    """
+    height = float(height)
+    if not (math.isfinite(height) and height > 0):
+        raise ValueError(f"height must be positive, got {height!r} m")
+    if rule not in RULES:
+        raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
+    gamma = check_cap_mass_ratio(cap_mass_ratio)
+    if rule == "exact":
+        return _exact_width(height, excitation, criterion=criterion, eta=eta, n_scan=n_scan,
+                            rtol=rtol, model=model, n_zone=n_zone, settings=settings, gamma=gamma)
+    if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
+        raise ValueError(f"rule={rule!r} needs a pulse (ap, Tp); for a whole record fit its pulse "
+                         "first or use rule='exact'")
+    ap, tp = abs(excitation.ap), excitation.tp
+    if rule == "eq31":
+        f = lambda p: eq31(ap, tp, p)
+    elif rule == "eq20":
+        f = lambda p: eq20(ap, tp, p, lam)
+    else:
+        f = lambda p: envelope_rule(ap, tp, p, shape)
+    # B_{k+1} = H f(p(B_k)): f falls as B grows (p falls), so the map is monotone decreasing and
+    # its slope is small (|dB'/dB| = H |f'(p)| |dp/dB| << 1 for columns); it converges in a few
+    # steps.  Started from the no-uplift width H ap/g, an upper bound of the answer.
+    width = height * ap / G
+    for it in range(1, 201):
+        new = height * f(_p_of(height, width, gamma))
+        if abs(new - width) <= 1e-13 * max(height, 1.0):
+            width = new
+            break
+        width = new
+    else:  # pragma: no cover - the map is a strong contraction for any realistic column
+        from scipy.optimize import brentq
+
+        width = brentq(lambda b: b - height * f(_p_of(height, b, gamma)), 0.0,
+                       height * ap / G + 1e-300,
+                       xtol=1e-14)
+    return RequiredWidth(width=float(width), height=height, rule=rule, iterations=it,
+                         method=f"fixed point of {rule} in B (p depends on B): "
+                                f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
+
+
+def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None,
+                 settings=DEFAULT_SETTINGS, gamma=0.0):
+    _check_criterion(criterion)
+    top = height * _peak(excitation) / G       # wider than this the column never uplifts
+    if top <= 0:
+        return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion,
+                             cap_mass_ratio=gamma)
+
+    def runs(widths):
+        return _batch([Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma)
+                       for b in widths], excitation, None, model=model)
+
+    def evaluate(idx, widths):
+        return _failed(runs(widths), criterion)
+
+    is_pulse = getattr(excitation, "shape", "record") in SHAPES
+    if not is_pulse:
+        def evaluate_record(widths):
+            res = runs(widths)
+            return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
+
+        res = _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
+                            settings=settings.replace(record_scan=n_scan, rtol=rtol,
+                                                      record_zone_points=n_zone))
+        res.cap_mass_ratio = gamma
+        return res
+    settings = settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol)
+    x = _scan_points(np.array([top]), settings.n_scan, settings.n_tail)
+    known = np.zeros(x.shape, dtype=bool)
+    known[:, -1] = True
+    scan = _scan_refine(evaluate, x, settings, known=known, refine="all",
+                        zone=settings.zone_points != 0)
+    br = scan.brackets[0]
+    width, n_iter, runs, below_scan = 0.0, scan.calls, scan.runs, False
+    for lo, hi, flo, fhi in br:
+        if flo and not fhi:
+            width = hi
+    if width == 0.0:
+        # nothing scanned failed: look below the narrowest width, halving, for a failure
+        down = x[0, 0] * 2.0 ** -np.arange(1, DOWN_HALVINGS + 1)
+        failed = np.asarray(evaluate(np.zeros(down.size, dtype=int), down), dtype=bool)
+        n_iter, runs = n_iter + 1, runs + down.size
+        if failed.any():
+            lo = down[np.nonzero(failed)[0][0]]
+            hi = 2.0 * lo                       # examined (scan or halving): survives
+            while hi - lo > settings.rtol * hi:
+                mid = 0.5 * (lo + hi)
+                if evaluate(np.zeros(1, dtype=int), np.array([mid]))[0]:
+                    lo = mid
+                else:
+                    hi = mid
+                n_iter, runs = n_iter + 1, runs + 1
+            width = hi
+        else:
+            width, below_scan = down[-1], True
+    return RequiredWidth(
+        width=float(width), height=height, rule="exact", iterations=n_iter,
+        method=(f"verified width: scan of {x.shape[1]} widths up to the no-uplift width "
+                f"{top:.4g} m (denser just above the widest failure), then bracketed "
+                f"refinement of {len(br)} verdict change(s) ({scan.runs} solver runs in "
+                f"{scan.calls} batches)"
+                + ("; no width examined failed: the answer is at most this width"
+                   if below_scan else "")),
+        criterion=criterion, transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br),
+        runs=runs, eta=eta, below_scan=below_scan, cap_mass_ratio=gamma)
+
+
+#: how far below the scan's narrowest width (in halvings) the verified width looks for a failure
+#: when nothing scanned failed
+DOWN_HALVINGS = 40
+
+
+def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SETTINGS):
+    """Verified width under a record: the smallest width above which every scanned width survives.
+
+    A record's verdict can change hundreds of times with the width (slender columns rock
+    chaotically; real records have isolated failing bands well above the main transition), so
+    the answer is defined by the widths examined.  They are chosen to need few runs (a run that
+    survives costs the whole record, and most runs here survive) while looking hardest where a
+    failure is likely:
+
+    The fields named below are those of ``settings`` (:class:`rocking.search.SearchSettings`).
+
+    1. ``record_tail`` widths towards zero and ``record_scan`` widths geometric from ``top`` x
+       ``record_low`` to the no-uplift width ``top`` (known to survive), one batch;
+    2. the bracket above the widest failing width is bisected (so the highest change is the one
+       followed) to ``record_zone_first`` / 4 relative: the candidate ``w``;
+    3. (if ``record_zone_points``) a zone above it: that many widths ``w (1 + d)``, ``d`` geometric from
+       ``record_zone_first`` to ``record_zone_fraction``;
+    4. the fine zone: every width of the fixed grid ``top (1 + record_fine)^-k`` between ``w`` and
+       ``w (1 + record_fine_span)`` not run yet (0.05 % apart, up to 20 % above ``w``), run from
+       the widest down ``record_chunk`` at a time and stopped at the first batch with a
+       failure (the widths below it cannot move the answer);
+    5. above ``w``, every gap between scanned widths wider than ``record_gap`` (relative) is
+       halved, repeatedly, while either end reached ``max|theta|/alpha >= record_near``;
+    6. a failure found in 3-5 moves the candidate up (back to 2; at most ``record_rounds``
+       rounds); finally the top bracket is bisected to ``rtol`` relative.
+
+    Resolution (the caveat): a failing band is found if it is wider than the gap between the
+    scanned widths around it: 0.05 % of ``w`` up to 20 % above the answer, 1 % or less further
+    up wherever the block came near tipping, 3.3 % where it rocked little.  Bands narrower than
+    that can be missed, and so can they by any finite scan: slender columns under real records
+    have failing slivers thinner than 0.05 %, and on 30 real cases a uniform 1500-width scan
+    was itself up to 19 % below the highest failure a 6000-width scan found (README "Design"
+    has the table).  Islands of survival below the widest failure never lower the answer; every
+    verdict change among the scanned widths is in ``transitions`` (the top one refined, the
+    others at scan resolution).
+    ``tests/test_design.py`` checks the answer against dense brute-force scans.
+    """
+    s = settings
+    n_scan, rtol, n_zone = s.record_scan, s.rtol, s.record_zone_points
+    if s.record_spacing == "geometric":
+        low = s.record_low
+        xs = top * np.geomspace(low, 1.0, n_scan)
+    else:
+        low = 1.0 / n_scan
+        xs = top * np.arange(1, n_scan + 1) / n_scan
+    xs = np.concatenate([top * low * 2.0 ** -np.arange(s.record_tail, 0, -1), xs])
+    runs = calls = 0
+    pts_x, pts_f, pts_r = [xs[-1:]], [np.zeros(1, dtype=bool)], [np.zeros(1)]  # top: no uplift
+
+    def run(widths):
+        nonlocal runs, calls
+        widths = np.atleast_1d(np.asarray(widths, dtype=float))
+        f, r = evaluate(widths)
+        runs += widths.size
+        calls += 1
+        pts_x.append(widths)
+        pts_f.append(np.asarray(f, dtype=bool))
+        pts_r.append(np.asarray(r, dtype=float))
+        return pts_f[-1]
+
+    def scanned():
+        x, f, r = np.concatenate(pts_x), np.concatenate(pts_f), np.concatenate(pts_r)
+        order = np.argsort(x, kind="stable")
+        return x[order], f[order], r[order]
+
+    def run_down(widths):
+        """Run ``widths`` from the widest down, ``record_chunk`` at a time, stopping after the
+        first chunk with a failure: narrower widths cannot change the answer (it lies above the
+        widest failure), so they are not run.  Returns whether any failed."""
+        widths = np.sort(np.asarray(widths, dtype=float))[::-1]
+        for k in range(0, widths.size, s.record_chunk):
+            if run(widths[k:k + s.record_chunk]).any():
+                return True
+        return False
+
+    def top_bracket():
+        x, f, _ = scanned()
+        if not f.any():
+            return None
+        j = np.nonzero(f)[0][-1]
+        return x[j], x[j + 1]                     # x[-1] = top survives, so j + 1 exists
+
+    def bisect(lo, hi, tol):
+        while hi - lo > tol * hi:
+            mid = 0.5 * (lo + hi)
+            if run([mid])[0]:
+                lo = mid
+            else:
+                hi = mid
+        return lo, hi
+
+    def near_gaps(w):
+        """Midpoints of the gaps above ``w`` to halve (step 5)."""
+        x, f, r = scanned()
+        sel = x >= w
+        x, r = x[sel], r[sel]
+        wide = (x[1:] - x[:-1]) > s.record_gap * x[:-1]
+        near = np.maximum(r[1:], r[:-1]) >= s.record_near
+        m = np.nonzero(wide & near)[0]
+        return 0.5 * (x[m] + x[m + 1])
+
+    run(xs[:-1])
+    fine_done = np.zeros(0)
+    limited = False
+    br = top_bracket()
+    narrowest = xs[0]
+    for _ in range(DOWN_HALVINGS // 10):
+        if br is not None:
+            break
+        # nothing scanned failed: halve below the narrowest width, ten at a time, until a width
+        # fails (a tall column survives more than its scan's floor, top / 1024, suggests)
+        down = narrowest * 2.0 ** -np.arange(1, 11)
+        run(down)
+        narrowest = down[-1]
+        br = top_bracket()
+    rounds = 0
+    while br is not None and rounds < s.record_rounds:
+        rounds += 1
+        lo, hi = bisect(*br, max(s.record_zone_first / 4.0, rtol))
+        found = False
+        if n_zone > 0:
+            z = hi * (1.0 + np.geomspace(s.record_zone_first, s.record_zone_fraction, int(n_zone)))
+            z = z[z < top]
+            found = bool(z.size) and bool(run(z).any())
+        if not found and s.record_fine > 0:
+            # every width of the fixed fine grid top (1 + s.record_fine)^-k in (hi, hi (1 + s.record_fine_span)]
+            # not run yet (a later round only adds the part above the previous one)
+            k_hi = math.floor(math.log(top / hi) / math.log1p(s.record_fine))
+            k_lo = max(math.ceil(math.log(top / (hi * (1.0 + s.record_fine_span))) / math.log1p(s.record_fine)), 1)
+            z = top * (1.0 + s.record_fine) ** -np.arange(k_lo, k_hi + 1, dtype=float)
+            z = np.setdiff1d(z[(z > hi) & (z < top)], fine_done)
+            if z.size:
+                fine_done = np.union1d(fine_done, z)
+                found = run_down(z)
+        while not found:
+            mids = near_gaps(hi)
+            if not mids.size:
+                break
+            found = bool(run(mids).any())
+        if not found:
+            break
+        br = top_bracket()
+    else:
+        limited = br is not None   # failures were still being found above the candidate
+    width, below_scan = narrowest, True
+    if br is not None:
+        width, below_scan = bisect(*top_bracket(), rtol)[1], False
+    x, f, _ = scanned()
+    ch = np.nonzero(f[1:] != f[:-1])[0]
+    transitions = tuple(float(t) for t in 0.5 * (x[ch] + x[ch + 1]))
+    return RequiredWidth(
+        width=float(width), height=height, rule="exact", iterations=calls,
+        method=(f"verified width: scan of {xs.size} widths up to the no-uplift width {top:.4g} m, "
+                f"then {rounds} round(s) of bisection above the widest failure and checks above "
+                f"it (widths {s.record_fine:.2%} apart up to {s.record_fine_span:.0%} above, "
+                + (f"a zone of {int(n_zone)} widths up to {s.record_zone_fraction:.0%} above, " if n_zone else "")
+                + f"gaps halved to {s.record_gap:.0%} where the block nearly tipped"
+                + ("; round limit reached" if limited else "")
+                + ("; no width examined failed: the answer is at most this width"
+                   if below_scan else "")
+                + f"); {runs} solver runs in {calls} batches"),
+        criterion=criterion, transitions=transitions, runs=runs, eta=eta, below_scan=below_scan)
+
