@@ -50,6 +50,12 @@ def add_parser(subparsers) -> None:
     p.add_argument("--shapes", nargs="+", metavar="SHAPE",
                    help="pulse shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: "
                         "the fitter's default set)")
+    p.add_argument("--force", action="store_true",
+                   help="compute every record again; by default a record whose report in --out was "
+                        "made from the same file content, options and version is kept")
+    p.add_argument("--log", metavar="FILE",
+                   help="append one JSON line per record to FILE (record, status, seconds, model, "
+                        "worker), to watch a long batch")
     add_record_options(p)
     site.add_options(p)
     add_common(p, DEFAULT_OUT)
@@ -104,5 +110,5 @@ def main(args) -> int:
                             "(a folder gives the files directly in it)")
     tasks = site.tasks_from_args(args, paths, columns, options)
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
-                  quiet=args.quiet, tasks=tasks)
+                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
     return summary.exit_code

@@ -206,6 +206,10 @@ _MANIFEST_HEADER = ("# pipeline run: the files it wrote into this folder (sha256
                     "it replaces or removes no other file\n")
 
 
+#: the resume journal in ``--out`` (:mod:`pipeline.resume`): which records a later run may keep
+RESUME = "pipeline-resume.txt"
+
+
 class NotOurs(OSError):
     """A file in the output folder that ``pipeline run`` did not write (left as it is)."""
 
@@ -280,15 +284,7 @@ class Outputs:
         return True
 
     def _journal(self, line: str) -> None:
-        from . import interrupts
-
-        with interrupts.deferred():
-            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
-            fd = os.open(self.path, flags, 0o666)
-            with os.fdopen(fd, "a", encoding="utf-8") as fh:
-                if fh.tell() == 0:
-                    fh.write(_MANIFEST_HEADER)
-                fh.write(line)
+        append_line(self.path, _MANIFEST_HEADER, line)
 
     def finish(self) -> None:
         """Rewrite the manifest compactly: for each file still there, the content the tool wrote
@@ -305,6 +301,27 @@ class Outputs:
             lines += [f"{d}  {rel}\n" for d in sorted(digests)]
         if lines or os.path.lexists(self.path):
             write_atomic(self.path, _MANIFEST_HEADER + "".join(lines))
+
+
+def append_line(path, header: str, line: str) -> None:
+    """Append ``line`` (ending in a newline) to the journal at ``path``, starting it with ``header``.
+
+    A last line cut by a killed run is ended first, so that it spoils no other line; Ctrl-C waits
+    until the line is written."""
+    from . import interrupts
+
+    with interrupts.deferred():
+        flags = os.O_RDWR | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
+        fd = os.open(path, flags, 0o666)
+        with os.fdopen(fd, "a+b") as fh:
+            end = fh.seek(0, os.SEEK_END)
+            if end == 0:
+                fh.write(header.encode("utf-8"))
+            else:
+                fh.seek(end - 1)
+                if fh.read(1) != b"\n":
+                    fh.write(b"\n")
+            fh.write(line.encode("utf-8"))
 
 
 def _digest(raw: bytes) -> str:
@@ -357,6 +374,9 @@ def columns_markdown(columns, failure_columns) -> str:
         f"- `{MANIFEST}`: the files `pipeline run` wrote here (with a hash of their content). A later "
         "run into this folder replaces or removes only those, and only while their content is still "
         "what it wrote; any other file in its way is left as it is, and the run says so.",
+        f"- `{RESUME}`: for each record computed, a key of its file content, options and "
+        "package version and a hash of its report: a later run into this folder with the same "
+        "command keeps those records and computes only the others (`--force`: all).",
         "",
         "Accelerations are in g (g = 9.81 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
         "digits; a blank cell means the value does not apply (or, in `<shape>_*` columns, that the shape "

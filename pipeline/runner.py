@@ -13,7 +13,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import interrupts, report, site
+from . import interrupts, joblog, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
@@ -25,6 +25,7 @@ class RunSummary:
     n_ok: int
     n_failed: int
     out: pathlib.Path
+    n_reused: int = 0
 
     @property
     def exit_code(self) -> int:
@@ -73,12 +74,14 @@ def make_tasks(paths, columns, options: Options) -> list[Task]:
 def _serial(tasks):
     for task in tasks:
         interrupts.check()
-        yield process_record(task)
+        yield work(task)
 
 
 def init_worker() -> None:
     """Set up a worker process: one compiled-solver thread (the processes share the CPUs; the
     solver's batches then run on one thread, with the same runs and the same results)."""
+    global _in_worker
+    _in_worker = True
     try:
         import numba
 
@@ -94,18 +97,55 @@ def _size(task) -> int:
         return 0
 
 
-def _init_pool_worker() -> None:
+def _init_pool_worker(kill_at: str | None = None) -> None:
     """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
-    the workers itself (a worker interrupted on its own would only print a traceback)."""
+    the workers itself (a worker interrupted on its own would only print a traceback).
+    ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
+    the workers may have been started before it was set)."""
     import signal
+
+    if kill_at is None:
+        os.environ.pop(TEST_KILL_ENV, None)
+    else:
+        os.environ[TEST_KILL_ENV] = kill_at
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     init_worker()
 
 
+#: test-only: a record id at which a worker process (never the main one) kills itself with SIGKILL,
+#: to test what a batch does when a worker dies; not for use
+TEST_KILL_ENV = "PIPELINE_TEST_KILL_WORKER_AT"
+
+_in_worker = False  # set in worker processes by init_worker
+
+
+def work(task: Task) -> dict:
+    """:func:`process_record` as a worker runs it."""
+    if _in_worker and os.environ.get(TEST_KILL_ENV) == task.record_id:
+        import signal
+
+        os.kill(os.getpid(), signal.SIGKILL)
+    import time
+
+    start = time.perf_counter()
+    res = process_record(task)
+    res[joblog.SECONDS] = time.perf_counter() - start
+    res[joblog.WORKER] = joblog.here()
+    return res
+
+
+def worker_failure(task: Task, exc: BaseException) -> dict:
+    """The result of a record whose worker process died (twice) while running it."""
+    return {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
+            "plot": None, "failure": failure(task, "worker", exc)}
+
+
 def _pool(tasks, jobs):
+    import collections
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
 
     plots = any(t.options.plots for t in tasks)
     # Not plain fork: the parent may already run OpenMP threads (numba's parallel solver), and
@@ -114,7 +154,7 @@ def _pool(tasks, jobs):
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     if ctx.get_start_method() == "forkserver":
-        preload = ["pipeline.batch", "pulses", "rocking"]
+        preload = ["pipeline.batch", "pipeline.runner", "pulses", "rocking"]
         if plots:
             preload.append("pipeline.plots")  # matplotlib: ~0.2 s a worker otherwise
         ctx.set_forkserver_preload(preload)
@@ -124,31 +164,79 @@ def _pool(tasks, jobs):
 
         threading.Thread(target=_import_plots, daemon=True).start()
     others = _child_processes()
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker)
+    # the largest files first (longer records take longer), so that no long record is left alone at
+    # the end while the other workers idle; results are placed by index, so the reports do not
+    # depend on this order
+    queue = collections.deque(sorted(tasks, key=_size, reverse=True))
+    # records in the pool when a worker process died: each is run once more alone, so that the
+    # one that kills its worker is known and fails, and the others complete
+    suspects = collections.deque()
+    # at most this many records submitted at once: a few queued per worker keep them busy, and a
+    # dead worker makes only these suspects (and the pool holds no future per record of a long batch)
+    window = 2 * jobs
+    pool = None
     finished = False
+
+    def new_pool():
+        return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
+                                   initargs=(os.environ.get(TEST_KILL_ENV),))
+
     try:
-        # the largest files first (longer records take longer), so that no long record is left
-        # alone at the end while the other workers idle; results are placed by index, so the
-        # reports do not depend on this order
-        futures = {pool.submit(process_record, t): t for t in sorted(tasks, key=_size, reverse=True)}
-        waiting = set(futures)
-        while waiting:
-            # a short wait, so that an interrupt whose exception was swallowed still stops the run
-            done, waiting = wait(waiting, timeout=0.25, return_when=FIRST_COMPLETED)
-            interrupts.check()
-            for fut in done:
+        while queue or suspects:
+            if pool is None:
+                pool = new_pool()
+            if suspects:  # one record alone in the pool
+                task = suspects.popleft()
+                fut = pool.submit(work, task)
+                while not wait([fut], timeout=0.25)[0]:
+                    interrupts.check()
                 try:
                     yield fut.result()
-                except Exception as exc:  # the worker process died (e.g. out of memory)
-                    t = futures[fut]
-                    yield {"index": t.index, "record": t.record_id, "file": t.path, "rows": [],
-                           "plot": None, "failure": failure(t, "worker", exc)}
+                except BrokenProcessPool as exc:  # its second death: a worker failure
+                    pool.shutdown(wait=True)
+                    pool = None
+                    yield worker_failure(task, exc)
+                except Exception as exc:
+                    yield worker_failure(task, exc)
+                continue
+            running: dict = {}
+            broken = False
+            while (queue or running) and not broken:
+                while queue and len(running) < window:
+                    task = queue.popleft()
+                    try:
+                        running[pool.submit(work, task)] = task
+                    except BrokenProcessPool:
+                        queue.appendleft(task)
+                        broken = True
+                        break
+                # a short wait, so that an interrupt whose exception was swallowed still stops the run
+                done, _ = wait(running, timeout=0.25, return_when=FIRST_COMPLETED)
+                interrupts.check()
+                for fut in done:
+                    task = running.pop(fut)
+                    try:
+                        yield fut.result()
+                    except BrokenProcessPool:
+                        suspects.append(task)
+                        broken = True
+                    except Exception as exc:  # e.g. a result that cannot be sent back
+                        yield worker_failure(task, exc)
+            if broken:  # every record still in the broken pool is a suspect
+                for fut, task in running.items():
+                    if fut.done() and not fut.cancelled() and fut.exception() is None:
+                        yield fut.result()
+                    else:
+                        suspects.append(task)
+                pool.shutdown(wait=True)
+                pool = None
         finished = True
     finally:
-        if finished:
-            pool.shutdown(wait=True)
-        else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
-            _stop(pool, others)
+        if pool is not None:
+            if finished:
+                pool.shutdown(wait=True)
+            else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
+                _stop(pool, others)
 
 
 def _child_processes() -> set:
@@ -244,8 +332,12 @@ def dask_client(address: str, jobs: int | None):
     except ImportError:
         raise ArgumentError("--dask needs dask.distributed: pip install 'rocking-columns[dask]'") from None
     if address == "local":
-        cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1,
-                               processes=True, dashboard_address=None, silence_logs=logging.ERROR)
+        import dask
+
+        # a task whose worker dies comes back at once; pipeline.remote retries it once itself
+        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+            cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1,
+                                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
         return Client(cluster), cluster
     try:
         return Client(address, timeout="20s"), None
@@ -254,20 +346,13 @@ def dask_client(address: str, jobs: int | None):
 
 
 def _dask(tasks, address, jobs):
-    from dask.distributed import as_completed
+    from .remote import run_dask
 
     client, cluster = dask_client(address, jobs)
     try:
         client.run(init_worker)
-        futures = client.map(process_record, tasks, pure=False)
-        index = {f.key: t for f, t in zip(futures, tasks)}
-        for fut in as_completed(futures):
-            try:
-                yield fut.result()
-            except Exception as exc:
-                t = index[fut.key]
-                yield {"index": t.index, "record": t.record_id, "file": t.path, "rows": [],
-                       "plot": None, "failure": failure(t, "worker", exc)}
+        workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
+        yield from run_dask(tasks, client, workers)
     finally:
         client.close()
         if cluster is not None:
@@ -359,8 +444,14 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
 
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
-        quiet: bool = False, progress: bool | None = None, tasks=None) -> RunSummary:
+        quiet: bool = False, progress: bool | None = None, tasks=None, force: bool = False,
+        log=None) -> RunSummary:
     """Process ``paths`` for ``columns`` and write every report into ``out``.
+
+    A record whose report in ``out`` was made by an earlier run from the same file content, options
+    and package version is kept, not computed again (:mod:`pipeline.resume`), unless ``force``;
+    ``summary.csv``, ``failures.csv`` and the plots are rebuilt from every record's report.
+    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.joblog`).
 
     Raises
     ------
@@ -376,17 +467,49 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)
     outputs = prepare_output(out, tasks, options.plots, options)
+    try:
+        journal = resume.Journal(out)
+    except report.NotOurs as exc:
+        raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
+    names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
+             resume.RESUME] + site.output_files(options)
+    names += [n for t in tasks for n in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id))]
+    resume.remove_stale_temporaries(out, names)  # left by a run killed while writing
+
+    # what each record's rows are (text as in its report), and why it failed; nothing else is kept
+    # per record, so that memory stays flat over a long batch
+    texts: list[str] = [""] * len(tasks)
+    failures: list[dict | None] = [None] * len(tasks)
+    version = resume.package_version()
+    keys = [resume.task_key(t, version) for t in tasks]
+    todo = []
+    for t, key in zip(tasks, keys):
+        kept = None if force else journal.reusable(t, key, options.plots)
+        if kept is None:
+            journal.drop(t.record_id)
+            todo.append(t)
+        else:
+            texts[t.index] = kept
+    n_reused = len(tasks) - len(todo)
+    try:
+        log = joblog.JobLog(log)
+    except OSError as exc:
+        raise ArgumentError(f"--log {report.display(log)}: {report.display(exc.strerror or exc)}") from None
+    for t in tasks:
+        if texts[t.index]:
+            log.record(None, t.record_id, reused=True)
+
     if progress is None:
         progress = (not quiet) and sys.stderr.isatty()
     bar = None
-    if progress:
+    if progress and todo:
         import shutil
 
         from tqdm import tqdm
 
         # a terminal that reports a size of 0 x 0 (some pseudo-terminals) would hide the bar
         size = shutil.get_terminal_size((100, 24))
-        bar = tqdm(total=len(tasks), unit="record", file=sys.stderr, desc="pipeline run",
+        bar = tqdm(total=len(todo), unit="record", file=sys.stderr, desc="pipeline run",
                    ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
 
     def say(msg):
@@ -397,41 +520,57 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         else:
             print(msg, file=sys.stderr)
 
-    results = [None] * len(tasks)
-    stream = execute(tasks, jobs=jobs, dask=dask)
+    header = report.csv_text(FIELDS, [])
+    stream = execute(todo, jobs=jobs, dask=dask) if todo else _serial([])
     try:
         for res in stream:
-            results[res["index"]] = res
-            _write_record(outputs, tasks[res["index"]], res, options.plots, say)
+            i = res["index"]
+            task = tasks[i]
+            figure = res.get("plot")
+            _write_record(outputs, task, res, options.plots, say)
+            texts[i] = report.csv_text(FIELDS, res["rows"])[len(header):]
+            failures[i] = res["failure"]
+            if res["failure"] or not res["rows"] or keys[i] is None:
+                journal.drop(task.record_id)
+            else:
+                journal.add(task.record_id, keys[i], (header + texts[i]).encode("utf-8"),
+                            figure if options.plots else None)
             if res["failure"]:
                 f = res["failure"]
                 say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
+            log.record(res, task.record_id)
             if bar is not None:
                 bar.update(1)
     finally:
         with interrupts.deferred():
             stream.close()  # an interrupted pool is stopped here, at once
+            log.close()
             if bar is not None:
                 bar.close()
             with contextlib.suppress(OSError):
                 outputs.finish()
 
-    rows = [row for res in results for row in res["rows"]]
-    failures = [res["failure"] for res in results if res["failure"]]
-    outputs.write(report.SUMMARY, report.csv_text(FIELDS, rows))
+    failures = [f for f in failures if f]
+    text = "".join(texts)
+    del texts
+    outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
                   + site.columns_markdown())
+    # the rows as the reports hold them, so that a resumed run writes the same files
+    rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options)
     if options.plots:
         from .plots import summary_figure_png
 
         outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
     outputs.finish()
+    journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out)
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
+        msg += f" ({n_reused} reused from an earlier run, {len(todo)} computed)"
         if n_failed:
             msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
         print(f"{msg}; reports in {report.display(out)}")

@@ -14,7 +14,7 @@ import pytest
 
 import pulses
 import rocking
-from pipeline import report
+from pipeline import report, resume
 from pipeline.batch import FAILURE_FIELDS, Column, Options, record_ids
 from pipeline.cli import main
 from pulses import G
@@ -245,7 +245,8 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
     assert "interrupted" in err and "Traceback" not in err
     files = [p for p in out.rglob("*") if p.is_file()]
     assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
-    files = [p for p in files if p.name != report.MANIFEST]  # the list of files written, not a report
+    # the list of files written and the resume journal, not reports
+    files = [p for p in files if p.name not in (report.MANIFEST, resume.RESUME)]
     for path in files:  # every report written is whole: the header and one row
         rows = read_csv(path)
         assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
@@ -740,7 +741,7 @@ def _check_reports_whole(out):
     files = [p for p in out.rglob("*") if p.is_file()]
     assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
     for path in files:
-        if path.name != report.MANIFEST:
+        if path.name not in (report.MANIFEST, resume.RESUME):
             rows = read_csv(path)
             assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
 

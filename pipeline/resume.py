@@ -1,0 +1,188 @@
+"""Resuming ``pipeline run``: which records of an earlier run into the same ``--out`` can be kept.
+
+A record's report is kept when it was made from the same file content (sha256 of the bytes; both
+files of a pair), the same task (record id, path, columns, options, direction, scale ...) and the
+same package version.  These make the record's *key*.  After each record's report is written, a line
+``<key>  <sha256 of the report>  <record id>`` is appended to :data:`RESUME` in the output folder;
+a later run keeps the record only if that line is there and the report (and its figure, with plots)
+still has the content recorded, so a report edited, removed or half-written by a killed run is
+computed again.  Records that failed have no line and are always computed again.
+
+The per-record reports hold exactly the rows of ``summary.csv`` (the same header and formatting),
+so ``summary.csv`` is rebuilt from the reports' text, and the files computed from the rows
+(``suite.csv``, ``pairs.csv``, the plots) from the rows read back from that text (numbers at the
+reports' 6 digits) in every run: a resumed run and an uninterrupted one write the same bytes.
+"""
+from __future__ import annotations
+
+import contextlib
+import csv
+import hashlib
+import io
+import os
+import pathlib
+import re
+
+from . import report
+
+#: the resume journal in ``--out`` (written by ``pipeline run`` alone, like the manifest)
+RESUME = report.RESUME
+_HEADER = ("# pipeline run: records whose reports may be kept by a later run (key of input, options "
+           "and version; sha256 of the report; sha256 of the figure or -; record id)\n")
+_LINE = re.compile(r"^([0-9a-f]{64})  ([0-9a-f]{64})  ([0-9a-f]{64}|-)  (\S+)$")
+
+
+def package_version() -> str:
+    """The installed package's version, or that of the source tree's ``pyproject.toml``."""
+    try:
+        from importlib.metadata import version
+
+        return version("rocking-columns")
+    except Exception:
+        pass
+    path = pathlib.Path(__file__).resolve().parents[1] / "pyproject.toml"
+    with contextlib.suppress(OSError):
+        m = re.search(r'^version\s*=\s*"([^"]+)"', path.read_text(), re.M)
+        if m:
+            return m.group(1)
+    return "unknown"
+
+
+def file_digest(path) -> str | None:
+    """sha256 of a file's bytes, or None when it cannot be read."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for chunk in iter(lambda: fh.read(1 << 20), b""):
+                h.update(chunk)
+    except (OSError, ValueError):
+        return None
+    return h.hexdigest()
+
+
+def task_key(task, version: str) -> str | None:
+    """The key of ``task`` (see the module's docstring): every field of the task but its place in
+    the batch, the content of its file(s) and ``version``; None when a file cannot be read."""
+    import dataclasses
+
+    contents = [file_digest(p) for p in (task.path, getattr(task, "path2", None)) if p is not None]
+    if None in contents:
+        return None
+    text = repr((version, contents, dataclasses.replace(task, index=0)))
+    return hashlib.sha256(text.encode("utf-8", "surrogateescape")).hexdigest()
+
+
+def _digest(raw: bytes) -> str:
+    return hashlib.sha256(raw).hexdigest()
+
+
+def report_rows_text(raw: bytes) -> str | None:
+    """The rows of a per-record report (its text after the header line), or None if the header is
+    not the present one."""
+    text = raw.decode("utf-8", "surrogateescape")
+    head, sep, rest = text.partition("\n")
+    if not sep or head + "\n" != report.csv_text(_fields(), []):
+        return None
+    return rest
+
+
+def _fields():
+    from .batch import FIELDS
+
+    return FIELDS
+
+
+def typed(cell: str):
+    """A cell of a report as the value it was written from: blank -> None, True/False -> bool, a
+    number -> float when it is written back as the same text (so ``1e5`` or ``007`` in a name stay
+    text), else the text."""
+    if cell == "":
+        return None
+    if cell in ("True", "False"):
+        return cell == "True"
+    try:
+        value = float(cell)
+    except ValueError:
+        return cell
+    return value if report.fmt(value) == cell else cell
+
+
+def rows_from_text(rows_text: str) -> list[dict]:
+    """Rows (dicts of :func:`typed` values) of report text without its header."""
+    fields = _fields()
+    return [{f: typed(c) for f, c in zip(fields, cells)} for cells in csv.reader(io.StringIO(rows_text))]
+
+
+class Journal:
+    """The resume journal of one output folder (see the module's docstring)."""
+
+    def __init__(self, folder):
+        self.folder = pathlib.Path(folder)
+        self.path = self.folder / RESUME
+        self.entries: dict[str, tuple[str, str, str]] = {}  # record id -> (key, report, figure)
+        raw = report._regular_file_bytes(self.path)
+        if raw is None and os.path.lexists(self.path):
+            raise report.NotOurs(f"{report.display(self.path)} is not a file pipeline run wrote")
+        if raw is not None:
+            text = raw.decode("utf-8", "replace")
+            if not text.startswith(_HEADER):
+                raise report.NotOurs(f"{report.display(self.path)} was not written by pipeline run")
+            for line in text.splitlines()[1:]:  # a line cut by a killed run does not match
+                m = _LINE.match(line)
+                if m:
+                    self.entries[m.group(4)] = m.group(1, 2, 3)
+
+    def reusable(self, task, key: str | None, plots: bool) -> str | None:
+        """The rows text of ``task``'s report if it can be kept, else None."""
+        entry = self.entries.get(task.record_id)
+        if key is None or entry is None or entry[0] != key:
+            return None
+        raw = report._regular_file_bytes(self.folder / report.record_csv_name(task.record_id))
+        if raw is None or _digest(raw) != entry[1]:
+            return None
+        if plots:
+            fig = report._regular_file_bytes(self.folder / report.record_plot_name(task.record_id))
+            if fig is None or entry[2] == "-" or _digest(fig) != entry[2]:
+                return None
+        return report_rows_text(raw)
+
+    def add(self, record_id: str, key: str, report_raw: bytes, figure_raw: bytes | None) -> None:
+        """Note that ``record_id``'s report (and figure) were written from ``key``."""
+        entry = (key, _digest(report_raw), _digest(figure_raw) if figure_raw is not None else "-")
+        self.entries[record_id] = entry
+        report.append_line(self.path, _HEADER, f"{entry[0]}  {entry[1]}  {entry[2]}  {record_id}\n")
+
+    def drop(self, record_id: str) -> None:
+        self.entries.pop(record_id, None)
+
+    def finish(self, record_ids) -> None:
+        """Rewrite the journal with the entries of ``record_ids`` only, in that order."""
+        lines = [f"{e[0]}  {e[1]}  {e[2]}  {rid}\n" for rid in record_ids
+                 for e in [self.entries.get(rid)] if e is not None]
+        if lines or os.path.lexists(self.path):
+            report.write_atomic(self.path, _HEADER + "".join(lines))
+
+
+def remove_stale_temporaries(folder, names) -> int:
+    """Remove temporary files a killed run left in ``folder`` while writing one of ``names``
+    (paths relative to ``folder``): ``.<name>.XXXXXXXX.tmp``, as :func:`report.write_atomic` makes
+    them.  Returns how many were removed."""
+    folder = pathlib.Path(folder)
+    prefixes: dict[pathlib.Path, set[str]] = {}
+    for rel in names:
+        p = folder / rel
+        prefixes.setdefault(p.parent, set()).add(f".{p.name[:40]}.")
+    removed = 0
+    for parent, starts in prefixes.items():
+        try:
+            listing = os.listdir(parent)
+        except OSError:
+            continue
+        for name in listing:
+            if name.startswith(".") and name.endswith(".tmp"):
+                body = name[:-4]
+                if any(body.startswith(s) and re.fullmatch(r"[a-z0-9_]{8}", body[len(s):]) for s in starts):
+                    with contextlib.suppress(OSError):
+                        os.unlink(parent / name)
+                        removed += 1
+    return removed
