@@ -6,6 +6,7 @@ its Markdown is compared with tables written out by hand from those numbers.
 from __future__ import annotations
 
 import importlib
+import math
 import inspect
 
 from benchmarks import common, results
@@ -73,3 +74,16 @@ def test_write_report_puts_machine_and_sections_in_order(tmp_path):
     failed = text.index("## Section `solver` failed\n\n`RuntimeError: boom`")
     assert failed < text.index("## 6. `pipeline run` throughput") < text.index("*(section measured in 12 s)*")
     assert "| warm, records/s | 1.50 | 2.75 |" in text
+
+
+def test_work_precision_table_from_plain_results():
+    res = {"fast taylor, 8 steps/Tp": dict(errors=[1e-8, 2e-8], wrong=0, time=1e-4, best=9e-5, n=2, kind="fast",
+                                           family="fast taylor", slow=False),
+           "reference": dict(errors=[], wrong=0, time=math.nan, best=math.nan, n=2, kind="reference",
+                             family="reference", slow=True),
+           "usual": dict(errors=[1e-3], wrong=1, time=0.1, best=0.1, n=2, kind="usual", family="usual RK45", slow=True)}
+    # max error 2e-8, median of (1e-8, 2e-8) = 1.5e-8; a slow setting is timed once, the reference is the yardstick
+    assert results.wp_table(res, 0.5)[2:] == [
+        "| fast taylor, 8 steps/Tp | 2 | 100 µs (90 µs) | 2.0e-08 | 1.5e-08 | 0 |",
+        "| reference | 2 | 500 ms | (the yardstick) | | |",
+        "| usual | 2 | 100 ms (one run) | 1.0e-03 | 1.0e-03 | 1 |"]
