@@ -44,7 +44,7 @@ def make_pair(seed: int = 2007) -> tuple[Record, Record]:
 
 
 def calibration() -> float:
-    """The workload ``benchmarks/run.py`` calibrates with: a 20,000-step Python loop (s, best of 5)."""
+    """The workload ``benchmarks/common.py`` calibrates with: a 20,000-step Python loop (s, best of 5)."""
     def loop():
         s = 0.0
         for i in range(20000):
@@ -95,7 +95,7 @@ def main(argv=None) -> None:
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
     print(f"load average {' '.join(f'{x:.1f}' for x in os.getloadavg())}; calibration "
-          f"(20,000-step Python loop, as benchmarks/run.py): {1e3 * calibration():.2f} ms")
+          f"(20,000-step Python loop, as benchmarks/common.py): {1e3 * calibration():.2f} ms")
     print(f"pair of {DURATION:g} s records at {1 / DT:g} Hz ({first.npts} samples each): "
           f"pulse-like {result.is_pulse}, Tp {result.tp:.2f} s, orientation {result.orientation:.1f} deg")
     print(f"first call: {1e3 * cold_wall:.1f} ms wall, {1e3 * cold_cpu:.1f} ms CPU")

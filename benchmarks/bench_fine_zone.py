@@ -117,7 +117,7 @@ def cases():
 
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
     from bench_pipeline import make_records
-    from run import RECORDS_DIR
+    from common import RECORDS_DIR
 
     out = []
     if RECORDS_DIR.is_dir():

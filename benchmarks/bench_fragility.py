@@ -41,7 +41,7 @@ def main(argv=None):
     from pulses import G
 
     sys.path.insert(0, str(HERE))
-    from run import RECORDS_DIR
+    from common import RECORDS_DIR
 
     paths = sorted(RECORDS_DIR.glob("*.AT2")) if RECORDS_DIR.is_dir() else []
     if not paths:

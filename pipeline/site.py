@@ -92,14 +92,16 @@ def classification_fields(record, other=None, pair_fields=None) -> tuple[dict, s
     """
     from .cmd_classify import classify_fields
 
+    blank = dict.fromkeys(["pulse_like", "velocity_pulse_indicator", "velocity_tp_s",
+                           "orientation_deg", "azimuth_deg"])
+    if pair_fields and "error" in pair_fields:  # the pair's classification failed: no direction
+        return blank, f"velocity-pulse classification of the pair failed: {pair_fields['error']}"
     if pair_fields:
         fields = dict(pair_fields)
     else:
         try:
             fields = classify_fields(record, other)
         except Exception as exc:  # an unusual record: designed all the same, and said so
-            blank = dict.fromkeys(["pulse_like", "velocity_pulse_indicator", "velocity_tp_s",
-                                   "orientation_deg", "azimuth_deg"])
             return blank, f"velocity-pulse classification failed: {' '.join(str(exc).split())}"
     return fields, (None if fields.get("pulse_like") else NOT_PULSE_WARNING)
 
@@ -361,7 +363,7 @@ def make_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale
         try:
             first, second = pulses.read_pair(a, b, **opts)
             fields = _pair_classification(first, second)
-            angles = directions(fields["orientation_deg"], n_directions)
+            angles = directions(fields.get("orientation_deg"), n_directions)
         except pulses.RecordError as exc:
             if not explicit and _both_readable(a, b, opts):
                 say(f"pipeline run: note: {exc}; designing {a} and {b} one by one")
@@ -384,12 +386,14 @@ def make_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale
 
 
 def _pair_classification(first, second) -> dict:
+    """The pair's velocity-pulse fields; where the classification fails, ``{"error": reason}``:
+    the pair is then designed in its recorded components and every row says why."""
     from .cmd_classify import classify_fields
 
     try:
         return classify_fields(first, second)
-    except Exception:
-        return {}
+    except Exception as exc:
+        return {"error": " ".join(str(exc).split()) or type(exc).__name__}
 
 
 def _both_readable(a, b, opts) -> bool:

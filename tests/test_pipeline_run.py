@@ -407,12 +407,10 @@ def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
     out2 = tmp_path / "dask"
     assert main(["run", *subset, *BATCH_ARGS, "--out", str(out2), "--dask", "local", "--jobs", "2"]) == 1
     produced = tree(out2)
-    # the files over the whole batch (summary, failures, pairs, suite) hold only the subset here
-    whole_batch = ("summary.csv", "failures.csv", "pairs.csv", "suite.csv")
     for name in produced:
-        if name.endswith(".csv") and name not in whole_batch:
+        if name.endswith(".csv") and name not in ("summary.csv", "failures.csv", "pairs.csv", "suite.csv"):
             assert produced[name] == (out / name).read_bytes(), name
-    assert sum(n.endswith(".csv") for n in produced) == 5 + 4
+    assert sum(n.endswith(".csv") for n in produced) == 5 + 4  # records, summary, failures, pairs, suite
     fail = read_csv(out2 / "failures.csv")
     assert fail == [f for f in read_csv(out / "failures.csv") if f["record"] == "missing"]
 

@@ -278,3 +278,12 @@ def test_suite_and_fragility_plots():
     fp = rocking.fragility([0.5, 1.0, 2.0], measure="pga")
     png = fragility_figure_png({"2x0.35": (fs, fp, [])})
     assert imread(io.BytesIO(png)).shape[1] >= 1000
+
+
+def test_a_pair_whose_classification_fails_is_designed_in_its_components_and_says_why():
+    from pipeline.site import classification_fields, directions
+
+    fields, warning = classification_fields(None, pair_fields={"error": "too short"})
+    assert set(fields.values()) == {None}  # no pulse columns made up
+    assert warning == "velocity-pulse classification of the pair failed: too short"
+    assert directions(None) == [(0.0, "component-1"), (90.0, "component-2")]
