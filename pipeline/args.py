@@ -36,6 +36,20 @@ def add_record_options(parser) -> None:
                                         "id or channel")
 
 
+def add_pair_options(parser, *, default: str, action: str) -> None:
+    """Add ``--pair A B`` (repeatable) and ``--pairs auto|none`` (pairing the horizontal components
+    of one station, as :func:`pulses.pair_files` does); ``action`` says what is done with a pair
+    and ``default`` is the ``--pairs`` default."""
+    parser.add_argument("--pair", nargs=2, action="append", default=[], metavar=("A", "B"),
+                        help=f"{action} A and B as the two horizontal components of one station "
+                             "(angles measured from A towards B); repeatable")
+    described = {"auto": "pair the other files from their names and headers, verticals left out",
+                 "none": "every file is one component"}
+    parser.add_argument("--pairs", choices=["auto", "none"], default=default,
+                        help="; ".join(f"{k}{' (default)' if k == default else ''}: {v}"
+                                       for k, v in described.items()))
+
+
 def record_options(args) -> dict:
     """Keyword arguments of :func:`pulses.read_record` from the options of
     :func:`add_record_options` (checked: :class:`ArgumentError` for a bad value)."""

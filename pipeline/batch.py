@@ -19,9 +19,12 @@ import time
 from dataclasses import dataclass, field
 
 from . import site
-from .report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
+from .report import COLUMNS_MD, FAILURES, FIT_TOLERANCE, SHAPE_NAMES, SUMMARY, Columns, _shape_key
 
-RESERVED_IDS = {"summary", "failures", "columns", "pairs", "suite", "fragility", "fragility_curve"}
+#: record ids that would collide with the run's own reports (their names without extension)
+RESERVED_IDS = {name.rsplit(".", 1)[0] for name in
+                (SUMMARY, FAILURES, COLUMNS_MD, site.PAIRS_CSV, site.SUITE_CSV, site.FRAGILITY_CSV,
+                 site.FRAGILITY_CURVE_CSV)}
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import sys
 
-from .args import ArgumentError, add_record_options, record_options
+from .args import ArgumentError, add_pair_options, add_record_options, record_options
 
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
@@ -55,12 +55,7 @@ def add_parser(subparsers) -> None:
                     "when some could not be read or paired, 2 for bad arguments.")
     p.add_argument("files", nargs="*", metavar="FILE",
                    help="record files (AT2, SAC, MiniSEED, K-NET, text ...) or folders of them")
-    p.add_argument("--pair", nargs=2, action="append", default=[], metavar=("A", "B"),
-                   help="classify A and B as the two horizontal components of one station "
-                        "(orientation measured from A towards B); repeatable")
-    p.add_argument("--pairs", choices=["auto", "none"], default="auto",
-                   help="auto (default): pair the other files from their names and headers and "
-                        "leave verticals out; none: classify every file as one component")
+    add_pair_options(p, default="auto", action="classify")
     add_record_options(p)
     p.add_argument("--csv", metavar="FILE", help="write one row per pair or component to this CSV file")
     p.add_argument("--json", action="store_true", help="print the rows as JSON instead of a table")

@@ -396,9 +396,12 @@ def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> rep
         written += [report.record_plot_name(t.record_id) for t in tasks]
     inputs = {}
     for t in tasks:
-        with contextlib.suppress(OSError, ValueError):
-            st = os.stat(t.path)
-            inputs[(st.st_dev, st.st_ino)] = t.path
+        for path in (t.path, t.path2):  # both files of a pair are inputs
+            if path is None:
+                continue
+            with contextlib.suppress(OSError, ValueError):
+                st = os.stat(path)
+                inputs[(st.st_dev, st.st_ino)] = path
     for rel in written:
         try:
             st = os.stat(out / rel)
@@ -407,7 +410,7 @@ def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> rep
         if (st.st_dev, st.st_ino) in inputs:
             raise ArgumentError(f"the report {report.display(out / rel)} would overwrite the input "
                                 f"{report.display(inputs[(st.st_dev, st.st_ino)])}; choose another --out")
-    for rel in fixed[:3] + fixed[4:]:
+    for rel in (f for f in fixed if f != report.MANIFEST):  # the manifest vouches for the rest
         try:
             outputs.check(rel)
         except report.NotOurs as exc:

@@ -172,12 +172,9 @@ def add_options(parser) -> None:
     """The site options of ``pipeline run``."""
     import argparse
 
-    parser.add_argument("--pair", nargs=2, action="append", default=[], metavar=("A", "B"),
-                        help="design for A and B as the two horizontal components of one station, "
-                             "in several directions (angles from A towards B); repeatable")
-    parser.add_argument("--pairs", choices=["auto", "none"], default="none",
-                        help="auto: pair the other files from their names and headers (as pipeline "
-                             "classify; verticals left out); none (default): every file is one component")
+    from .args import add_pair_options
+
+    add_pair_options(parser, default="none", action="design, in several directions, for")
     parser.add_argument("--directions", metavar="N", default="0",
                         help="for pairs, add N evenly spaced directions over 0-180 deg to the two "
                              "components, the velocity-pulse direction and its normal")
