@@ -37,7 +37,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
 from scipy import fft as sfft
 
 from .baseline import pgv as _pgv
@@ -489,6 +488,8 @@ class Background:
         self.dt = float(dt)
         segment = SEGMENT if segment is None else segment
         nseg = int(min(resid.size, max(16, round(segment / dt))))
+        from scipy import signal  # here, not at import: scipy.signal alone takes ~1.4 s to import
+
         self.freq, power = signal.welch(resid, fs=1.0 / dt, window="hann", nperseg=nseg, detrend="constant")
         # below two frequency steps the segments (their means removed) cannot measure the
         # power: it is taken as no lower than there

@@ -37,7 +37,6 @@ from functools import lru_cache
 import numpy as np
 import pywt
 from scipy import fft as sfft
-from scipy import signal as ssignal
 
 from .errors import RecordError
 from .record import Record
