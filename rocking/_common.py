@@ -90,18 +90,9 @@ class BatchResult:
 
 
 def _pulse_extrema(pulse: Pulse) -> list[float]:
-    """Times (s) of the extrema of the pulse's acceleration inside its support."""
-    if pulse.shape == "sine":
-        taus = [0.25, 0.75]
-    elif pulse.shape == "ricker-sym":
-        x = math.sqrt(1.5) / math.pi
-        taus = [-x, 0.0, x]
-    elif pulse.shape == "ricker-anti":
-        c = math.sqrt(3.0) / (2.0 * math.pi)
-        taus = [sgn * math.sqrt(3.0 + d * math.sqrt(6.0)) * c for sgn in (-1, 1) for d in (-1, 1)]
-    else:
-        taus = []
-    return [pulse.t0 + tau * pulse.tp for tau in taus]
+    """Times (s) of the extrema of the pulse's acceleration inside its support (the shape knows
+    them: :attr:`pulses.Pulse.extrema`)."""
+    return list(pulse.extrema)
 
 
 def _free_rocking_horizon(block: Block) -> float:
