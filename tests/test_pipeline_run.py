@@ -422,7 +422,11 @@ def test_demo_from_another_directory(tmp_path):
                           cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "5 of 5 records processed" in proc.stdout
-    assert proc.stderr == ""  # no progress bar when stderr is not a terminal
+    # no progress bar when stderr is not a terminal; on a fresh install the solver's one-line
+    # compilation notice (once per process that compiles) is the only thing said there
+    from rocking._compiling import MESSAGE
+
+    assert [line for line in proc.stderr.splitlines() if line != MESSAGE] == []
     out = tmp_path / "demo-output"
     rows = read_csv(out / "summary.csv")
     assert len(rows) == 5 and {r["column"] for r in rows} == {"7.5x1.8"}
