@@ -87,9 +87,11 @@ class Block:
                    cap_mass_ratio=gamma)
 
     @classmethod
-    def from_tan_alpha(cls, p: float, tan_alpha: float, eta: float | None = None) -> "Block":
-        """Block of frequency parameter ``p`` (rad/s) and slenderness ``tan(alpha) = B/H``."""
-        return cls(p, math.atan(tan_alpha), eta)
+    def from_tan_alpha(cls, p: float, tan_alpha: float, eta: float | None = None, *,
+                       cap_mass_ratio: float = 0.0) -> "Block":
+        """Block of frequency parameter ``p`` (rad/s) and slenderness ``tan(alpha) = B/H``; with
+        ``cap_mass_ratio``, a rocking frame whose (frame's) ``p`` is given."""
+        return cls(p, math.atan(tan_alpha), eta, cap_mass_ratio=cap_mass_ratio)
 
     @property
     def R(self) -> float:

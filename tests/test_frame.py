@@ -241,3 +241,15 @@ def test_bad_cap_mass_ratio():
     for bad in (-0.1, math.nan, math.inf, "x"):
         with pytest.raises(ValueError, match="cap_mass_ratio"):
             Block.from_dimensions(H, B, cap_mass_ratio=bad)
+
+
+def test_from_tan_alpha_keeps_a_frame():
+    import math
+
+    import rocking
+    from rocking.frame import eta_frame
+
+    frame = rocking.Block.from_tan_alpha(1.2, 0.2, cap_mass_ratio=2.0)
+    # the frame's restitution (SPEC section 8), not the lone column's Eq. 5
+    assert frame.eta == eta_frame(math.atan(0.2), 2.0) < rocking.eta_housner(math.atan(0.2))
+    assert rocking.Block.from_tan_alpha(1.2, 0.2) == rocking.Block(1.2, math.atan(0.2))
