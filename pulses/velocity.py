@@ -414,7 +414,7 @@ class PulseCandidate:
         return self.velocity - self.pulse
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class PulseClassification:
     """Result of :func:`classify_pulse`.
 
@@ -444,15 +444,6 @@ class PulseClassification:
     """
 
     name: str
-    is_pulse: bool
-    indicator: float
-    tp: float
-    pgv: float
-    pgv_ratio: float
-    energy_ratio: float
-    late: bool
-    arrival: float
-    orientation: float
     azimuth: float | None
     candidates: tuple = field(repr=False)
     chosen: int = 0
@@ -462,6 +453,22 @@ class PulseClassification:
     @property
     def candidate(self) -> PulseCandidate:
         return self.candidates[self.chosen]
+
+    def __repr__(self):
+        return (f"PulseClassification(name={self.name!r}, is_pulse={self.is_pulse}, "
+                f"indicator={self.indicator:.4g}, tp={self.tp:.4g} s, pgv={self.pgv:.4g} m/s, "
+                f"orientation={self.orientation:.4g} deg, azimuth={self.azimuth})")
+
+    # the chosen candidate's values (it is pulse-like exactly when some candidate is)
+    is_pulse = property(lambda self: self.candidate.is_pulse)
+    indicator = property(lambda self: self.candidate.indicator)
+    tp = property(lambda self: self.candidate.tp)
+    pgv = property(lambda self: self.candidate.pgv)
+    pgv_ratio = property(lambda self: self.candidate.pgv_ratio)
+    energy_ratio = property(lambda self: self.candidate.energy_ratio)
+    late = property(lambda self: self.candidate.late)
+    arrival = property(lambda self: self.candidate.arrival)
+    orientation = property(lambda self: self.candidate.orientation)
 
     @property
     def pulse(self) -> np.ndarray:
@@ -649,7 +656,5 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
         azimuth = _azimuth(record)
     name = record.name if other is None else f"{record.name}+{other.name}"
     return PulseClassification(
-        name=name, is_pulse=bool(pulse_like), indicator=c.indicator, tp=c.tp, pgv=c.pgv,
-        pgv_ratio=c.pgv_ratio, energy_ratio=c.energy_ratio, late=c.late, arrival=c.arrival,
-        orientation=c.orientation, azimuth=None if azimuth is None else azimuth % 180.0,
+        name=name, azimuth=None if azimuth is None else azimuth % 180.0,
         candidates=tuple(candidates), chosen=chosen, t_start=record.t_start, dt=dt)
