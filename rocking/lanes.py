@@ -35,8 +35,9 @@ from ._compiling import compiling_notice
 from ._taylor_fixed import taylor_fixed
 from ._taylor_lanes import ORDERS, lanes_step
 from .engine import (HALF_PI, N_STAGES, NMAX, NODAL, OVERTURNED, REST, ROCKING, TAYLOR,
-                     TAYLOR_EPS, WORK_SIZE, _first_crossing, _hermite, _step_peak,
-                     as_input, check_kind, corner_sincos, energy_verdict, run_core)
+                     TAYLOR_EPS, WORK_SIZE, Dynamics, Forcing, Grid, Rocker, Settings,
+                     Start, _first_crossing, _hermite, _step_peak, as_input, check_kind,
+                     corner_sincos, energy_verdict, run_core)
 
 #: runs stepped together at most (a chunk; the rocking ones are kept first, so that one loop over
 #: the first ``n_rocking`` lanes steps them all).  Measured per run and step at order 8: 45 ns for
@@ -116,9 +117,10 @@ def _turn(order, a, uval, j, ta, h, theta, omega, side, sa, ca, p, cf, kt, kw):
     lo, _, _ = _first_crossing(c0, c1h, c2, c3, side, 0.0)
     if lo >= 0.0:
         return False, 0.0, 0.0, 0.0, 1.0, 0.0
-    peak = _step_peak(np.int64(NODAL), a, 1.0, 0.0, uval, j, ta, ta + h, ta, h, theta, omega,
-                      th2, om2, side, p, sa, ca, np.bool_(False), np.int64(TAYLOR), kt, kw, h,
-                      cf, order)
+    peak = _step_peak(Forcing(np.int64(NODAL), a, np.float64(1.0), np.float64(0.0)), uval, j, ta,
+                      ta + h, ta, h, theta, omega, th2, om2, side,
+                      Dynamics(p, sa, ca, np.bool_(False), np.int64(TAYLOR)), kt, kw, h, cf, order,
+                      np.float64(0.0))
     return True, th2, om2, s1, c1, max(peak, abs(th2))
 
 
@@ -155,7 +157,11 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
     cf = np.zeros(NMAX + 3)
     empty = np.zeros(0)
     # constants passed to compiled functions as np.int64 / np.bool_: a bare constant is typed as
-    # a literal, and numba would compile those functions once more for it
+    # a literal, and numba would compile those functions once more for it; the engine's bundles
+    # that hold arrays made once (each made anew would count references to its arrays)
+    grid = Grid(t_start, h, np.int64(1))
+    settings = Settings(np.bool_(False), np.int64(TAYLOR), zeno_tol, np.bool_(False),
+                        np.bool_(False))
     order = np.int64(ORDERS[2])
     n_low = 0
     n_rocking, n_live = np.int64(0), n
@@ -214,10 +220,10 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
                 # something happens in this interval: the engine takes this lane through it
                 stats[2 if st == ROCKING else 3] += 1
                 (st2, th, om, _, m, ni, _, u, r) = run_core(
-                    np.int64(NODAL), a[i], 1.0, 0.0, uval, empty, t_start, h, j, j + 1,
-                    np.int64(1), F[_P, i], F[_ALPHA, i], F[_ETA, i], theta[i], omega[i],
-                    F[_REST, i], np.bool_(False), zeno_tol, np.bool_(False), empty, empty, empty,
-                    empty, np.bool_(False), np.int64(TAYLOR), work)
+                    Forcing(np.int64(NODAL), a[i], np.float64(1.0), np.float64(0.0)), uval, grid,
+                    empty, Rocker(F[_P, i], F[_ALPHA, i], F[_ETA, i]), settings,
+                    Start(j, theta[i], omega[i], F[_REST, i]), j + 1, empty, empty, empty, empty,
+                    work)
                 if m > peak[i]:
                     peak[i] = m
                 I[_NIMP, i] += ni
@@ -289,11 +295,13 @@ def _kernel(lanes, i0, i1, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_
         return
     work = np.zeros(WORK_SIZE)
     empty = np.zeros(0)
+    settings = Settings(linear, method, zeno_tol, np.bool_(False), np.bool_(False))
+    start = Start(np.int64(0), np.float64(0.0), np.float64(0.0), np.float64(-np.inf))
     for i in range(i0, i1):
         st, th, om, _, mx, ni, _, up, _ = run_core(
-            kind, amp[i], tp, t0, uval, nodes, t_start, h, np.int64(0), n_int, n_sub[i], p[i],
-            alpha[i], eta[i], 0.0, 0.0, -np.inf, linear, zeno_tol, np.bool_(False), empty, empty,
-            empty, empty, np.bool_(False), method, work)
+            Forcing(kind, amp[i], tp, t0), uval, Grid(t_start, h, n_sub[i]), nodes,
+            Rocker(p[i], alpha[i], eta[i]), settings, start, n_int, empty, empty, empty, empty,
+            work)
         if st == OVERTURNED:
             over = True
         elif st == ROCKING:

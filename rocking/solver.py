@@ -301,22 +301,26 @@ def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_t
     size = grid.n_int + 1 if history else 0
     hist_t, hist_th, hist_om = np.empty(size), np.empty(size), np.empty(size)
     impacts = np.empty(4096)
-    out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes, grid.t_start,
-                     grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta, theta0, omega0,
-                     linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om, impacts, history,
-                     method)
+    args = (_engine_forcing(grid), grid.uval, engine.Grid(grid.t_start, grid.h, n_sub), grid.nodes,
+            grid.n_int, engine.Rocker(block.p, block.alpha, block.eta),
+            engine.Settings(linear, method, zeno_tol, stop_at_rest, history),
+            (hist_t, hist_th, hist_om))
+    start = engine.Start(0, theta0, omega0, -math.inf)
+    out = engine.run(*args, impacts, start)
     status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
-        out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, grid.nodes,
-                         grid.t_start, grid.h, grid.n_int, n_sub, block.p, block.alpha, block.eta,
-                         theta0, omega0, linear, zeno_tol, stop_at_rest, hist_t, hist_th, hist_om,
-                         impacts, history, method)
+        out = engine.run(*args, impacts, start)
         status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if history:
         hist_t, hist_th, hist_om = hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist]
     return (status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts[:n_imp],
             hist_t, hist_th, hist_om)
+
+
+def _engine_forcing(grid: _Grid) -> engine.Forcing:
+    """The engine's :class:`rocking.engine.Forcing` of a grid."""
+    return engine.Forcing(grid.kind, grid.amp, grid.tp, grid.t0)
 
 
 #: longest stretch of intervals integrated at once: longer grids (a pulse of a very long period,
@@ -355,9 +359,10 @@ def _run_in_parts(grid, block, theta0, omega0, linear, history, zeno_tol, stop_a
         size = j1 - j0 + 1 if history else 0
         hist = np.empty(size), np.empty(size), np.empty(size)
         imp = np.empty(4096)
-        out = engine.run(grid.kind, grid.amp, grid.tp, grid.t0, grid.uval, nodes, t_start, grid.h,
-                         n_end, n_sub, block.p, block.alpha, block.eta, theta, omega, linear,
-                         zeno_tol, stop_at_rest, *hist, imp, history, method, first, rest_until)
+        out = engine.run(_engine_forcing(grid), grid.uval, engine.Grid(t_start, grid.h, n_sub),
+                         nodes, n_end, engine.Rocker(block.p, block.alpha, block.eta),
+                         engine.Settings(linear, method, zeno_tol, stop_at_rest, history), hist,
+                         imp, engine.Start(first, theta, omega, rest_until))
         status, theta, omega, t_end, mx, ni, n_hist, up, rest_until = out
         max_abs, uplifted = max(max_abs, mx), uplifted or up
         impacts.append(imp[:min(ni, imp.size)])

@@ -439,8 +439,9 @@ def test_forcing_series_of_smooth_pulses_matches_the_pulse(shape):
     U = np.zeros(2 * (engine.NMAX + 3))
     h = pulse.tp / 8
     for t in np.linspace(pulse.support[0], pulse.support[1] - h, 7):
-        n, complete = engine.forcing_series(pulse.kind, pulse.ap / G, pulse.tp, pulse.t0,
-                                            np.zeros(0), 0, 0.0, 1.0, t, h, U, engine.NMAX + 1)
+        n, complete = engine.forcing_series(engine.Forcing(pulse.kind, pulse.ap / G, pulse.tp,
+                                                          pulse.t0), np.zeros(0),
+                                            0, 0.0, 1.0, t, h, U, engine.NMAX + 1)
         assert complete
         x = np.linspace(0.0, 1.0, 9)
         series = np.polynomial.polynomial.polyval(x, U[:n])
@@ -462,8 +463,9 @@ def test_unrolled_smooth_pulse_steps_match_the_general_series(shape):
     for t in np.linspace(pulse.support[0], pulse.support[1], 9):
         h = rng.uniform(0.02, 0.1)
         theta, omega = 0.7 * block.alpha, -0.5 * block.p * block.alpha
-        nu, complete = engine.forcing_series(pulse.kind, pulse.ap / G, pulse.tp, pulse.t0,
-                                             np.zeros(0), 0, 0.0, 1.0, t, h, U, engine.NMAX + 1)
+        nu, complete = engine.forcing_series(engine.Forcing(pulse.kind, pulse.ap / G, pulse.tp,
+                                                           pulse.t0), np.zeros(0),
+                                             0, 0.0, 1.0, t, h, U, engine.NMAX + 1)
         n, _, _ = engine.taylor_series(U, nu, complete, h, theta, omega, 1.0, block.p**2,
                                        math.sin(block.alpha), math.cos(block.alpha), cf, S, C,
                                        False, 0.0, 1.0)
@@ -501,8 +503,10 @@ def test_api_rejects_what_it_cannot_use_with_a_value_error():
 
     e = np.zeros(0)
     with pytest.raises(RockingInputError, match="no forcing of kind 7"):
-        engine.run(7, 1.0, 1.0, 0.0, e, np.array([0.0, 1.0]), 0.0, 0.0, 1, 1, 1.0, 0.2, 0.9,
-                   0.0, 0.0, False, 1e-7, False, e, e, e, np.zeros(4), False)
+        engine.run(engine.Forcing(7, 1.0, 1.0, 0.0), e, engine.Grid(0.0, 0.0, 1),
+                   np.array([0.0, 1.0]), 1, engine.Rocker(1.0, 0.2, 0.9),
+                   engine.Settings(False, engine.TAYLOR, 1e-7, False, False), (e, e, e),
+                   np.zeros(4))
     assert issubclass(RockingInputError, ValueError)
 
 
