@@ -330,9 +330,11 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         resid = x - fits[best][2]
         # a record the plain fit explains to round-off has no background to weight by
         exact = _dot(resid, resid) <= 1e-24 * energy
-        background = None if exact else _estimate_background(x, t, dt, best, fits[best], energy, baseline)
+        background, best_trial = (None, None) if exact else \
+            _estimate_background(x, t, dt, best, fits[best], energy, baseline)
         for shape, (match, trial, p_trial) in ([] if background is None else fits.items()):
-            trial = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
+            trial = best_trial if shape == best else \
+                _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
             fits[shape] = (match, trial, _score(x, t, dt, shape, trial, energy)[1])
     else:
         background = None
@@ -537,9 +539,16 @@ class Background:
 
     def explained(self, x, pulses: dict) -> dict:
         """Share of the weighted energy of the samples ``x`` that each pulse (samples on the same
-        times, by name) explains: ``1 - r' S^-1 r / x' S^-1 x`` with ``r = x - p``."""
+        times, by name) explains: ``1 - r' S^-1 r / x' S^-1 x`` with ``r = x - p``.
+
+        The metric is circular (a Fourier transform of the record): the straight line through
+        the record's first and last samples is removed from ``x`` and ``r`` first, so that the
+        jump from the record's last sample back to its first, which the weights would see as
+        motion at every frequency, does not count, and a pulse cannot gain by cancelling it.
+        """
         nfft = sfft.next_fast_len(x.size, real=True)
         w = self.weights(nfft)
+        x = x - (x[0] + (x[-1] - x[0]) * np.linspace(0.0, 1.0, x.size))
 
         def energy(v):
             V = sfft.rfft(v, nfft)
@@ -568,10 +577,10 @@ def _estimate_background(x, t, dt, shape, fit, energy, baseline):
     lo, hi = pulse_window(shape, tp, t0)
     first = Background(x - p, dt, segment, skip=(lo - SKIP_PERIODS * tp, hi + SKIP_PERIODS * tp))
     if not first.usable:
-        return None
+        return None, None
     trial = _refine_weighted(x, t, dt, shape, match, trial, first, baseline)
     second = Background(x - _score(x, t, dt, shape, trial, energy)[1], dt, segment)
-    return second if second.usable else first
+    return (second if second.usable else first), trial
 
 
 def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
