@@ -77,6 +77,8 @@ SEGMENT_PERIODS = 2.5
 #: background has almost no power.  Half a period holds the true pulse even where the plain fit
 #: is off by its noise limit (Tp within 10 %, t0 within 5 % of Tp in 9 of 10 cases at 30 % noise)
 SKIP_PERIODS = 0.5
+#: length (s) over which the record is tapered to zero at each end for the weighted score
+SCORE_TAPER = 1.0
 #: white noise added to the background's spectrum, as a share of its mean power: bounds the
 #: weight of frequencies where the background has (almost) no power
 LOADING = 1e-3
@@ -541,17 +543,20 @@ class Background:
         """Share of the weighted energy of the samples ``x`` that each pulse (samples on the same
         times, by name) explains: ``1 - r' S^-1 r / x' S^-1 x`` with ``r = x - p``.
 
-        The metric is circular (a Fourier transform of the record): the straight line through
-        the record's first and last samples is removed from ``x`` and ``r`` first, so that the
+        The metric is circular (a Fourier transform of the record): ``x`` and ``r`` are tapered
+        to zero over :data:`SCORE_TAPER` s at each end first (half a Hann window), so that the
         jump from the record's last sample back to its first, which the weights would see as
         motion at every frequency, does not count, and a pulse cannot gain by cancelling it.
         """
         nfft = sfft.next_fast_len(x.size, real=True)
         w = self.weights(nfft)
-        x = x - (x[0] + (x[-1] - x[0]) * np.linspace(0.0, 1.0, x.size))
+        m = max(1, min(x.size // 4, int(round(SCORE_TAPER / self.dt))))
+        taper = np.ones(x.size)
+        ramp = 0.5 - 0.5 * np.cos(np.pi * (np.arange(m) + 0.5) / m)
+        taper[:m], taper[-m:] = ramp, ramp[::-1]
 
         def energy(v):
-            V = sfft.rfft(v, nfft)
+            V = sfft.rfft(v * taper, nfft)
             return float(np.sum(w * (V.real**2 + V.imag**2)))
 
         xx = energy(x)
