@@ -11,12 +11,14 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
 3. **Weight** (``weighting="background"``, an option; the default ``"plain"`` stops after step 2,
-   see the README's "Accuracy on synthetic records" for why): the
-   background's spectrum is estimated from the record away from the best plain fit's pulse
-   (:class:`Background`), each shape is refit by least squares weighted by its inverse
-   (generalised least squares, :func:`_refine_weighted`) unless the record departs from the
-   pulse model there (Hausman's test, :func:`_difference_covariance`), and the candidates are
-   ranked by the share of the record's energy they explain in the same metric.
+   see the README's "Accuracy on synthetic records" for why): the background's spectrum is
+   estimated from the record (:class:`Background`), first away from the best plain fit's pulse,
+   then from the residual of that shape's fit weighted by the first estimate
+   (:func:`_estimate_background`); every other shape is refit by least squares weighted by the
+   inverse of the second (generalised least squares, :func:`_refine_weighted`), each weighted
+   fit kept unless the record departs from the pulse model (Hausman's test,
+   :func:`_difference_covariance`), and the candidates are ranked by the share of the record's
+   energy they explain in the same metric.
 
 A sampled pulse is the pulse evaluated at the sample times, except the rectangular pulse, whose
 point samples do not locate its edges more finely than ``dt``: it is sampled as its average over
@@ -74,8 +76,9 @@ SEGMENT_PERIODS = 2.5
 #: the segments that overlap the best plain pulse's window widened by this many of its periods
 #: on each side are left out of the background's spectrum (:class:`Background`): there the
 #: residual holds the plain fit's own error, whose corners reach frequencies where the
-#: background has almost no power.  Half a period holds the true pulse even where the plain fit
-#: is off by its noise limit (Tp within 10 %, t0 within 5 % of Tp in 9 of 10 cases at 30 % noise)
+#: background has almost no power.  Half a period beyond the window holds the true pulse where
+#: the plain fit is off by its noise limit (t0 within 5 % of Tp in 86 % of the README's cases at
+#: 30 % noise, Tp within 15 % in 76 %)
 SKIP_PERIODS = 0.5
 #: length (s) over which the record is tapered to zero at each end for the weighted score
 SCORE_TAPER = 1.0
@@ -292,11 +295,12 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         the plain share of energy.  ``"background"``: after plain least squares, refine once
         more with the residual weighted by the inverse of the background's spectrum, estimated
         from the record itself (generalised least squares, :class:`Background`), and rank the
-        candidates by the share of the record's energy they explain in that metric; more
+        candidates by the share of the record's energy they explain in that metric: more
         accurate ap and Tp and shapes right more often on synthetic records with band-limited
-        background motion, but with background in 0.1-25 Hz it identifies the shape of short
-        pulses slightly less often, so it is not the default (README, "Accuracy on synthetic
-        records").
+        background motion; not the default yet, because on the README's records it identifies
+        the shape of short pulses in 0.1-25 Hz background slightly less often (98 % against
+        100 % at 15 %; not on other seeds) and costs about twice the plain fit (README,
+        "Accuracy on synthetic records").
 
     Returns
     -------
@@ -565,14 +569,18 @@ class Background:
 
 def _estimate_background(x, t, dt, shape, fit, energy, baseline):
     """The background's spectrum (:class:`Background`) from the record and its best plain fit
-    ``fit = (match, trial, samples)`` of ``shape``, or None if it has no power to weight by.
+    ``fit = (match, trial, samples)`` of ``shape``, and that shape's weighted fit ``(ap, Tp, t0,
+    window)`` with the first estimate (kept as its result); ``(None, None)`` if the residual has
+    no power to weight by.
 
     Two passes.  The plain fit's residual holds its own error where the pulse is, and a
     one-sine's or a rectangle's corners put that error at frequencies where the background has
     almost no power: the first estimate leaves out the segments near the pulse
     (:data:`SKIP_PERIODS`).  The best shape is refit with it; that fit's error being much
     smaller, the spectrum is estimated again from the whole of its residual, which counts the
-    background where it is strongest too: around the pulse, on a real record.  Segments of
+    background where it is strongest too: around the pulse, on a real record; the other shapes
+    are refit with this second estimate (on Rinaldi 228, with the first one the one-sine's Tp
+    would move 4 % from the plain fit's, with the second 2 %).  Segments of
     :data:`SEGMENT` s or :data:`SEGMENT_PERIODS` plain periods if longer, to resolve the
     spectrum down to the pulse's own frequencies.
     """
