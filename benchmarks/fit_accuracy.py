@@ -1,9 +1,10 @@
 """Accuracy of the pulse fitter on synthetic records: the README's error-against-noise table.
 
-``python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain]`` prints a Markdown table (N records
-per shape, Tp and noise level; default 10, fixed seeds; with a noise band LOW-HIGH Hz, only the
-rows pooled over Tp; ``plain``: the fitter's plain least squares, ``weighting="plain"``, instead
-of its default weighted ones).  Each record (:func:`pulses.synthetic.synthetic_record`):
+``python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain] [seed=K]`` prints a Markdown table (N
+records per shape, Tp and noise level; default 10, fixed seeds; with a noise band LOW-HIGH Hz,
+only the rows pooled over Tp; ``plain``: the fitter's plain least squares, ``weighting="plain"``,
+instead of its weighted ones; ``seed=K``: every seed shifted by K, other records than the
+README's, to check that a change is not fitted to those).  Each record (:func:`pulses.synthetic.synthetic_record`):
 one pulse of random polarity, amplitude 2-8 m/s^2 and arrival; 20 s long (8 Tp for long pulses)
 at 200 Hz; background motion band-passed to 0.5-10 Hz whose RMS over the record is the stated
 fraction of ap.  Columns:
@@ -96,14 +97,14 @@ def summarise(rows):
     return out
 
 
-def table(n=10, band=(0.5, 10.0), pooled_only=False, weighting="background"):
+def table(n=10, band=(0.5, 10.0), pooled_only=False, weighting="background", seed=0):
     lines = ["| noise | Tp (s) | cases | ap&Tp <3 % | <5 % | <15 % | shape | arrival | median err ap / Tp | "
              "limit ap / Tp | weighted limit | RMS/limit | search fails |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for k, noise in enumerate(NOISES):
         pooled = []
         for j, tp in enumerate(TPS):
-            rows = cases(noise, tp, n, seed=1000 * k + j, band=band, weighting=weighting)
+            rows = cases(noise, tp, n, seed=1000 * k + j + seed, band=band, weighting=weighting)
             pooled += rows
             if not pooled_only:
                 lines.append(_line(f"{noise:.0%}", f"{tp:g}", summarise(rows)))
@@ -123,9 +124,11 @@ def _line(noise, tp, s):
 
 
 if __name__ == "__main__":
-    # python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain]: N records per cell, noise band in Hz
-    args = [a for a in sys.argv[1:] if a != "plain"]
+    # python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain] [seed=K]: N records per cell,
+    # noise band in Hz, seeds shifted by K
+    args = [a for a in sys.argv[1:] if a != "plain" and not a.startswith("seed=")]
     weighting = "plain" if "plain" in sys.argv[1:] else "background"
+    shift = sum(int(a[5:]) for a in sys.argv[1:] if a.startswith("seed="))
     n = int(args[0]) if args else 10
     band = (float(args[1]), float(args[2])) if len(args) > 2 else (0.5, 10.0)
-    print(table(n, band, pooled_only=len(args) > 2, weighting=weighting))
+    print(table(n, band, pooled_only=len(args) > 2, weighting=weighting, seed=shift))
