@@ -224,3 +224,24 @@ def output_folder(path, what: str = "--out") -> pathlib.Path:
         raise ArgumentError(f"{what} {display(out)} is not a folder this command can write to: "
                             f"{exc.strerror or exc}") from None
     return out
+
+
+class ShapeNames:
+    """The names of the pulse shapes (:data:`pulses.SHAPES`), as ``choices`` of an option, read
+    when first asked (checking a value, printing help): the command line starts without importing
+    ``pulses``.  ``extra``: names accepted besides the shapes (``"all"``).  Give the option a
+    ``metavar``: argparse would otherwise list the choices when the option is declared."""
+
+    def __init__(self, *extra: str):
+        self.extra = extra
+
+    def names(self) -> list[str]:
+        from pulses import SHAPES
+
+        return [*self.extra, *SHAPES]
+
+    def __iter__(self):
+        return iter(self.names())
+
+    def __contains__(self, name) -> bool:
+        return name in self.names()

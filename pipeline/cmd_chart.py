@@ -6,9 +6,7 @@ from __future__ import annotations
 
 import time
 
-from .args import ArgumentError
-
-SHAPES = ["rect", "sine", "ricker-sym", "ricker-anti"]
+from .args import ArgumentError, ShapeNames
 
 
 def _floats(text, what):
@@ -27,7 +25,8 @@ def add_parser(subparsers):
         description="Exact minimum slenderness (time-history analysis, scan + bracketed "
                     "refinement) against ap/g for several pTp and pulse shapes, beside Eq. 31 "
                     "(the paper's Fig. 8).")
-    p.add_argument("--pulse", default="all", choices=["all"] + SHAPES, help="shape(s) (default all)")
+    p.add_argument("--pulse", default="all", choices=ShapeNames("all"), metavar="SHAPE",
+                   help="shape(s): %(choices)s (default all)")
     p.add_argument("--ptp", help="comma-separated pTp values (default 0.5,1,2,3,4,6,10,20)")
     p.add_argument("--apg", help="comma-separated ap/g values (default 20 from 0.075 to 1.5)")
     p.add_argument("--criterion", default="overturn", choices=["overturn", "exceed"])
@@ -40,7 +39,7 @@ def run(args) -> int:
     import rocking
     from rocking.spectrum import CHART_APG, CHART_PTP
 
-    shapes = SHAPES if args.pulse == "all" else [args.pulse]
+    shapes = ShapeNames().names() if args.pulse == "all" else [args.pulse]
     ptp = _floats(args.ptp, "--ptp") if args.ptp else CHART_PTP
     apg = _floats(args.apg, "--apg") if args.apg else CHART_APG
     start = time.perf_counter()

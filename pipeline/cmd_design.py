@@ -9,10 +9,9 @@ import json
 import math
 import sys
 
-from .args import ArgumentError, parse_acceleration, parse_block, parse_length, parse_positive
+from .args import (ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_length,
+                   parse_positive)
 
-SHAPE_NAMES = {"rect": "rectangular", "sine": "one-sine", "ricker-sym": "symmetric Ricker",
-               "ricker-anti": "antisymmetric Ricker"}
 
 
 def add_parser(subparsers):
@@ -25,8 +24,8 @@ def add_parser(subparsers):
     size = p.add_mutually_exclusive_group(required=True)
     size.add_argument("--block", help="HEIGHTxWIDTH in m, e.g. 7.5x1.8")
     size.add_argument("--height", help="full height in m: report the required widths only")
-    p.add_argument("--pulse", default="sine", choices=sorted(SHAPE_NAMES),
-                   help="pulse shape (default sine)")
+    p.add_argument("--pulse", default="sine", choices=ShapeNames(), metavar="SHAPE",
+                   help="pulse shape: %(choices)s (default sine)")
     p.add_argument("--ap", help="pulse amplitude, e.g. 0.71g or 6.96m/s2")
     p.add_argument("--tp", help="pulse period, s")
     p.add_argument("--magnitude", help="design for a near-fault scenario of this Mw (Eq. 6) "
@@ -106,7 +105,7 @@ def run(args) -> int:
         json.dump(out, sys.stdout, indent=2)
         print()
         return 0
-    print(f"Pulse: {SHAPE_NAMES[pulse.shape]}, ap = {ap_g:.4g} g ({abs(pulse.ap):.4g} m/s2), "
+    print(f"Pulse: {pulse.label}, ap = {ap_g:.4g} g ({abs(pulse.ap):.4g} m/s2), "
           f"Tp = {pulse.tp:.4g} s ({origin})")
     if block is not None:
         b = out["block"]

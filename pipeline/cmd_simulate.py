@@ -13,10 +13,8 @@ import json
 import math
 import sys
 
-from .args import (ArgumentError, add_record_options, parse_acceleration, parse_block, parse_positive,
-                   record_options)
-
-PULSES = ("rect", "sine", "ricker-sym", "ricker-anti")
+from .args import (ArgumentError, ShapeNames, add_record_options, parse_acceleration, parse_block,
+                   parse_positive, record_options)
 
 
 def add_parser(subparsers) -> None:
@@ -26,7 +24,8 @@ def add_parser(subparsers) -> None:
                     "and report overturning, max|theta|/alpha, impacts and the model that answered.")
     p.add_argument("--block", required=True, help="HEIGHTxWIDTH in m, e.g. 7.5x1.8")
     source = p.add_mutually_exclusive_group(required=True)
-    source.add_argument("--pulse", choices=PULSES, help="pulse shape (with --ap and --tp)")
+    source.add_argument("--pulse", choices=ShapeNames(), metavar="SHAPE",
+                        help="pulse shape: %(choices)s (with --ap and --tp)")
     source.add_argument("--record", help="accelerogram file (AT2, SAC, MiniSEED, text, ...)")
     p.add_argument("--ap", help="pulse amplitude with its unit, e.g. 0.71g or 6.96m/s2 "
                                 "(negative flips the polarity)")

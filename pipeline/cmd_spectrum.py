@@ -8,9 +8,8 @@ import math
 import re
 import time
 
-from .args import ArgumentError, parse_angle
+from .args import ArgumentError, ShapeNames, parse_angle
 
-SHAPES = ["rect", "sine", "ricker-sym", "ricker-anti"]
 
 
 def _range(text, what):
@@ -38,7 +37,8 @@ def add_parser(subparsers):
                     "slenderness alpha under one pulse shape (the paper's Fig. 5), from the batch "
                     "solver and the similarity law.")
     p.add_argument("--alpha", required=True, help="slenderness: 14deg, 0.244rad or tan0.25")
-    p.add_argument("--pulse", default="sine", choices=SHAPES, help="pulse shape (default sine)")
+    p.add_argument("--pulse", default="sine", choices=ShapeNames(), metavar="SHAPE",
+                   help="pulse shape: %(choices)s (default sine)")
     p.add_argument("--grid", default="200x200", help="points along omega_p/p x ap/(g tan alpha)")
     p.add_argument("--wp-range", default="0.5:12", help="omega_p/p range LOW:HIGH (default 0.5:12)")
     p.add_argument("--ap-range", default="1:6", help="ap/(g tan alpha) range (default 1:6)")
