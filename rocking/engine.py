@@ -862,7 +862,10 @@ def run_core(F, uval, grid, nodes, block, settings, start, n_end, hist_t, hist_t
     S = work[2 * N_STAGES + 2 * m:2 * N_STAGES + 3 * m]
     C = work[2 * N_STAGES + 3 * m:2 * N_STAGES + 4 * m]
     cf = work[2 * N_STAGES + 4 * m:2 * N_STAGES + 5 * m]
-    sc_known, s_phi, c_phi = False, 0.0, 1.0  # sin, cos of s alpha - theta when known
+    # sin, cos of s alpha - theta when known (initial values that are passed on to compiled
+    # functions as np.bool_ / np.int64: a bare constant is typed as a literal, and numba would
+    # compile the callee once more for it)
+    sc_known, s_phi, c_phi = np.bool_(False), 0.0, 1.0
     pending, th2, om2, s_next, c_next, nt, n_pending = False, 0.0, 0.0, 0.0, 1.0, 0, 0
     # forcing linear over each step: unrolled Taylor steps of a fixed order, adapted as we go
     # (raised as soon as a step's last terms are too large, lowered after a run of steps where
@@ -881,7 +884,7 @@ def run_core(F, uval, grid, nodes, block, settings, start, n_end, hist_t, hist_t
         bounds = (SMOOTH_ORDERS[0], SMOOTH_ORDERS[-1], 16)
         order = np.int64(SMOOTH_ORDERS[2])
     orders = (order, np.int64(0))
-    n_general = FIXED_ORDERS[-1]  # order of the last step of the general Taylor loop
+    n_general = np.int64(FIXED_ORDERS[-1])  # order of the last step of the general Taylor loop
     p2 = p * p
     if linear:
         sa, ca = alpha, 1.0
