@@ -168,8 +168,9 @@ class _Locks(event.Listener):
     """The ``numba:compile`` listener of one process: takes a function's lock before it is
     compiled, or abandons the compilation (:class:`_Busy`) when another process holds it."""
 
-    def __init__(self, folder: pathlib.Path, first_compile=None):
+    def __init__(self, folder: pathlib.Path, first_compile=None, packages: tuple = PACKAGES):
         self.folder = folder
+        self.packages = packages
         self.first_compile = first_compile  # called at this process's first compilation
         self.stack = []        # lock (or None) of every compilation under way, innermost last
         self.written = []      # locks of functions compiled, whose cache is written by now
@@ -187,7 +188,7 @@ class _Locks(event.Listener):
             self.stack.append(None)
             raise _Busy(str(self.blocked))
         name = _name(ev.data["dispatcher"])
-        if not self.exclusive or not name.startswith(PACKAGES):
+        if not self.exclusive or not name.startswith(self.packages):
             self.stack.append(None)
             return
         lock = self.folder / (hashlib.sha1(name.encode()).hexdigest()[:20] + ".lock")
@@ -196,7 +197,6 @@ class _Locks(event.Listener):
             self.blocked = lock
             raise _Busy(name)
         self.stack.append(lock)
-        self.compiled += 1
 
     def on_end(self, ev):
         lock = self.stack.pop()
@@ -206,6 +206,7 @@ class _Locks(event.Listener):
             _unlink(lock)
         else:  # numba writes the cache right after this event (or nothing, after an error)
             self.written.append(lock)
+            self.compiled += 1
 
     def _take(self, lock: pathlib.Path) -> bool:
         if _create(lock):
@@ -273,7 +274,10 @@ def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = W
         Names of :data:`GROUPS` to run.
     helpers : int
         Processes to start, when something must be compiled, to share the compilation with this
-        one (each runs the same groups); they end before this function returns.  0: none.
+        one (each runs the same groups; at most one per group besides this process); they end
+        before this function returns.  0: none.  They are started as :mod:`multiprocessing`
+        starts processes: a script that asks for helpers keeps its own work under
+        ``if __name__ == "__main__":``.
     shared : str or path-like, optional
         A folder shared by the processes that warm up together (each given the same one); a
         temporary folder by default (for this process and its helpers).
@@ -296,21 +300,32 @@ def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = W
     if unknown:
         raise ValueError(f"unknown warm-up group(s) {', '.join(map(repr, unknown))}; "
                          f"known: {', '.join(GROUPS)}")
+    return _run_groups({n: GROUPS[n] for n in names}, helpers=helpers, shared=shared,
+                       wait_limit=wait_limit)
+
+
+def _run_groups(groups: dict, *, helpers: int = 0, shared=None, wait_limit: float = WAIT_LIMIT,
+                packages: tuple = PACKAGES) -> WarmUp:
+    """:func:`warm_up` of ``groups`` (name: function of no arguments, defined at a module's top
+    level when there are helpers), sharing out the functions of ``packages``."""
+    names = tuple(groups)
     start = time.perf_counter()
     own = shared is None
     folder = pathlib.Path(tempfile.mkdtemp(prefix="rocking-warm-up-")) if own else pathlib.Path(shared)
     started = []
+    # one group per process at most: more processes would find nothing to do
+    helpers = max(0, min(int(helpers), len(names) - 1))
 
     def first_compile():
         _notice(folder)
-        for _ in range(max(0, int(helpers))):
-            started.append(_start_helper(folder, names, wait_limit))
+        for _ in range(helpers):
+            started.append(_start_helper(folder, groups, wait_limit, packages))
 
     ok = False
     try:
         k = _slot(folder)
         order = list(names[k % len(names):] + names[:k % len(names)]) if names else []
-        locks = _Locks(folder, first_compile)
+        locks = _Locks(folder, first_compile, packages)
         waited, failed = 0.0, []
         with event.install_listener("numba:compile", locks):
             while order:
@@ -318,7 +333,7 @@ def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = W
                 for name in list(order):
                     locks.blocked = None
                     try:
-                        GROUPS[name]()
+                        groups[name]()
                     except Exception as exc:  # noqa: BLE001 - reported in the result
                         if locks.blocked is None:
                             failed.append((name, f"{type(exc).__name__}: {exc}"))
@@ -350,19 +365,19 @@ def _context():
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
-def _start_helper(folder, names, wait_limit):
-    proc = _context().Process(target=_helper, args=(str(folder), names, wait_limit), daemon=True,
-                              name="rocking-warm-up")
+def _start_helper(folder, groups, wait_limit, packages):
+    proc = _context().Process(target=_helper, args=(str(folder), groups, wait_limit, packages),
+                              daemon=True, name="rocking-warm-up")
     proc.start()
     return proc
 
 
-def _helper(folder, names, wait_limit):
-    """A helper process: :func:`warm_up` of the same groups in the same folder.  Ctrl-C is left
-    to the process that started it, which ends its helpers."""
+def _helper(folder, groups, wait_limit, packages):
+    """A helper process: the same groups in the same folder.  Ctrl-C is left to the process that
+    started it, which ends its helpers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        warm_up(names, shared=folder, wait_limit=wait_limit)
+        _run_groups(groups, shared=folder, wait_limit=wait_limit, packages=packages)
     except Exception:  # noqa: BLE001 - a helper only saves time; the caller compiles what is left
         pass
 
