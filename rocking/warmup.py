@@ -179,27 +179,30 @@ class _Locks(event.Listener):
         self.compiled = 0
 
     def on_start(self, ev):
+        self.stack.append(None)  # first: numba sends the end event whatever happens here
         # a compilation that ended before this event has had its cache written since
         self.release_written()
         if self.first_compile is not None:
             first, self.first_compile = self.first_compile, None
             first()
         if self.blocked is not None:  # the group is being abandoned: nothing more in it
-            self.stack.append(None)
             raise _Busy(str(self.blocked))
         name = _name(ev.data["dispatcher"])
         if not self.exclusive or not name.startswith(self.packages):
-            self.stack.append(None)
             return
         lock = self.folder / (hashlib.sha1(name.encode()).hexdigest()[:20] + ".lock")
-        if not self._take(lock):
-            self.stack.append(None)
+        try:
+            taken = self._take(lock)
+        except OSError:  # the folder is gone or read-only: compile without sharing
+            self.exclusive = False
+            return
+        if not taken:
             self.blocked = lock
             raise _Busy(name)
-        self.stack.append(lock)
+        self.stack[-1] = lock
 
     def on_end(self, ev):
-        lock = self.stack.pop()
+        lock = self.stack.pop() if self.stack else None
         if lock is None:
             return
         if self.blocked is not None:  # abandoned (:class:`_Busy`): nothing was written
@@ -225,7 +228,7 @@ class _Locks(event.Listener):
 def _unlink(path: pathlib.Path) -> None:
     try:
         path.unlink()
-    except FileNotFoundError:
+    except OSError:  # already released (or the folder is gone)
         pass
 
 
@@ -312,6 +315,7 @@ def _run_groups(groups: dict, *, helpers: int = 0, shared=None, wait_limit: floa
     start = time.perf_counter()
     own = shared is None
     folder = pathlib.Path(tempfile.mkdtemp(prefix="rocking-warm-up-")) if own else pathlib.Path(shared)
+    folder.mkdir(parents=True, exist_ok=True)
     started = []
     # one group per process at most: more processes would find nothing to do
     helpers = max(0, min(int(helpers), len(names) - 1))
