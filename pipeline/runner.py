@@ -76,13 +76,13 @@ def _serial(tasks, helpers: int = 0):
     solver's compilation with this one when its cache is cold (:func:`warm_up`); 0: the solver
     compiles in this process, on its first call."""
     if helpers and tasks:
-        warm_up(helpers=helpers)
+        warm_up(helpers=helpers, check=interrupts.check)
     for task in tasks:
         interrupts.check()
         yield work(task)
 
 
-def warm_up(shared=None, helpers: int = 0) -> None:
+def warm_up(shared=None, helpers: int = 0, check=None) -> None:
     """Compile (or load) the solver before the first record: ``rocking.warm_up``, which shares
     the compilation between the processes given the same ``shared`` folder (and ``helpers``
     started for it).  It never fails the run: what it could not compile is compiled by the
@@ -90,7 +90,7 @@ def warm_up(shared=None, helpers: int = 0) -> None:
     try:
         import rocking
 
-        rocking.warm_up(shared=shared, helpers=helpers)
+        rocking.warm_up(shared=shared, helpers=helpers, check=check)
     except Exception:  # pragma: no cover - the records report any real problem
         pass
 

@@ -232,11 +232,12 @@ def _unlink(path: pathlib.Path) -> None:
         pass
 
 
-def _wait(locks, limit: float) -> bool:
+def _wait(locks, limit: float, check) -> bool:
     """Wait until one of ``locks`` is released (or its process has died); False after ``limit``
-    seconds."""
+    seconds.  ``check()`` is called at every look."""
     end = time.monotonic() + limit
     while time.monotonic() < end:
+        check()
         for lock in locks:
             pid = _holder(lock)
             if not lock.exists() or (pid is not None and not _alive(pid)):
@@ -263,7 +264,8 @@ def _notice(folder: pathlib.Path | None) -> None:
         _compiling.announce(print_it=_create(folder / "notice"))
 
 
-def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = WAIT_LIMIT) -> WarmUp:
+def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = WAIT_LIMIT,
+            check=None) -> WarmUp:
     """Compile (or load from numba's disk cache) the compiled solver a workload needs.
 
     Runs the :data:`GROUPS` named in ``groups`` (default: all, which covers ``pipeline run``)
@@ -287,6 +289,10 @@ def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = W
     wait_limit : float
         Longest wait for functions other processes are compiling before this process compiles
         them itself (s).
+    check : callable, optional
+        Called with no arguments between groups and while waiting; whatever it raises stops the
+        warm-up (e.g. a command line's check for Ctrl-C, which a compilation cannot always be
+        interrupted by).
 
     Returns
     -------
@@ -304,11 +310,11 @@ def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = W
         raise ValueError(f"unknown warm-up group(s) {', '.join(map(repr, unknown))}; "
                          f"known: {', '.join(GROUPS)}")
     return _run_groups({n: GROUPS[n] for n in names}, helpers=helpers, shared=shared,
-                       wait_limit=wait_limit)
+                       wait_limit=wait_limit, check=check)
 
 
 def _run_groups(groups: dict, *, helpers: int = 0, shared=None, wait_limit: float = WAIT_LIMIT,
-                packages: tuple = PACKAGES) -> WarmUp:
+                packages: tuple = PACKAGES, check=None) -> WarmUp:
     """:func:`warm_up` of ``groups`` (name: function of no arguments, defined at a module's top
     level when there are helpers), sharing out the functions of ``packages``."""
     names = tuple(groups)
@@ -317,6 +323,7 @@ def _run_groups(groups: dict, *, helpers: int = 0, shared=None, wait_limit: floa
     folder = pathlib.Path(tempfile.mkdtemp(prefix="rocking-warm-up-")) if own else pathlib.Path(shared)
     folder.mkdir(parents=True, exist_ok=True)
     started = []
+    check = check or (lambda: None)
     # one group per process at most: more processes would find nothing to do
     helpers = max(0, min(int(helpers), len(names) - 1))
 
@@ -335,6 +342,7 @@ def _run_groups(groups: dict, *, helpers: int = 0, shared=None, wait_limit: floa
             while order:
                 blockers = []
                 for name in list(order):
+                    check()
                     locks.blocked = None
                     try:
                         groups[name]()
@@ -350,7 +358,7 @@ def _run_groups(groups: dict, *, helpers: int = 0, shared=None, wait_limit: floa
                     order.remove(name)
                 if order and blockers and len(blockers) == len(order):
                     t = time.perf_counter()
-                    if not _wait(blockers, max(0.0, wait_limit - waited)):
+                    if not _wait(blockers, max(0.0, wait_limit - waited), check):
                         locks.exclusive = False  # waited too long: compile it here too
                     waited += time.perf_counter() - t
         ok = True
