@@ -3,6 +3,9 @@
     python benchmarks/bench_first_run.py               # first calls, each in a fresh process
     python benchmarks/bench_first_run.py --functions   # also: compile time per compiled function
     python benchmarks/bench_first_run.py --demo        # also: the demo's run, fresh and warm
+    python benchmarks/bench_first_run.py --warm-up     # only: rocking.warm_up, then a run (below)
+    python benchmarks/bench_first_run.py --root DIR [--variants default,jobs2]  # only the demo, of
+                                                       # another checkout (before/after)
 
 Every measurement runs in a new Python process with a new, empty ``NUMBA_CACHE_DIR`` (numba's
 on-disk cache of machine code), as on a machine where the package was just installed; the child
@@ -18,7 +21,16 @@ them:
 - ``warm_*``: the same calls again in the same process (compiled).
 
 ``--demo``: ``pipeline run data/*.sac --block 7.5x1.8`` (what ``pipeline demo`` runs) in a fresh
-process with an empty cache, then again with the cache it filled.
+process with an empty cache, then again with the cache it filled: as ``pipeline demo`` runs it
+(no ``--jobs``: records in one process, a cold cache compiled by one process per CPU,
+``rocking.warm_up``), and with ``--jobs 1`` (compiled in the one process, as before the warm-up)
+and ``--jobs 2`` (two workers that share the compilation).  CPU seconds are those of every
+process of the run (the command's process tree, sampled every 0.1 s with psutil: helper
+processes are not children the command waits for).
+
+``--warm-up``: the full check that the warm-up covers a pipeline run: ``rocking.warm_up`` with
+one helper per further CPU in a fresh process with an empty cache, then the demo's run (``--jobs
+1``) in another process counting numba's compilations (``numba:compile`` events): 0 expected.
 """
 from __future__ import annotations
 
@@ -105,39 +117,143 @@ def first_calls(functions=False) -> dict:
     return out
 
 
-def _timed_run(cmd, env):
-    import resource
+def _timed_run(cmd, env, cwd=None):
+    """Wall-clock and CPU seconds of ``cmd`` and every process it starts (sampled)."""
     import time
 
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    import psutil
+
+    cpu = {}
     t = time.perf_counter()
-    subprocess.run(cmd, env=env, check=True, capture_output=True)
+    proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE)
+    root = psutil.Process(proc.pid)
+    while proc.poll() is None:
+        try:
+            tree = [root] + root.children(recursive=True)
+        except psutil.Error:
+            tree = []
+        for p in tree:
+            try:
+                c = p.cpu_times()
+                cpu[p.pid] = c.user + c.system
+            except psutil.Error:
+                pass
+        time.sleep(0.1)
     wall = time.perf_counter() - t
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return {"wall_s": round(wall, 2), "cpu_s": round(cpu, 2)}
+    err = proc.stderr.read().decode(errors="replace")
+    if proc.returncode != 0:
+        raise RuntimeError(f"{cmd} failed ({proc.returncode}): {err[-2000:]}")
+    return {"wall_s": round(wall, 2), "cpu_s": round(sum(cpu.values()), 2),
+            "processes": len(cpu), "stderr_lines": len(err.splitlines())}
 
 
-def demo() -> dict:
-    """``pipeline run data/*.sac --block 7.5x1.8`` with an empty cache, then with the filled one."""
+WARM_RUNS = 3  # the warm run's median of this many (it takes seconds; a busy machine varies)
+DEMO_VARIANTS = {"default": [], "jobs1": ["--jobs", "1"], "jobs2": ["--jobs", "2"]}
+
+
+def demo(root=ROOT, variants=tuple(DEMO_VARIANTS)) -> dict:
+    """``pipeline run data/*.sac --block 7.5x1.8`` with an empty cache, then with the filled one;
+    as ``pipeline demo`` runs it, with ``--jobs 1`` and with ``--jobs 2`` (``variants``)."""
+    root = pathlib.Path(root)
     records = sorted(str(p) for p in (ROOT / "data").glob("*.sac"))
+    out = {}
+    for label in variants:
+        jobs = DEMO_VARIANTS[label]
+        with tempfile.TemporaryDirectory() as tmp:
+            cache = os.path.join(tmp, "cache")
+            env = _fresh_env(cache)
+            env["PYTHONPATH"] = str(root)
+            cmd = [sys.executable, "-m", "pipeline", "run", *records, "--block", "7.5x1.8",
+                   "--out", os.path.join(tmp, "out"), "--force", *jobs]
+            out[f"demo_{label}_fresh"] = _timed_run(cmd, env, cwd=tmp)
+            warm = [_timed_run(cmd, env, cwd=tmp) for _ in range(WARM_RUNS)]
+            out[f"demo_{label}_warm"] = {key: sorted(r[key] for r in warm)[WARM_RUNS // 2]
+                                         for key in ("wall_s", "cpu_s")}  # medians
+    return out
+
+
+COUNT = r'''
+import glob, json, sys, tempfile
+from numba.core import event
+
+compiled = []
+
+
+class Count(event.Listener):
+    def on_start(self, ev):
+        f = ev.data["dispatcher"].py_func
+        compiled.append(f.__module__ + "." + f.__qualname__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Count())
+from pipeline.batch import Column
+from pipeline.runner import run
+
+with tempfile.TemporaryDirectory() as out:
+    run(sorted(glob.glob(sys.argv[1] + "/data/*.sac")), (Column(7.5, 1.8),), out, jobs=1,
+        quiet=True)
+print("RESULT " + json.dumps(compiled))
+'''
+
+WARM = r'''
+import json, os, time
+if __name__ == "__main__":
+    import rocking
+
+    t, c = time.perf_counter(), time.process_time()
+    res = rocking.warm_up(helpers=len(os.sched_getaffinity(0)) - 1)
+    print("RESULT " + json.dumps({"wall_s": round(time.perf_counter() - t, 2),
+                                  "cpu_s_this_process": round(time.process_time() - c, 2),
+                                  "compiled_here": res.compiled, "waited_s": round(res.waited, 2),
+                                  "helpers": res.helpers, "failed": res.failed}))
+'''
+
+
+def warm_up_check() -> dict:
+    """``rocking.warm_up`` with helpers in an empty cache, then the demo's run counting numba's
+    compilations (0 expected: the warm-up's groups cover it)."""
     with tempfile.TemporaryDirectory() as tmp:
-        cache = os.path.join(tmp, "cache")
-        env = _fresh_env(cache)
-        cmd = [sys.executable, "-m", "pipeline", "run", *records, "--block", "7.5x1.8",
-               "--out", os.path.join(tmp, "out"), "--quiet"]
-        return {"demo_fresh": _timed_run(cmd, env), "demo_warm": _timed_run(cmd, env)}
+        env = _fresh_env(os.path.join(tmp, "cache"))
+        script = os.path.join(tmp, "warm.py")
+        with open(script, "w") as fh:
+            fh.write(WARM)
+        timed = _timed_run([sys.executable, script], env)
+        res = subprocess.run([sys.executable, script], env=env, capture_output=True, text=True,
+                             check=True)  # the cache is warm now: what a warm warm-up costs
+        warm = json.loads(res.stdout.split("RESULT ", 1)[1])
+        res = subprocess.run([sys.executable, "-c", COUNT, str(ROOT)], env=env,
+                             capture_output=True, text=True, check=True)
+        compiled = json.loads(res.stdout.split("RESULT ", 1)[1])
+    return {"warm_up_fresh": timed, "warm_up_again": warm,
+            "compilations_in_the_run_after_it": len(compiled),
+            "compiled_in_the_run": sorted(set(compiled))[:10]}
 
 
-def run(functions=False, with_demo=False) -> dict:
+def run(functions=False, with_demo=False, root=ROOT) -> dict:
     out = first_calls(functions)
     if with_demo:
-        out.update(demo())
+        out.update(demo(root))
     return out
 
 
 if __name__ == "__main__":
-    result = run("--functions" in sys.argv[1:], "--demo" in sys.argv[1:])
+    argv = sys.argv[1:]
+    if "--warm-up" in argv:
+        for key, value in warm_up_check().items():
+            print(f"{key:<34} {value}")
+        sys.exit(0)
+    variants = tuple(DEMO_VARIANTS)
+    if "--variants" in argv:  # e.g. --variants default,jobs2
+        variants = tuple(argv[argv.index("--variants") + 1].split(","))
+    if "--root" in argv:  # only the demo, of another checkout
+        for key, value in demo(argv[argv.index("--root") + 1], variants).items():
+            print(f"{key:<26} {value}")
+        sys.exit(0)
+    result = run("--functions" in argv, "--demo" in argv)
     top = result.pop("functions_cpu_s", None)
     for key, value in result.items():
         print(f"{key:<26} {value}")

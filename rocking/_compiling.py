@@ -14,15 +14,22 @@ _done = set()      # entry points whose first call in this process has returned
 _said = False      # the line is printed at most once per process
 
 
+def announce(print_it: bool = True) -> None:
+    """Print :data:`MESSAGE` unless this process has already done so; ``print_it=False``: only
+    note that it was said (by another process of the same run, :mod:`rocking.warmup`)."""
+    global _said
+    if not _said:
+        _said = True
+        if print_it:
+            print(MESSAGE, file=sys.stderr, flush=True)
+
+
 class _Notice(event.Listener):
     """Prints :data:`MESSAGE` when a compilation starts (numba broadcasts ``numba:compile`` only
     on a cache miss: loading cached machine code sends no such event)."""
 
     def on_start(self, ev):
-        global _said
-        if not _said:
-            _said = True
-            print(MESSAGE, file=sys.stderr, flush=True)
+        announce()
 
     def on_end(self, ev):
         pass

@@ -423,7 +423,7 @@ def test_demo_from_another_directory(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "5 of 5 records processed" in proc.stdout
     # no progress bar when stderr is not a terminal; on a fresh install the solver's one-line
-    # compilation notice (once per process that compiles) is the only thing said there
+    # compilation notice (printed once, by the first process that compiles) is the only thing said there
     from rocking._compiling import MESSAGE
 
     assert [line for line in proc.stderr.splitlines() if line != MESSAGE] == []
