@@ -148,7 +148,7 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
         F[_REST, i] = -np.inf
         I[_STATUS, i] = REST
         I[_RUN, i] = k
-    a, q, theta, omega = F[_A], F[_Q], F[_TH], F[_OM]
+    a, theta, omega = F[_A], F[_TH], F[_OM]
     side, s_phi, c_phi, peak = F[_SIDE], F[_SPHI], F[_CPHI], F[_MX]
     bad = np.zeros(n, dtype=np.int64)
     work = np.zeros(WORK_SIZE)
@@ -159,6 +159,9 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
     # constants passed to compiled functions as np.int64 / np.bool_: a bare constant is typed as
     # a literal, and numba would compile those functions once more for it; the engine's bundles
     # that hold arrays made once (each made anew would count references to its arrays)
+    # the rows lanes_step reads and writes (it takes the whole state: one array, not eight)
+    rows = (np.int64(_A), np.int64(_Q), np.int64(_TH), np.int64(_OM), np.int64(_SIDE),
+            np.int64(_SPHI), np.int64(_CPHI), np.int64(_MX))
     grid = Grid(t_start, h, np.int64(1))
     settings = Settings(np.bool_(False), np.int64(TAYLOR), zeno_tol, np.bool_(False),
                         np.bool_(False))
@@ -176,8 +179,8 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
         n_bad = 0
         all_low = False
         if n_rocking > 0:
-            n_bad, n_two = lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], a, q, h,
-                                      theta, omega, side, s_phi, c_phi, peak, TAYLOR_EPS, bad)
+            n_bad, n_two = lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], F,
+                                      rows, h, TAYLOR_EPS, bad)
             stats[0] += n_rocking - n_bad
             all_low = n_two == n_rocking
         wake_all = j >= next_wake
