@@ -564,14 +564,14 @@ def test_compiled_steps_compute_their_python_source():
         # one lane of lanes_16 against its Python source
         u0, u1, h = rng.uniform(-1.0, 1.0), rng.uniform(-0.1, 0.1), 0.01
         om = wh / h
-        th_a, om_a, side = np.array([theta]), np.array([om]), np.array([1.0])
-        sp, cp, pk, bad = np.array([s0]), np.array([c0]), np.zeros(1), np.zeros(1, dtype=np.int64)
-        tl.lanes_16(1, u0, u1, np.ones(1), np.array([q]), h, th_a, om_a, side, sp, cp, pk, 1e-15,
-                    bad)
+        # the lane state: rows amp, q, theta, omega, side, s_phi, c_phi, peak
+        state = np.array([[1.0], [q], [theta], [om], [1.0], [s0], [c0], [0.0]])
+        bad = np.zeros(1, dtype=np.int64)
+        tl.lanes_16(1, u0, u1, state, tuple(range(8)), h, 1e-15, bad)
         want = tl._lane_16(1.0 * u0, 1.0 * u1, q, theta, om * h, s0, c0, 1e-15, 1.0 / h)
         if bad[0] == 0:  # kept: the lane's new state is the Python source's, bit for bit
             kept += 1
-            assert (th_a[0], om_a[0], sp[0], cp[0]) == (want[0], want[1], want[2], want[3])
+            assert tuple(state[[2, 3, 5, 6], 0]) == (want[0], want[1], want[2], want[3])
         got = tf.taylor_16(u0, u1, q, theta, wh, s0, c0, 1e-15, cf1, True)
         want = tf._taylor_16(u0, u1, q, theta, wh, s0, c0, 1e-15, cf2, True)
         assert got[4] == want[4]
