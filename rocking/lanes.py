@@ -157,9 +157,9 @@ def _chunk(i0, i1, amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, overtu
     cf = np.zeros(NMAX + 3)
     empty = np.zeros(0)
     # constants passed to compiled functions as np.int64 / np.bool_: a bare constant is typed as
-    # a literal, and numba would compile those functions once more for it; the engine's bundles
-    # that hold arrays made once (each made anew would count references to its arrays)
-    # the rows lanes_step reads and writes (it takes the whole state: one array, not eight)
+    # a literal, and numba would compile those functions once more for it.  The rows that
+    # lanes_step reads and writes: it takes the whole state, one array rather than eight views
+    # (numba counts a reference to every array a compiled function is given, at every interval)
     rows = (np.int64(_A), np.int64(_Q), np.int64(_TH), np.int64(_OM), np.int64(_SIDE),
             np.int64(_SPHI), np.int64(_CPHI), np.int64(_MX))
     grid = Grid(t_start, h, np.int64(1))
