@@ -332,21 +332,23 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
             if s > score:
                 score, fits[shape] = s, (start, trial, p_trial)
     if weighting == "background":
-        best = max(fits, key=lambda k: _score(x, t, dt, k, fits[k][1], energy)[0])
-        resid = x - fits[best][2]
+        plain = _plain_scores(x, fits, energy)
+        best = max(fits, key=plain.get)
         # a record the plain fit explains to round-off has no background to weight by
+        resid = x - fits[best][2]
         exact = _dot(resid, resid) <= 1e-24 * energy
-        background, best_trial = (None, None) if exact else \
+        background, best_fit = (None, None) if exact else \
             _estimate_background(x, t, dt, best, fits[best], energy, baseline)
         for shape, (match, trial, p_trial) in ([] if background is None else fits.items()):
-            trial = best_trial if shape == best else \
-                _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
+            if shape == best:
+                fits[shape] = (match, *best_fit)
+                continue
+            trial = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
             fits[shape] = (match, trial, _score(x, t, dt, shape, trial, energy)[1])
     else:
         background = None
     # the share of energy explained in the metric of the least squares used
-    scores = {shape: 1.0 - _dot(x - p, x - p) / energy for shape, (_, _, p) in fits.items()} \
-        if background is None else background.explained(x, {shape: p for shape, (_, _, p) in fits.items()})
+    scores = _plain_scores(x, fits, energy) if background is None else background.explained(x, {shape: p for shape, (_, _, p) in fits.items()})
     candidates = []
     for shape, (_, (ap, tp, t0, idx), p) in fits.items():
         score = scores[shape]
@@ -366,6 +368,12 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         c.rank = k
     return PulseFit(record.name, ranked, record.pga, _pgv(record.acc, dt), record.duration,
                     significant_duration(record.acc, dt))
+
+
+def _plain_scores(x, fits, energy) -> dict:
+    """Share of the record's energy each fit's samples explain (``fits``: shape -> ``(match,
+    trial, samples)``)."""
+    return {shape: 1.0 - _dot(x - p, x - p) / energy for shape, (_, _, p) in fits.items()}
 
 
 def _score(x, t, dt, shape, trial, energy):
@@ -569,9 +577,9 @@ class Background:
 
 def _estimate_background(x, t, dt, shape, fit, energy, baseline):
     """The background's spectrum (:class:`Background`) from the record and its best plain fit
-    ``fit = (match, trial, samples)`` of ``shape``, and that shape's weighted fit ``(ap, Tp, t0,
-    window)`` with the first estimate (kept as its result); ``(None, None)`` if the residual has
-    no power to weight by.
+    ``fit = (match, trial, samples)`` of ``shape``, and that shape's weighted fit with the first
+    estimate (kept as its result), as ``((ap, Tp, t0, window), samples)``; ``(None, None)`` if
+    the residual has no power to weight by.
 
     Two passes.  The plain fit's residual holds its own error where the pulse is, and a
     one-sine's or a rectangle's corners put that error at frequencies where the background has
@@ -592,8 +600,9 @@ def _estimate_background(x, t, dt, shape, fit, energy, baseline):
     if not first.usable:
         return None, None
     trial = _refine_weighted(x, t, dt, shape, match, trial, first, baseline)
-    second = Background(x - _score(x, t, dt, shape, trial, energy)[1], dt, segment)
-    return (second if second.usable else first), trial
+    samples = _score(x, t, dt, shape, trial, energy)[1]
+    second = Background(x - samples, dt, segment)
+    return (second if second.usable else first), (trial, samples)
 
 
 def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
@@ -918,7 +927,7 @@ def _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00):
         coef, *_ = np.linalg.lstsq(A, xw, rcond=None)
         ap_new = float(coef[0])
         best = (ap_new, tp_new, t0_new, idx)
-        ap, tp, t0 = ap_new, tp_new, t0_new
+        tp, t0 = tp_new, t0_new
         if _covers(idx, shape, tp, t0, dt, x.size):
             break
     return best
