@@ -255,13 +255,10 @@ def _slot(folder: pathlib.Path) -> int:
     return k
 
 
-def _notice(folder: pathlib.Path | None) -> None:
+def _notice(folder: pathlib.Path) -> None:
     """The one line saying the solver is compiling: printed by the first process of those sharing
     ``folder`` that compiles something, and by none of the others."""
-    if folder is None:
-        _compiling.announce()
-    else:
-        _compiling.announce(print_it=_create(folder / "notice"))
+    _compiling.announce(print_it=_create(folder / "notice"))
 
 
 def warm_up(groups=None, *, helpers: int = 0, shared=None, wait_limit: float = WAIT_LIMIT,
