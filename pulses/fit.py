@@ -96,6 +96,12 @@ GLS_SHIFT = 0.1
 #: or after GLS_MAX_CALLS evaluations (the noise limits are 1e-3 of Tp or more)
 GLS_FTOL = 1e-7
 GLS_MAX_CALLS = 12
+#: for a shape with corners (:meth:`pulses.Pulse.cornered`) the descent is restarted from the
+#: best of a lattice of the pulse's two edges about where it stopped, GLS_LATTICE points per
+#: sample, the width within GLS_LATTICE_SPAN points: weighted by the background's spectrum, the
+#: corners pin the pulse to a fraction of a sample, and the objective has a kink at every sample
+GLS_LATTICE = 4
+GLS_LATTICE_SPAN = 6
 #: the weighted estimate is refused when it differs from the plain one by more than noise
 #: explains: Hausman's statistic (chi-square of 3 degrees of freedom under the model) above its
 #: 99.9 % point
@@ -693,33 +699,52 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     if difference is None:
         return start
     start_cost, _ = profiled(tp, t0)
-    # scan of the period about the start, the pulse's centre kept; each period's best shift in
-    # whole samples from the weighted cross-correlation (one inverse FFT; baseline left out)
-    centre = t0 + cls.centre_tau * tp
+    # each candidate pulse's best whole-sample shift from the weighted cross-correlation (one
+    # inverse FFT per candidate, all at once; baseline left out)
     shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
-    near = np.abs(shifts) <= max(2, int(GLS_SHIFT * tp / dt))
-    k_near = np.flatnonzero(near)
+    k_near = np.flatnonzero(np.abs(shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
     # irfft counts the interior bins twice, which the weights already do
     Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
-    best_gain, tp_b, t0_b = -1.0, tp, t0
-    for f in np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN)):
-        tp_s = tp * f
-        t0_s = centre - cls.centre_tau * tp_s
-        M = sfft.rfft(sampled(tp_s, t0_s)[0], overwrite_x=True)
-        mm = float(gram(M[None], (M * w)[None])[0, 0])
-        corr = sfft.irfft(Xw_half * M.conj(), nfft)[k_near] * nfft
-        j = int(np.argmax(np.abs(corr)))
-        gain = corr[j] ** 2 / max(mm, 1e-300)
-        if gain > best_gain:
-            best_gain, tp_b, t0_b = gain, tp_s, t0_s + shifts[k_near[j]] * dt
-    _, ap_b = profiled(tp_b, t0_b)
+
+    def scan(tps, t0s):
+        cols = np.zeros((len(tps), nfft))
+        for row, tp_, t0_ in zip(cols, tps, t0s):
+            k = support(tp_, t0_)
+            row[k] = cls.sampled(tp_, t0_, tw[k], dt)
+        M = sfft.rfft(cols, axis=-1, overwrite_x=True)
+        mm = np.einsum("ik,ik->i", M.view(float), (M * w).view(float))
+        corr = sfft.irfft(Xw_half * M.conj(), nfft, axis=-1)[:, k_near] * nfft
+        j = np.argmax(np.abs(corr), axis=1)
+        gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
+        i = int(np.argmax(gain))
+        return tps[i], t0s[i] + shifts[k_near[j[i]]] * dt
+
     _, tp0, t00 = match
+    lower = np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0])
+    upper = np.array([np.inf, tp0 * TP_LEASH, t00 + tp0])
+
+    def descent(tp_, t0_):
+        _, ap_ = profiled(tp_, t0_)
+        return _levenberg_marquardt(normal, np.array([ap_, tp_, t0_]), scale=np.array([abs(ap_) or 1.0, tp_, tp_]),
+                                    ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS, lower=lower, upper=upper)
+
+    # a scan of the period about the start, the pulse's centre kept, then the descent
+    factors = np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN))
+    tps = tp * factors
+    centres = np.full(GLS_SCAN, t0 + cls.centre_tau * tp)
     try:
-        p_new, cost = _levenberg_marquardt(normal, np.array([ap_b, tp_b, t0_b]),
-                                           scale=np.array([abs(ap_b) or 1.0, tp_b, tp_b]),
-                                           ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS,
-                                           lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
-                                           upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
+        p_new, cost = descent(*scan(tps, centres - cls.centre_tau * tps))
+        if cls.cornered():
+            # the descent stops in the first kink it meets, a sample or two from the optimum:
+            # a lattice of both edges about where it stopped, then the descent from its best
+            lo_, hi_ = cls.support_tau
+            widths, starts = (v.ravel() for v in np.meshgrid(
+                (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
+                p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
+            tps = widths / (hi_ - lo_)
+            p_lattice, cost_lattice = descent(*scan(tps, starts - lo_ * tps))
+            if cost_lattice < cost:
+                p_new, cost = p_lattice, cost_lattice
     except np.linalg.LinAlgError:
         return start
     ap_new, tp_new, t0_new = (float(v) for v in p_new)

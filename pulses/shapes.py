@@ -145,6 +145,16 @@ class Pulse:
         dw = np.where(inside, cls.slope(tau), 0.0)
         return m, -dw * tau / tp, -dw / tp
 
+    @classmethod
+    def cornered(cls) -> bool:
+        """Whether the unit shape or its slope jumps at an edge of its support (a one-sine's
+        corners, a rectangle's edges; a Ricker's truncation is below round-off).  Sampled, such
+        a shape moves with a kink each time an edge crosses a sample time, so a least-squares
+        objective has a kink there too, in which a gradient method can stop."""
+        edges = np.array(cls.support_tau, dtype=float)
+        jump = np.max(np.abs(cls.unit(edges))) + np.max(np.abs(cls.slope(edges))) / (2.0 * math.pi)
+        return bool(jump > 1e-9)
+
     # -- common API -------------------------------------------------------------------
     def __call__(self, t):
         """Ground acceleration (m/s^2) at time(s) ``t`` (s)."""
