@@ -27,6 +27,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("files", nargs="+", metavar="FILE", help="record files (AT2, SAC, MiniSEED, K-NET, text ...)")
     p.add_argument("--shapes", nargs="+", metavar="SHAPE",
                    help="shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: all)")
+    p.add_argument("--weighting", choices=("background", "plain"), default="background",
+                   help="least squares weighted by the background's spectrum estimated from the record "
+                        "(default), or plain least squares, for comparison")
     add_record_options(p)
     p.add_argument("--csv", metavar="FILE", help="write one row per record and shape to this CSV file")
     p.add_argument("--plot", metavar="DIR", help="draw each record with its fitted pulses into DIR/<record>.png")
@@ -49,7 +52,7 @@ def main(args) -> int:
     for path in args.files:
         try:
             record = pulses.read_record(path, **opts)
-            fit = pulses.fit_pulse(record, shapes=shapes)
+            fit = pulses.fit_pulse(record, shapes=shapes, weighting=args.weighting)
         except (pulses.RecordError, ValueError) as exc:
             print(f"pipeline fit: {_with_path(path, exc)}", file=sys.stderr)
             failures += 1
@@ -95,7 +98,8 @@ def format_fit(record, fit) -> str:
     from pulses import G
 
     lines = [f"{fit.name}: PGA {fit.pga / G:.3f} g, PGV {fit.pgv:.3f} m/s, duration {fit.duration:.2f} s "
-             f"(D5-95 {fit.significant_duration:.2f} s), units {record.metadata.get('units')}"]
+             f"(D5-95 {fit.significant_duration:.2f} s), units {record.metadata.get('units')}, "
+             f"{fit.weighting} least squares"]
     for w in record.metadata.get("warnings", []):
         lines.append(f"  warning: {w}")
     lines.append("  rank shape         ap (g)   Tp (s)  t0 (s)  arrival (s)  Lp (m)  score  corr")

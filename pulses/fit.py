@@ -226,6 +226,10 @@ class PulseFit:
         Length of the record, s.
     significant_duration : float
         D5-95 (time between 5 % and 95 % of the Arias intensity), s.
+    weighting : str
+        The least squares that gave the candidates: ``"background"`` (weighted by the
+        background's spectrum) or ``"plain"`` (asked for, or where the record did not support
+        the weighting: see :func:`fit_pulse`).
     """
 
     name: str
@@ -234,6 +238,7 @@ class PulseFit:
     pgv: float
     duration: float
     significant_duration: float
+    weighting: str = "plain"
 
     @property
     def best(self) -> Candidate:
@@ -255,14 +260,14 @@ class PulseFit:
         for c in self.candidates:
             row = {"record": self.name, **c.as_dict(), "best": c.rank == 1,
                    "pga_g": self.pga / G, "pgv_m_s": self.pgv, "duration_s": self.duration,
-                   "d5_95_s": self.significant_duration}
+                   "d5_95_s": self.significant_duration, "weighting": self.weighting}
             rows.append(row)
         return pd.DataFrame(rows)
 
     def as_dict(self) -> dict:
         return {"record": self.name, "pga_g": self.pga / G, "pgv_m_s": self.pgv,
                 "duration_s": self.duration, "d5_95_s": self.significant_duration,
-                "best": self.best.shape, "candidates": [c.as_dict() for c in self.candidates]}
+                "weighting": self.weighting, "best": self.best.shape, "candidates": [c.as_dict() for c in self.candidates]}
 
 
 # -- the fitter ------------------------------------------------------------------------------------
@@ -282,7 +287,7 @@ def default_tp_range(record: Record) -> tuple[float, float]:
 
 
 def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = True,
-              weighting: str = "plain") -> PulseFit:
+              weighting: str = "background") -> PulseFit:
     """Fit every candidate pulse shape to a record.
 
     Parameters
@@ -296,23 +301,24 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     baseline : bool, optional
         Fit a straight-line baseline together with the pulse inside the refinement window
         (default True).
-    weighting : {"plain", "background"}, optional
-        ``"plain"`` (default): ordinary least squares (every frequency weighted alike), ranked by
-        the plain share of energy.  ``"background"``: after plain least squares, refine once
-        more with the residual weighted by the inverse of the background's spectrum, estimated
-        from the record itself (generalised least squares, :class:`Background`), and rank the
-        candidates by the share of the record's energy they explain in that metric: more
-        accurate ap and Tp and shapes right more often on synthetic records with band-limited
-        background motion; not the default yet, because on the README's records it identifies
-        the shape of short pulses in 0.1-25 Hz background slightly less often (98 % against
-        100 % at 15 %; not on other seeds) and costs about twice the plain fit (README,
-        "Accuracy on synthetic records").
+    weighting : {"background", "plain"}, optional
+        ``"background"`` (default): after plain least squares, refine every shape once more with
+        the residual weighted by the inverse of the background's spectrum, estimated from the
+        record itself (generalised least squares, :class:`Background`), and rank the candidates
+        by the share of the record's energy they explain in that metric.  More accurate ap and
+        Tp, and the shape right more often, on synthetic records with band-limited background
+        motion; about twice the cost of the plain fit (README, "Accuracy on synthetic records").
+        Where the record does not follow its best plain pulse at the frequencies the weights
+        favour (Hausman's test), the plain fit answers and ``PulseFit.weighting`` says so.
+        ``"plain"``: ordinary least squares only (every frequency weighted alike), ranked by the
+        plain share of energy; kept for comparison.
 
     Returns
     -------
     PulseFit
-        Candidates ranked by score, ``.best``, and the record's PGA, PGV and duration.  A record
-        the plain fit explains to round-off has no background to weight by: its fit is the plain one.
+        Candidates ranked by score, ``.best``, the record's PGA, PGV and duration, and the least
+        squares that answered.  A record the plain fit explains to round-off has no background
+        to weight by: its fit is the plain one.
     """
     shapes = tuple(DEFAULT_SHAPES if shapes is None else shapes)
     for s in shapes:
@@ -337,24 +343,11 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
             s, p_trial = _score(x, t, dt, shape, trial, energy)
             if s > score:
                 score, fits[shape] = s, (start, trial, p_trial)
+    # the share of energy explained, in the metric of the least squares used
+    scores, weighted_scores = _plain_scores(x, fits, energy), None
     if weighting == "background":
-        plain = _plain_scores(x, fits, energy)
-        best = max(fits, key=plain.get)
-        # a record the plain fit explains to round-off has no background to weight by
-        resid = x - fits[best][2]
-        exact = _dot(resid, resid) <= 1e-24 * energy
-        background, best_fit = (None, None) if exact else \
-            _estimate_background(x, t, dt, best, fits[best], energy, baseline)
-        for shape, (match, trial, p_trial) in ([] if background is None else fits.items()):
-            if shape == best:
-                fits[shape] = (match, *best_fit)
-                continue
-            trial = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
-            fits[shape] = (match, trial, _score(x, t, dt, shape, trial, energy)[1])
-    else:
-        background = None
-    # the share of energy explained in the metric of the least squares used
-    scores = _plain_scores(x, fits, energy) if background is None else background.explained(x, {shape: p for shape, (_, _, p) in fits.items()})
+        fits, weighted_scores = _weighted(x, t, dt, fits, scores, energy, baseline)
+        scores = scores if weighted_scores is None else weighted_scores
     candidates = []
     for shape, (_, (ap, tp, t0, idx), p) in fits.items():
         score = scores[shape]
@@ -373,7 +366,39 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     for k, c in enumerate(ranked, start=1):
         c.rank = k
     return PulseFit(record.name, ranked, record.pga, _pgv(record.acc, dt), record.duration,
-                    significant_duration(record.acc, dt))
+                    significant_duration(record.acc, dt), "plain" if weighted_scores is None else "background")
+
+
+def _weighted(x, t, dt, fits, plain_scores, energy, baseline):
+    """The weighted least squares of every shape from its plain fit (``fits``: shape ->
+    ``(match, trial, samples)``), and their scores: the share of the record's energy each
+    explains in the weighted metric; the plain fits and None where the weighting is not used.
+
+    It is not used where the record has no background to weight by (the plain fit explains it
+    to round-off), nor where it would overturn the plain ranking although the plain winner's own
+    weighted refit was refused (:func:`_estimate_background`): then the weighted metric rests on
+    a spectrum the record does not support, and it would rank the winner by its plain fit's
+    corners, misplaced for the weights (on the README's records, a short one-sine in 0.1-25 Hz
+    background at 15 %, whose plain Tp was 12 % off).
+    """
+    best = max(fits, key=plain_scores.get)
+    resid = x - fits[best][2]
+    if _dot(resid, resid) <= 1e-24 * energy:
+        return fits, None
+    background, best_fit, accepted = _estimate_background(x, t, dt, best, fits[best], energy, baseline)
+    if background is None:
+        return fits, None
+    weighted = {}
+    for shape, (match, trial, p_trial) in fits.items():
+        if shape == best:
+            weighted[shape] = (match, *best_fit)
+            continue
+        trial = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
+        weighted[shape] = (match, trial, _score(x, t, dt, shape, trial, energy)[1])
+    scores = background.explained(x, {shape: p for shape, (_, _, p) in weighted.items()})
+    if not accepted and max(scores, key=scores.get) != best:
+        return fits, None
+    return weighted, scores
 
 
 def _plain_scores(x, fits, energy) -> dict:
@@ -584,8 +609,9 @@ class Background:
 def _estimate_background(x, t, dt, shape, fit, energy, baseline):
     """The background's spectrum (:class:`Background`) from the record and its best plain fit
     ``fit = (match, trial, samples)`` of ``shape``, and that shape's weighted fit with the first
-    estimate (kept as its result), as ``((ap, Tp, t0, window), samples)``; ``(None, None)`` if
-    the residual has no power to weight by.
+    estimate, as ``((ap, Tp, t0, window), samples)``, and whether that refit was accepted (else
+    it is the plain fit: :func:`_refine_weighted`); ``(None, None, False)`` if the residual has
+    no power to weight by.
 
     Two passes.  The plain fit's residual holds its own error where the pulse is, and a
     one-sine's or a rectangle's corners put that error at frequencies where the background has
@@ -604,11 +630,11 @@ def _estimate_background(x, t, dt, shape, fit, energy, baseline):
     lo, hi = pulse_window(shape, tp, t0)
     first = Background(x - p, dt, segment, skip=(lo - SKIP_PERIODS * tp, hi + SKIP_PERIODS * tp))
     if not first.usable:
-        return None, None
-    trial = _refine_weighted(x, t, dt, shape, match, trial, first, baseline)
-    samples = _score(x, t, dt, shape, trial, energy)[1]
+        return None, None, False
+    refit = _refine_weighted(x, t, dt, shape, match, trial, first, baseline)
+    samples = p if refit is trial else _score(x, t, dt, shape, refit, energy)[1]
     second = Background(x - samples, dt, segment)
-    return (second if second.usable else first), (trial, samples)
+    return (second if second.usable else first), (refit, samples), refit is not trial
 
 
 def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
