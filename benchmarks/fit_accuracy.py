@@ -113,7 +113,7 @@ def table(n=10, band=(0.5, 10.0), pooled_only=False, weighting="background", see
 
 
 def _line(noise, tp, s):
-    pct = lambda v: f"{100 * v:.0f} %"
+    pct = lambda v: f"{100 * v:.1f}".rstrip("0").rstrip(".") + " %"  # 99.5 % is not 100 %
     lim = f"{100 * s['lim_ap']:.1f} / {100 * s['lim_tp']:.1f} %" if "lim_ap" in s else "0"
     wlim = f"{100 * s['wlim_ap']:.2g} / {100 * s['wlim_tp']:.2g} %" if "wlim_ap" in s else "0"
     ratio = f"{s['ratio']:.2f}" if "ratio" in s else "-"

@@ -6,7 +6,7 @@ PGA, PGV (baseline-corrected, :mod:`pulses.baseline`), the best shape and every 
 ``|ap|`` (g), Tp (s) and score (share of the record's energy the pulse explains).
 
 ``python benchmarks/fit_records.py compare`` prints, for every record, where the weighted least
-squares (``weighting="background"``) and the plain ones (``weighting="plain"``, the default)
+squares (``weighting="background"``, the default) and the plain ones (``weighting="plain"``)
 differ: the best shape, and each shape's ``|ap|`` and Tp when they move by more than 1 %.
 """
 from __future__ import annotations
