@@ -645,7 +645,8 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     straight-line baseline is fitted alongside in the same metric.  Weighting sharpens the
     minimum, so first the period is scanned (:data:`GLS_SCAN` periods, centre kept) with every
     whole-sample shift of the pulse at once (one inverse FFT per period), then Levenberg-Marquardt
-    starts from the best.  ``start`` is returned when nothing beats it on the weighted objective,
+    starts from the best; for a shape with corners it starts again from the best of a lattice of
+    the pulse's edges about where it stopped (:data:`GLS_LATTICE`).  ``start`` is returned when nothing beats it on the weighted objective,
     or when the two estimates differ by more than noise of the estimated spectrum explains
     (:func:`_difference_covariance`).  By Gauss-Markov, under that spectrum the weighted
     estimate scatters less than the plain one, whatever the shape and period; it is used
@@ -697,14 +698,18 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
         BX = gram(B, Xw[None])[:, 0]
         xx -= float(BX @ BB_inv @ BX)
 
+    # the record's and the baseline's weighted spectra, stacked: one product with the columns
+    fixed = np.concatenate((Xw[None], Bw)) if baseline else Xw[None]
+
     def products(cols):
         """Weighted ``u'v`` among the columns and with the record, the baseline projected out."""
         U = sfft.rfft(cols, axis=-1, overwrite_x=True)
-        UU, UX = gram(U, U * w), gram(U, Xw[None])[:, 0]
+        UU, UF = gram(U, U * w), gram(U, fixed)
+        UX = UF[:, 0]
         if baseline:
-            UB = gram(U, Bw)
+            UB = UF[:, 1:]
             UU -= UB @ BB_inv @ UB.T
-            UX -= UB @ BB_inv @ BX
+            UX = UX - UB @ BB_inv @ BX
         return UU, UX
 
     def profiled(tp_, t0_):
@@ -732,18 +737,36 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     # irfft counts the interior bins twice, which the weights already do
     Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
 
-    def scan(tps, t0s):
+    def scan(tps, t0s, few_shifts=False):
+        """The best of the pulses ``(tps, t0s)``, each moved by its best whole-sample shift
+        (within +-2 samples if ``few_shifts``), by the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``."""
+        # every candidate sampled at once, over the union of their supports
+        a = max(0, int(math.floor((np.min(t0s + sup_lo * tps) - tw[0]) / dt)) - 1)
+        b = max(a, min(tw.size, int(math.ceil((np.max(t0s + sup_hi * tps) - tw[0]) / dt)) + 2))
         cols = np.zeros((len(tps), nfft))
-        for row, tp_, t0_ in zip(cols, tps, t0s):
-            k = support(tp_, t0_)
-            row[k] = cls.sampled(tp_, t0_, tw[k], dt)
+        cols[:, a:b] = cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
+        if few_shifts:  # a few shifts: sums over the support with the whitened record
+            lags = np.arange(-2, 3)
+            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened()[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        else:
+            lags = shifts[k_near]
         M = sfft.rfft(cols, axis=-1, overwrite_x=True)
         mm = np.einsum("ik,ik->i", M.view(float), (M * w).view(float))
-        corr = sfft.irfft(Xw_half * M.conj(), nfft, axis=-1)[:, k_near] * nfft
+        if not few_shifts:
+            corr = sfft.irfft(Xw_half * M.conj(), nfft, axis=-1)[:, k_near] * nfft
         j = np.argmax(np.abs(corr), axis=1)
         gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
         i = int(np.argmax(gain))
-        return tps[i], t0s[i] + shifts[k_near[j[i]]] * dt
+        return tps[i], t0s[i] + lags[j[i]] * dt
+
+    cache = {}
+
+    def whitened():
+        """The record whitened by the weights, in time: its circular cross-correlation with a
+        pulse ``u`` at lag ``m`` is ``u'S^-1 x`` for ``u`` moved by ``m`` samples."""
+        if "x" not in cache:
+            cache["x"] = sfft.irfft(Xw_half, nfft) * nfft
+        return cache["x"]
 
     _, tp0, t00 = match
     lower = np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0])
@@ -768,7 +791,7 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
                 (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
                 p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
             tps = widths / (hi_ - lo_)
-            p_lattice, cost_lattice = descent(*scan(tps, starts - lo_ * tps))
+            p_lattice, cost_lattice = descent(*scan(tps, starts - lo_ * tps, few_shifts=True))
             if cost_lattice < cost:
                 p_new, cost = p_lattice, cost_lattice
     except np.linalg.LinAlgError:
