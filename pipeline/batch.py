@@ -264,8 +264,13 @@ RECORD_COLUMNS = Columns(
     ("pulse_arrival_s", "s", "Time the best-fitting pulse starts: t0 for sine and rect, t0 - Tp/2 for "
                              "the Rickers."),
     ("pulse_lp_m", "m", "Persistence length scale Lp = |ap| Tp^2 of the best-fitting pulse."),
-    ("pulse_score", "-", "Fit quality of the best pulse: the fitter's score (share of the record's "
-                         "energy the pulse explains, 0 to 1)."),
+    ("pulse_score", "-", "Fit quality of the best pulse: the fitter's score, the share of the record's "
+                         "energy the pulse explains (1 at most), in the metric of `pulse_fit`: weighted "
+                         "by the background's spectrum it falls below zero for a pulse whose corners "
+                         "the record lacks."),
+    ("pulse_fit", "-", "The least squares that fitted the pulses: `background` (weighted by the "
+                       "background's spectrum estimated from the record, the default) or `plain` "
+                       "(where the record does not support the weighting)."),
     ("pulse_correlation", "-", "Correlation between the best pulse and the record within the pulse "
                                "window (-1 to 1)."),
     ("shapes_fitting", "-", f"Shapes that fit the record almost equally well (score at least "
@@ -299,6 +304,7 @@ def _record_fields(task: Task, record, fit, best, fitting) -> dict:
         "pulse_arrival_s": getattr(best, "arrival", None),
         "pulse_lp_m": abs(best.ap) * best.tp ** 2,
         "pulse_score": best.score,
+        "pulse_fit": getattr(fit, "weighting", None),
         "pulse_correlation": getattr(best, "correlation", None),
         "shapes_fitting": ";".join(c.shape for c in fitting),
     })
