@@ -3,7 +3,7 @@
 ``python benchmarks/bench_fit.py`` prints a dict; :func:`run` returns it.
 
 - The issue's case: a 20 s record at 200 Hz (4001 samples; a one-sine pulse plus band-limited
-  background motion at 15 % of ap), all four shapes (``fit_pulse(record)``, the default plain
+  background motion at 15 % of ap), all four shapes (``fit_pulse(record)``, the default weighted
   least squares): median and best of repeated fits, in ms (target: under 15 ms), then the same
   with ``weighting="plain"`` named and with ``weighting="background"`` (keys ``..._weighted_...``);
   also the process CPU time of the same fits, less disturbed than the wall time by other jobs

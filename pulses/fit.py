@@ -10,15 +10,15 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    search over its two edges, see :func:`_refine_edges`).  A straight-line baseline is fitted
    together with the pulse inside the window (``baseline=True``), so slow drift of the record
    does not bias the pulse; it is not part of the pulse and not counted in its score.
-3. **Weight** (``weighting="background"``, an option; the default ``"plain"`` stops after step 2,
-   see the README's "Accuracy on synthetic records" for why): the background's spectrum is
-   estimated from the record (:class:`Background`), first away from the best plain fit's pulse,
-   then from the residual of that shape's fit weighted by the first estimate
-   (:func:`_estimate_background`); every other shape is refit by least squares weighted by the
-   inverse of the second (generalised least squares, :func:`_refine_weighted`), each weighted
-   fit kept unless the record departs from the pulse model (Hausman's test,
-   :func:`_difference_covariance`), and the candidates are ranked by the share of the record's
-   energy they explain in the same metric.
+3. **Weight** (the default, ``weighting="background"``; ``"plain"`` stops after step 2, for
+   comparison): the background's spectrum is estimated from the record (:class:`Background`),
+   first away from the best plain fit's pulse, then from the residual of that shape's fit
+   weighted by the first estimate (:func:`_estimate_background`); every other shape is refit by
+   least squares weighted by the inverse of the second (generalised least squares,
+   :func:`_refine_weighted`), each weighted fit kept unless the record departs from the pulse
+   model (Hausman's test, :func:`_difference_covariance`), and the candidates are ranked by the
+   share of the record's energy they explain in the same metric (:func:`_weighted`; the plain
+   fit answers where the record does not support the weighting, ``PulseFit.weighting``).
 
 A sampled pulse is the pulse evaluated at the sample times, except the rectangular pulse, whose
 point samples do not locate its edges more finely than ``dt``: it is sampled as its average over
@@ -27,8 +27,8 @@ each sample's cell ``[t_i - dt/2, t_i + dt/2]``.
 Quality of a candidate:
 
 - ``score``: share of the record's energy the pulse explains, ``1 - ||x - p||^2 / ||x||^2`` over
-  the whole record (1 for a record that is exactly the pulse); with ``weighting="background"``
-  the norm is the weighted one, ``||v||^2 = v' S^-1 v`` with ``S`` the background's estimated
+  the whole record (1 for a record that is exactly the pulse); where the weighted least squares
+  answered the norm is the weighted one, ``||v||^2 = v' S^-1 v`` with ``S`` the background's estimated
   covariance (every frequency of the record weighted by the inverse of the background's power
   there), the metric whose minimum the weighted least squares find;
 - ``correlation``: ``<x, p> / (||x|| ||p||)`` within the pulse window (support of the rectangular
