@@ -482,6 +482,13 @@ def test_pipeline_fit_table_csv_json_plot(tmp_path, capsys):
     assert main(["fit", sac, "--json", "--shapes", "sine", "ricker-anti"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert [c["shape"] for c in data[0]["candidates"]][0] == "ricker-anti" and len(data[0]["candidates"]) == 2
+    # the weighted least squares by default, the plain ones on request; the CSV says which answered
+    assert frame["weighting"].eq("background").all() and "background least squares" in text
+    assert main(["fit", sac, "--weighting", "plain", "--csv", str(csv)]) == 0
+    assert pd.read_csv(csv)["weighting"].eq("plain").all() and "plain least squares" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as stop:  # argparse's choices: one line, status 2
+        main(["fit", sac, "--weighting", "inverse"])
+    assert stop.value.code == 2
     assert main(["fit", sac, "--shapes", "triangle"]) == 2
     assert main(["fit", str(tmp_path / "missing.AT2"), sac]) == 1  # one bad file: reported, others fitted
     captured = capsys.readouterr()
