@@ -245,3 +245,8 @@ class ShapeNames:
 
     def __contains__(self, name) -> bool:
         return name in self.names()
+
+    def __str__(self) -> str:
+        """The names, comma-separated: ``%(shapes)s`` in the help of an option whose action has
+        ``shapes = ShapeNames()`` (argparse formats help with the action's attributes)."""
+        return ", ".join(self.names())

@@ -13,7 +13,7 @@ import json
 import os
 import sys
 
-from .args import ArgumentError, add_record_options, output_folder, parse_shapes, record_options
+from .args import ArgumentError, ShapeNames, add_record_options, output_folder, parse_shapes, record_options
 from .report import display, text_cell
 
 
@@ -25,8 +25,9 @@ def add_parser(subparsers) -> None:
                     "first. Exit status 0 when every record was fitted, 1 when some could not be "
                     "read, 2 for bad arguments.")
     p.add_argument("files", nargs="+", metavar="FILE", help="record files (AT2, SAC, MiniSEED, K-NET, text ...)")
-    p.add_argument("--shapes", nargs="+", metavar="SHAPE",
-                   help="shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: all)")
+    shapes = p.add_argument("--shapes", nargs="+", metavar="SHAPE",
+                   help="shapes to fit: %(shapes)s or all (default: all)")
+    shapes.shapes = ShapeNames()  # listed when the help is printed
     p.add_argument("--weighting", choices=("background", "plain"), default="background",
                    help="least squares weighted by the background's spectrum estimated from the record "
                         "(default), or plain least squares, for comparison")

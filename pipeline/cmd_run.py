@@ -5,7 +5,8 @@ import argparse
 import os
 
 from . import site
-from .args import ArgumentError, add_record_options, parse_block, parse_length, parse_shapes, record_options
+from .args import (ArgumentError, ShapeNames, add_record_options, parse_block, parse_length, parse_shapes,
+                   record_options)
 
 DEFAULT_OUT = "pipeline-output"
 #: most worker processes: each holds the solver and a record (a few hundred MB)
@@ -49,9 +50,10 @@ def add_parser(subparsers) -> None:
                    help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
                    help="only the width a column of this height (m) needs; repeatable")
-    p.add_argument("--shapes", nargs="+", metavar="SHAPE",
-                   help="pulse shapes to fit: sine, ricker-sym, ricker-anti, rect, or all (default: "
+    shapes = p.add_argument("--shapes", nargs="+", metavar="SHAPE",
+                   help="pulse shapes to fit: %(shapes)s or all (default: "
                         "the fitter's default set)")
+    shapes.shapes = ShapeNames()  # listed when the help is printed
     p.add_argument("--force", action="store_true",
                    help="compute every record again; by default a record whose report in --out was "
                         "made from the same file content, options and version is kept")
