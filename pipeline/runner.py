@@ -5,6 +5,7 @@ the reports are assembled in input order, and files are written atomically with 
 """
 from __future__ import annotations
 
+import collections
 import contextlib
 import glob
 import logging
@@ -163,7 +164,6 @@ def worker_failure(task: Task, exc: BaseException) -> dict:
 
 
 def _pool(tasks, jobs):
-    import collections
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
@@ -594,6 +594,8 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
             with contextlib.suppress(OSError):
                 outputs.finish()
 
+    # a pair's failed directions, counted in pairs.csv: its governing direction is over the others
+    failed = collections.Counter(t.pair or t.record_id for t, f in zip(tasks, failures) if f)
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts
@@ -603,7 +605,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
                   + site.columns_markdown())
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
-    site.write_outputs(outputs, rows, FIELDS, options)
+    site.write_outputs(outputs, rows, FIELDS, options, failed)
     if options.plots:
         from .plots import summary_figure_png
 

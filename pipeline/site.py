@@ -407,6 +407,8 @@ def _both_readable(a, b, opts) -> bool:
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------
 PAIR_COLUMNS = Columns(
     ("n_directions", "-", "Directions designed for (rows of this pair and column in `summary.csv`)."),
+    ("n_directions_failed", "-", "Directions of this pair that failed (in `failures.csv`): where not "
+                                 "0, the governing direction is the widest of the others only."),
     ("governing_direction_deg", "deg", "The direction whose verified width is widest (the first such "
                                        "in angle order); blank for a single component."),
 )
@@ -420,12 +422,14 @@ def _groups(rows):
     return out
 
 
-def governing_rows(rows) -> list[dict]:
-    """One row per pair (or single record) and column: its direction with the widest verified width."""
+def governing_rows(rows, failed=None) -> list[dict]:
+    """One row per pair (or single record) and column: its direction with the widest verified width.
+    ``failed``: ``{pair: directions that failed}``."""
     out = []
-    for (_, _), group in _groups(rows).items():
+    for (_, pair), group in _groups(rows).items():
         gov = max(group, key=lambda r: r["verified_width_m"])  # first of equal widths
-        row = PAIR_COLUMNS.row({"n_directions": len(group), "governing_direction_deg": gov["direction_deg"]})
+        row = PAIR_COLUMNS.row({"n_directions": len(group), "n_directions_failed": (failed or {}).get(pair, 0),
+                                "governing_direction_deg": gov["direction_deg"]})
         row.update(gov)
         out.append(row)
     return out
@@ -575,13 +579,13 @@ PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV, FRAGILITY_CURVE_CSV = ("pairs.csv", "suite.
 SUITE_PLOT, FRAGILITY_PLOT = "plots/suite.png", "plots/fragility.png"
 
 
-def write_outputs(outputs, rows, fields, options) -> None:
+def write_outputs(outputs, rows, fields, options, failed=None) -> None:
     """Write ``pairs.csv``, ``suite.csv`` (and their plots) and, with ``--fragility``, the fragility
-    files, from every row of the run."""
+    files, from every row of the run (``failed``: ``{pair: directions that failed}``)."""
     from . import report
 
     pair_fields = list(PAIR_COLUMNS.names) + list(fields)
-    outputs.write(PAIRS_CSV, report.csv_text(pair_fields, governing_rows(rows)))
+    outputs.write(PAIRS_CSV, report.csv_text(pair_fields, governing_rows(rows, failed)))
     suite = suite_rows(rows) if rows else []
     outputs.write(SUITE_CSV, report.csv_text(list(SUITE_COLUMNS.names), suite))
     if options.plots and rows:

@@ -80,6 +80,29 @@ def pair_run(pairs, tmp_path_factory):
     return out
 
 
+def test_a_failed_direction_is_counted_in_pairs_csv(pairs, pair_run, tmp_path, monkeypatch):
+    # one direction of the first pair fails (its worker kills itself): the pair's governing row
+    # says so, and is the widest of the other directions; the second pair is untouched
+    from pipeline import runner
+
+    rows = _read(pair_run / "summary.csv")
+    first = rows[0]["pair"]
+    killed = next(r["record"] for r in rows if r["pair"] == first and r["direction_kind"] == "component-2")
+    monkeypatch.setenv(runner.TEST_KILL_ENV, killed)
+    folder, ((a1, a2), (b1, b2)) = pairs
+    out = tmp_path / "out"
+    code = _run(out, "--pair", a1, a2, "--pair", b1, b2, "--block", f"{H}x{B}", "--directions", "4",
+                "--jobs", "2")
+    assert code == 1
+    gov = {g["pair"]: g for g in _read(out / "pairs.csv")}
+    reference = {g["pair"]: g for g in _read(pair_run / "pairs.csv")}
+    others = [r for r in rows if r["pair"] == first and r["record"] != killed]
+    assert int(gov[first]["n_directions_failed"]) == 1 and int(gov[first]["n_directions"]) == len(others)
+    assert _f(gov[first]["verified_width_m"]) == max(_f(r["verified_width_m"]) for r in others)
+    second = next(p for p in gov if p != first)
+    assert int(gov[second]["n_directions_failed"]) == 0 and gov[second] == reference[second]
+
+
 def test_pair_rows_governing_and_suite(pairs, pair_run, tmp_path):
     folder, ((a1, a2), (b1, b2)) = pairs
     rows = _read(pair_run / "summary.csv")
