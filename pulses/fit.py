@@ -87,8 +87,8 @@ SCORE_TAPER = 1.0
 LOADING = 1e-3
 #: record (s) kept each side of the pulse by the weighted least squares
 GLS_MARGIN = 5.0
-#: periods scanned by the weighted least squares of a shape with corners before its descent, within a factor
-#: GLS_SCAN_RANGE of the plain least squares' period; shifts within GLS_SHIFT Tp
+#: periods scanned by the weighted least squares of a shape with corners before its descent,
+#: within a factor GLS_SCAN_RANGE of the plain least squares' period; shifts within GLS_SHIFT Tp
 GLS_SCAN = 9
 GLS_SCAN_RANGE = 1.1
 GLS_SHIFT = 0.1
@@ -267,7 +267,8 @@ class PulseFit:
     def as_dict(self) -> dict:
         return {"record": self.name, "pga_g": self.pga / G, "pgv_m_s": self.pgv,
                 "duration_s": self.duration, "d5_95_s": self.significant_duration,
-                "weighting": self.weighting, "best": self.best.shape, "candidates": [c.as_dict() for c in self.candidates]}
+                "weighting": self.weighting, "best": self.best.shape,
+                "candidates": [c.as_dict() for c in self.candidates]}
 
 
 # -- the fitter ------------------------------------------------------------------------------------
@@ -308,8 +309,9 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         by the share of the record's energy they explain in that metric.  More accurate ap and
         Tp, and the shape right more often, on synthetic records with band-limited background
         motion; about twice the cost of the plain fit (README, "Accuracy on synthetic records").
-        Where the record does not follow its best plain pulse at the frequencies the weights
-        favour (Hausman's test), the plain fit answers and ``PulseFit.weighting`` says so.
+        Where the weighting would overturn the plain ranking although the record does not
+        follow the plain winner at the frequencies the weights favour (Hausman's test), the
+        plain fit answers, and ``PulseFit.weighting`` says so.
         ``"plain"``: ordinary least squares only (every frequency weighted alike), ranked by the
         plain share of energy; kept for comparison.
 
@@ -648,11 +650,11 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     period), Levenberg-Marquardt starts from the best, and starts again from the best of a
     lattice of the pulse's edges about where it stopped (:data:`GLS_LATTICE`).  A smooth shape's
     weighted minimum lies in the plain one's basin (the scan never moved a Ricker on the
-    README's synthetic or shared records): the descent starts from ``start``.  ``start`` is returned when nothing beats it on the weighted objective,
-    or when the two estimates differ by more than noise of the estimated spectrum explains
-    (:func:`_difference_covariance`).  By Gauss-Markov, under that spectrum the weighted
-    estimate scatters less than the plain one, whatever the shape and period; it is used
-    wherever the record follows the model.
+    README's synthetic or shared records): the descent starts from ``start``.  ``start`` is
+    returned when nothing beats it on the weighted objective, or when the two estimates differ by
+    more than noise of the estimated spectrum explains (:func:`_difference_covariance`).  By
+    Gauss-Markov, under that spectrum the weighted estimate scatters less than the plain one,
+    whatever the shape and period; it is used wherever the record follows the model.
     """
     cls = shape_class(shape)
     ap, tp, t0, _ = start
@@ -739,36 +741,29 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     # irfft counts the interior bins twice, which the weights already do
     Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
 
-    def scan(tps, t0s, few_shifts=False):
-        """The best of the pulses ``(tps, t0s)``, each moved by its best whole-sample shift
-        (within +-2 samples if ``few_shifts``), by the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``."""
+    def scan(tps, t0s, whitened=None):
+        """The best of the pulses ``(tps, t0s)``, each moved by its best whole-sample shift, by
+        the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``.  Given the record ``whitened`` (in time,
+        ``irfft(Xw)``: its circular cross-correlation with ``u`` at lag ``m`` is ``u'S^-1 x``
+        for ``u`` moved by ``m`` samples), the shifts are within 2 samples, summed over the
+        pulses' support instead of an inverse FFT each."""
         # every candidate sampled at once, over the union of their supports
         a = max(0, int(math.floor((np.min(t0s + sup_lo * tps) - tw[0]) / dt)) - 1)
         b = max(a, min(tw.size, int(math.ceil((np.max(t0s + sup_hi * tps) - tw[0]) / dt)) + 2))
         cols = np.zeros((len(tps), nfft))
         cols[:, a:b] = cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
-        if few_shifts:  # a few shifts: sums over the support with the whitened record
+        if whitened is not None:
             lags = np.arange(-2, 3)
-            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened()[(np.arange(a, b)[None] + lags[:, None]) % nfft])
-        else:
-            lags = shifts[k_near]
+            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
         M = sfft.rfft(cols, axis=-1, overwrite_x=True)
         mm = np.einsum("ik,ik->i", M.view(float), (M * w).view(float))
-        if not few_shifts:
+        if whitened is None:
+            lags = shifts[k_near]
             corr = sfft.irfft(Xw_half * M.conj(), nfft, axis=-1)[:, k_near] * nfft
         j = np.argmax(np.abs(corr), axis=1)
         gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
         i = int(np.argmax(gain))
         return tps[i], t0s[i] + lags[j[i]] * dt
-
-    cache = {}
-
-    def whitened():
-        """The record whitened by the weights, in time: its circular cross-correlation with a
-        pulse ``u`` at lag ``m`` is ``u'S^-1 x`` for ``u`` moved by ``m`` samples."""
-        if "x" not in cache:
-            cache["x"] = sfft.irfft(Xw_half, nfft) * nfft
-        return cache["x"]
 
     _, tp0, t00 = match
     lower = np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0])
@@ -793,7 +788,7 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
                 (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
                 p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
             tps = widths / (hi_ - lo_)
-            p_lattice, cost_lattice = descent(*scan(tps, starts - lo_ * tps, few_shifts=True))
+            p_lattice, cost_lattice = descent(*scan(tps, starts - lo_ * tps, sfft.irfft(Xw_half, nfft) * nfft))
             if cost_lattice < cost:
                 p_new, cost = p_lattice, cost_lattice
     except np.linalg.LinAlgError:
