@@ -277,7 +277,7 @@ def test_weighted_fit_of_short_cornered_pulses_in_a_wide_band():
     # crosses a sample: a descent alone stopped in one a sample or two from the optimum
     # (one-sine: Tp RMS 2.6 %, ap 7.9 %, worse than plain), the lattice of edges reaches it.
     # Measured on these 24 records: one-sine Tp RMS 0.10 % against 3.7 % plain (0.03), ap 3.8 %
-    # against 6.6 % (0.57); rectangle ap 2.7 % against 6.1 % (0.45).  Bars: a tenth of plain for
+    # against 6.6 % (0.57); rectangle ap 2.0 % against 6.1 % (0.33).  Bars: a tenth of plain for
     # the one-sine's Tp, 0.8 of plain for the ap (12 records a shape: the ratio's sampling error
     # is about 0.15)
     rng = np.random.default_rng(2025)
