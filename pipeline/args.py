@@ -226,6 +226,13 @@ def output_folder(path, what: str = "--out") -> pathlib.Path:
     return out
 
 
+def add_weighting_option(p) -> None:
+    """``--weighting``: the least squares of the pulse fit (:func:`pulses.fit_pulse`'s ``weighting``)."""
+    p.add_argument("--weighting", choices=("background", "plain"), default="background",
+                   help="pulse fit: least squares weighted by the background's spectrum estimated from "
+                        "the record (default), or plain least squares, for comparison")
+
+
 class ShapeNames:
     """The names of the pulse shapes (:data:`pulses.SHAPES`), as ``choices`` of an option, read
     when first asked (checking a value, printing help): the command line starts without importing

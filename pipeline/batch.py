@@ -46,6 +46,8 @@ class Column:
 @dataclass(frozen=True)
 class Options:
     shapes: tuple | None = None
+    #: the pulse fit's least squares (``pulses.fit_pulse``'s ``weighting``)
+    weighting: str = "background"
     units: str | None = None
     dt: float | None = None
     column: int | None = None
@@ -487,7 +489,7 @@ def _process(task: Task):
 
     opts = task.options
     record = _stage("read", _read, task)
-    fit = _stage("fit", _fit, record, opts.shapes)
+    fit = _stage("fit", _fit, record, opts.shapes, opts.weighting)
     best = fit.best
     candidates = list(fit.candidates)
     fitting = [c for c in candidates if _fits(c, best)]
@@ -587,9 +589,7 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
     return out
 
 
-def _fit(record, shapes):
+def _fit(record, shapes, weighting):
     import pulses
 
-    if shapes:
-        return pulses.fit_pulse(record, shapes=list(shapes))
-    return pulses.fit_pulse(record)
+    return pulses.fit_pulse(record, shapes=list(shapes) if shapes else None, weighting=weighting)

@@ -13,7 +13,8 @@ import json
 import os
 import sys
 
-from .args import ArgumentError, ShapeNames, add_record_options, output_folder, parse_shapes, record_options
+from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, output_folder, parse_shapes,
+                   record_options)
 from .report import display, text_cell
 
 
@@ -28,9 +29,7 @@ def add_parser(subparsers) -> None:
     shapes = p.add_argument("--shapes", nargs="+", metavar="SHAPE",
                    help="shapes to fit: %(shapes)s or all (default: all)")
     shapes.shapes = ShapeNames()  # listed when the help is printed
-    p.add_argument("--weighting", choices=("background", "plain"), default="background",
-                   help="least squares weighted by the background's spectrum estimated from the record "
-                        "(default), or plain least squares, for comparison")
+    add_weighting_option(p)
     add_record_options(p)
     p.add_argument("--csv", metavar="FILE", help="write one row per record and shape to this CSV file")
     p.add_argument("--plot", metavar="DIR", help="draw each record with its fitted pulses into DIR/<record>.png")

@@ -5,8 +5,8 @@ import argparse
 import os
 
 from . import site
-from .args import (ArgumentError, ShapeNames, add_record_options, parse_block, parse_length, parse_shapes,
-                   record_options)
+from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
+                   parse_shapes, record_options)
 
 DEFAULT_OUT = "pipeline-output"
 #: most worker processes: each holds the solver and a record (a few hundred MB)
@@ -54,6 +54,7 @@ def add_parser(subparsers) -> None:
                    help="pulse shapes to fit: %(shapes)s or all (default: "
                         "the fitter's default set)")
     shapes.shapes = ShapeNames()  # listed when the help is printed
+    add_weighting_option(p)
     p.add_argument("--force", action="store_true",
                    help="compute every record again; by default a record whose report in --out was "
                         "made from the same file content, options and version is kept")
@@ -102,8 +103,8 @@ def main(args) -> int:
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
-    options = options_from(args, shapes=parse_shapes(args.shapes), **record_options(args),
-                           **site.options_from_args(args))
+    options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
+                           **record_options(args), **site.options_from_args(args))
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     paths = expand_inputs(args.records)

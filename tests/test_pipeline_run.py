@@ -335,6 +335,14 @@ def test_cli_end_to_end_numbers_match_library(tmp_path):
     assert max(widths.values()) == pytest.approx(w31)
     # summary.csv is the per-record report's rows
     assert read_csv(out / "summary.csv") == rows
+    # the fit's least squares: the weighted ones by default, the plain ones on request
+    assert r["pulse_fit"] == fit.weighting == "background"
+    assert main(["run", str(sac), "--block", "7.5x1.8", "--weighting", "plain", "--out", str(tmp_path / "plain"),
+                 "--no-plots", "-q"]) == 0
+    (p,) = read_csv(tmp_path / "plain" / "example.csv")
+    plain = pulses.fit_pulse(record, weighting="plain").best
+    assert p["pulse_fit"] == "plain" and p["pulse_shape"] == plain.shape
+    assert close(p["pulse_ap_g"], plain.ap / G) and close(p["pulse_tp_s"], plain.tp)
 
 
 # -- the paper's records -----------------------------------------------------------------------
