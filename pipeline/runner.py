@@ -595,7 +595,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
                 outputs.finish()
 
     # a pair's failed directions, counted in pairs.csv: its governing direction is over the others
-    failed = collections.Counter(t.pair or t.record_id for t, f in zip(tasks, failures) if f)
+    failed = collections.Counter(site.pair_of(t) for t, f in zip(tasks, failures) if f)
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts

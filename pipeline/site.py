@@ -106,6 +106,11 @@ def classification_fields(record, other=None, pair_fields=None) -> tuple[dict, s
     return fields, (None if fields.get("pulse_like") else NOT_PULSE_WARNING)
 
 
+def pair_of(task) -> str:
+    """The pair a task's rows belong to (``pair`` in the reports): a single record is its own."""
+    return task.pair or task.record_id
+
+
 def site_fields(task, record) -> tuple[dict, str | None]:
     """The :data:`SITE_COLUMNS` group of one task's rows, and the warning to add (or None)."""
     cls, warning = classification_fields(record, pair_fields=dict(task.pair_fields) or None)
@@ -113,7 +118,7 @@ def site_fields(task, record) -> tuple[dict, str | None]:
     if task.path2 is not None:
         az = record.metadata.get("azimuth")
         az = None if az is None else float(az) % 180.0
-    fields = {"pair": task.pair or task.record_id, "file2": task.path2,
+    fields = {"pair": pair_of(task), "file2": task.path2,
               "direction_deg": task.direction, "direction_kind": task.direction_kind or None,
               "direction_azimuth_deg": az, "scale": float(task.scale),
               "cap_mass_ratio": float(task.options.cap_mass_ratio)}

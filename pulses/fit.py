@@ -396,7 +396,7 @@ def _weighted(x, t, dt, fits, plain_scores, energy, baseline):
     if background is None:
         return fits, None
     weighted = {}
-    for shape, (match, trial, p_trial) in fits.items():
+    for shape, (match, trial, _) in fits.items():
         if shape == best:
             weighted[shape] = (match, *best_fit)
             continue
@@ -759,14 +759,14 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
         b = max(a, min(tw.size, int(math.ceil((np.max(t0s + sup_hi * tps) - tw[0]) / dt)) + 2))
         cols = np.zeros((len(tps), nfft))
         cols[:, a:b] = cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
-        if whitened is not None:
-            lags = np.arange(-2, 3)
-            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
-        M = sfft.rfft(cols, axis=-1, overwrite_x=True)
+        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
         mm = np.einsum("ik,ik->i", M.view(float), (M * w).view(float))
         if whitened is None:
             lags = shifts[k_near]
             corr = sfft.irfft(Xw_half * M.conj(), nfft, axis=-1)[:, k_near] * nfft
+        else:
+            lags = np.arange(-2, 3)
+            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
         j = np.argmax(np.abs(corr), axis=1)
         gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
         i = int(np.argmax(gain))
