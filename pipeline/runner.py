@@ -14,7 +14,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import interrupts, joblog, report, resume, site
+from . import design_table, html_report, interrupts, joblog, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
@@ -431,7 +431,7 @@ def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> rep
     fixed = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.MANIFEST]
     if plots:
         fixed.append(report.SUMMARY_PLOT)
-    fixed += site.output_files(options)
+    fixed += site.output_files(options) + answer_files()
     written = fixed + [report.record_csv_name(t.record_id) for t in tasks]
     if plots:
         written += [report.record_plot_name(t.record_id) for t in tasks]
@@ -516,7 +516,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     except report.NotOurs as exc:
         raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
     names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
-             resume.RESUME] + site.output_files(options)
+             resume.RESUME] + site.output_files(options) + answer_files()
     names += [n for t in tasks for n in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id))]
     resume.remove_stale_temporaries(out, names)  # left by a run killed while writing
 
@@ -602,7 +602,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
-                  + site.columns_markdown())
+                  + site.columns_markdown() + design_table.columns_markdown())
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed)
@@ -610,6 +610,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         from .plots import summary_figure_png
 
         outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
+    design = write_answer(outputs, out, tasks, rows, failures, failed, options)
     outputs.finish()
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
@@ -619,5 +620,25 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         msg += f" ({n_reused} reused from an earlier run, {len(todo)} computed)"
         if n_failed:
             msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
+        print(design_table.table_text(design, failures), end="")
         print(f"{msg}; reports in {report.display(out)}")
     return summary
+
+
+# -- the answer in view: design.csv, report.html (pipeline.design_table, pipeline.html_report) --------
+def answer_files() -> list[str]:
+    """The files :func:`write_answer` writes into ``--out``."""
+    return [design_table.DESIGN_CSV] + html_report.output_files()
+
+
+def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
+    """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
+    design = design_table.design_rows(rows, failed)
+    outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.DESIGN_FIELDS, design))
+    ids = [t.record_id for t in tasks]
+    this_run = set(site.output_files(options))  # a figure of an earlier run with other options is not shown
+    names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", site.SUITE_PLOT),
+                                   ("fragility", site.FRAGILITY_PLOT)) if k == "summary" or rel in this_run}
+    figures = html_report.figures_in(out, ids, options.plots, names)
+    outputs.write(html_report.REPORT_HTML, html_report.report_html(design, rows, failures, ids, figures))
+    return design

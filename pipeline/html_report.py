@@ -1,0 +1,272 @@
+"""``report.html``: one page in ``--out`` on which to review a batch of ``pipeline run``.
+
+It opens from the disk in any browser, with no server and no network: the style and the few lines
+that sort the table are in the page, and the figures are the run's own PNGs, linked by relative
+paths (``plots/...``), so the page stays small and a folder moved as a whole keeps working.  The
+page holds the batch table (the rows of ``design.csv``; a click on a heading sorts by it), every
+record with its classification, fitted pulse, verdicts and figure, the failures with their
+reasons, and the summary, suite and fragility figures where the run drew them.  It depends on
+nothing but the rows and files of the run (no date, no path of the machine), so a re-run writes the
+same bytes.
+"""
+from __future__ import annotations
+
+import html
+import math
+import pathlib
+import urllib.parse
+
+from . import report
+from .design_table import pulse_text, survives_text
+
+#: the file in ``--out``
+REPORT_HTML = "report.html"
+
+_CSS = """
+body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.5em auto;max-width:76em;
+padding:0 1em;color:#222;line-height:1.4}
+h1{font-size:1.5em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ccc}h3{font-size:1.05em}
+table{border-collapse:collapse;font-size:.9em;margin:.5em 0}
+th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left;vertical-align:top}
+td.n{text-align:right;font-variant-numeric:tabular-nums}
+thead th{background:#f0f0f0;cursor:pointer;user-select:none;white-space:nowrap}
+thead th.asc::after{content:" \\25B2"}thead th.desc::after{content:" \\25BC"}
+tr.no td{background:#fde8e8}tr.island td{background:#fff6dc}
+img{max-width:100%;height:auto;border:1px solid #ddd}
+.rec{margin-top:1.5em}.muted{color:#666}dl{display:grid;grid-template-columns:max-content auto;gap:.1em 1em}
+dt{font-weight:600}dd{margin:0}
+"""
+
+# sorts the table whose heading is clicked: by the cells' data-v (numbers as numbers, blanks last)
+_JS = """
+document.querySelectorAll("table.sortable").forEach(function (table) {
+  var heads = table.tHead.rows[0].cells;
+  Array.prototype.forEach.call(heads, function (th, col) {
+    th.addEventListener("click", function () {
+      var asc = !th.classList.contains("asc");
+      Array.prototype.forEach.call(heads, function (h) { h.classList.remove("asc", "desc"); });
+      th.classList.add(asc ? "asc" : "desc");
+      var body = table.tBodies[0], rows = Array.prototype.slice.call(body.rows);
+      function key(row) {
+        var v = row.cells[col].getAttribute("data-v"), x = parseFloat(v);
+        return v === "" ? null : (isNaN(x) || String(x) !== v ? v : x);
+      }
+      rows.sort(function (a, b) {
+        var x = key(a), y = key(b);
+        if (x === null || y === null) { return x === y ? 0 : (x === null ? 1 : -1); }
+        if (typeof x !== typeof y) { x = String(x); y = String(y); }
+        var c = x < y ? -1 : (x > y ? 1 : 0);
+        return asc ? c : -c;
+      });
+      rows.forEach(function (r) { body.appendChild(r); });
+    });
+  });
+});
+"""
+
+
+def output_files() -> list[str]:
+    """The files this module writes into ``--out``."""
+    return [REPORT_HTML]
+
+
+def _e(value) -> str:
+    return html.escape(report.display("" if value is None else value), quote=True)
+
+
+def _num(value):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def _sort_value(value) -> str:
+    """The ``data-v`` of a cell: a number as ``repr`` (parsed back to itself by the page), else text."""
+    v = _num(value)
+    if v is not None and not isinstance(value, bool):
+        return repr(v) if v != int(v) or abs(v) >= 1e15 else str(int(v))
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    return report.display(value)
+
+
+def _cell(value, shown=None, numeric=False) -> str:
+    shown = _e(shown if shown is not None else ("-" if value is None else value))
+    cls = ' class="n"' if numeric else ""
+    return f'<td{cls} data-v="{_e(_sort_value(value))}">{shown}</td>'
+
+
+def _fixed(value, digits=3, unit=""):
+    v = _num(value)
+    return None if v is None else f"{v:.{digits}f}{unit}"
+
+
+def _yes(value):
+    return "-" if value is None else ("yes" if value else "no")
+
+
+def _href(rel: str) -> str:
+    return urllib.parse.quote(rel, safe="/")
+
+
+def _anchor(record_id) -> str:
+    return "r-" + urllib.parse.quote(report.display(record_id), safe="").replace("%", "_")
+
+
+def _batch_table(design, anchors) -> list[str]:
+    heads = ["record", "column", "direction (deg)", "pulse-like", "velocity Tp (s)", "governing pulse",
+             "ap (g)", "Tp (s)", "Eq. 31 width (m)", "verified width (m)", "width (m)", "survives",
+             "max theta/alpha"]
+    out = ['<table class="sortable" id="batch"><thead><tr>' + "".join(f"<th>{_e(h)}</th>" for h in heads)
+           + "</tr></thead><tbody>"]
+    for r in design:
+        surv = survives_text(r)
+        cls = {"NO": ' class="no"', "yes, safe island": ' class="island"'}.get(surv, "")
+        target = anchors.get(r["record"])
+        name = _e(r["record"])
+        name = f'<a href="#{target}">{name}</a>' if target else name
+        out.append(
+            f"<tr{cls}>"
+            f'<td data-v="{_e(r["record"])}">{name}</td>'
+            + _cell(r["column"])
+            + _cell(r["direction_deg"], _fixed(r["direction_deg"], 1), numeric=True)
+            + _cell(r["pulse_like"], _yes(r["pulse_like"]))
+            + _cell(r["velocity_tp_s"], _fixed(r["velocity_tp_s"], 2), numeric=True)
+            + _cell(r["governing_shape"])
+            + _cell(r["governing_ap_g"], _fixed(r["governing_ap_g"], 3), numeric=True)
+            + _cell(r["governing_tp_s"], _fixed(r["governing_tp_s"], 3), numeric=True)
+            + _cell(r["eq31_width_m"], _fixed(r["eq31_width_m"]), numeric=True)
+            + _cell(r["verified_width_m"], _fixed(r["verified_width_m"]), numeric=True)
+            + _cell(r["width_m"], _fixed(r["width_m"]), numeric=True)
+            + _cell(surv if r["survives"] is not None else None, surv)
+            + _cell(r["max_theta_ratio"], _fixed(r["max_theta_ratio"]), numeric=True)
+            + "</tr>")
+    out.append("</tbody></table>")
+    return out
+
+
+def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
+    first = rows[0] if rows else {}
+    out = [f'<section class="rec" id="{anchor}"><h3>{_e(rid)}</h3>']
+    if first:
+        facts = [("file", first.get("file"))]
+        if first.get("file2"):
+            facts.append(("second component", first.get("file2")))
+        if first.get("direction_deg") is not None:
+            facts.append(("direction", f"{_fixed(first['direction_deg'], 1)} deg ({first.get('direction_kind') or ''})"))
+        if _num(first.get("scale")) not in (None, 1.0):
+            facts.append(("scale", first.get("scale")))
+        facts += [
+            ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s"),
+            ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
+                           f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
+                           f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"),
+            ("fitted pulse", f"{first.get('pulse_shape') or '-'}: ap {_fixed(first.get('pulse_ap_g'), 3) or '-'} g, "
+                             f"Tp {_fixed(first.get('pulse_tp_s'), 3) or '-'} s, score {_fixed(first.get('pulse_score'), 2) or '-'} "
+                             f"({first.get('pulse_fit') or '-'} least squares); shapes that fit: "
+                             f"{first.get('shapes_fitting') or '-'}"),
+        ]
+        if first.get("warnings"):
+            facts.append(("warnings", first.get("warnings")))
+        out.append("<dl>" + "".join(f"<dt>{_e(k)}</dt><dd>{_e(v)}</dd>" for k, v in facts) + "</dl>")
+        out.append("<ul>")
+        for r in rows:
+            parts = [f"column {r.get('column')}: governing pulse {pulse_text(r)}",
+                     f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
+                     + (" (overturns)" if r.get("eq31_width_overturns") else ""),
+                     f"verified width {_fixed(r.get('verified_width_m')) or '-'} m"]
+            if r.get("column_kind") == "block":
+                surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
+                                      "verified_adequate": r.get("verified_adequate")})
+                parts.append(f"as it stands: survives {surv}, max theta/alpha {_fixed(r.get('max_theta_ratio')) or '-'}")
+            out.append(f"<li>{_e('; '.join(parts))}</li>")
+        out.append("</ul>")
+    if failure:
+        out.append(f'<p class="muted">failed ({_e(failure["stage"])}): {_e(failure["reason"])}</p>')
+    if plot:
+        out.append(f'<p><img src="{_href(plot)}" alt="{_e(rid)}: record, pulses and rotation histories"></p>')
+    out.append("</section>")
+    return out
+
+
+def report_html(design, rows, failures, record_ids, figures, title="pipeline run") -> str:
+    """The page.
+
+    Parameters
+    ----------
+    design : list of dict
+        Rows of ``design.csv`` (:func:`pipeline.design_table.design_rows`).
+    rows : list of dict
+        Rows of ``summary.csv``.
+    failures : list of dict
+        Rows of ``failures.csv``.
+    record_ids : list of str
+        Every record of the run, in input order (failed ones too).
+    figures : dict
+        ``{record id or "summary", "suite", "fragility": path relative to --out}`` of the figures
+        the run wrote.
+    """
+    by_record = {}
+    for r in rows:
+        by_record.setdefault(r["record"], []).append(r)
+    failed = {f["record"]: f for f in failures}
+    anchors = {rid: _anchor(rid) for rid in record_ids}
+    # a pair's row in the batch table links to its first direction
+    pair_anchor = {}
+    for r in rows:
+        pair_anchor.setdefault(r.get("pair") or r["record"], anchors.get(r["record"]))
+    n_ok = len([rid for rid in record_ids if rid in by_record and rid not in failed])
+    out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+           '<meta name="viewport" content="width=device-width, initial-scale=1">',
+           f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
+           f"<h1>{_e(title)}</h1>",
+           f"<p>{len(record_ids)} records, {len(failures)} failed. Files: "
+           + ", ".join(f'<a href="{_href(f)}">{_e(f)}</a>' for f in
+                       ("design.csv", "summary.csv", "failures.csv", "columns.md"))
+           + ". Click a heading to sort the table. Rows in red: the column as it stands overturns; "
+             "in yellow: it survives on a safe island (a slightly wider column overturns).</p>",
+           "<h2>Designs</h2>"]
+    out += _batch_table(design, pair_anchor)
+    if failures:
+        out.append(f'<h2 id="failures">Failures ({len(failures)})</h2>')
+        out.append('<table class="sortable" id="failed"><thead><tr><th>record</th><th>file</th><th>stage</th>'
+                   "<th>error</th><th>reason</th></tr></thead><tbody>")
+        for f in failures:
+            out.append("<tr>" + "".join(_cell(f.get(k)) for k in ("record", "file", "stage", "error", "reason"))
+                       + "</tr>")
+        out.append("</tbody></table>")
+    site = [(k, label) for k, label in (("summary", "Required against actual slenderness"),
+                                        ("suite", "Suite: share of records verified against width"),
+                                        ("fragility", "Collapse fragility")) if figures.get(k)]
+    if site:
+        out.append("<h2>Batch figures</h2>")
+        for k, label in site:
+            out.append(f"<h3>{_e(label)}</h3><p><img src=\"{_href(figures[k])}\" alt=\"{_e(label)}\"></p>")
+    out.append(f"<h2>Records ({n_ok} processed)</h2>")
+    for rid in record_ids:
+        out += _record_section(rid, by_record.get(rid, []), failed.get(rid), figures.get(("record", rid)),
+                               anchors[rid])
+    out.append(f"<script>{_JS}</script></body></html>")
+    return "\n".join(out) + "\n"
+
+
+def figures_in(out, record_ids, plots: bool, names: dict) -> dict:
+    """The figures of the run present in ``out``: ``names`` maps ``"summary"``, ``"suite"``,
+    ``"fragility"`` to their paths; records' figures are ``plots/<record>.png``."""
+    out = pathlib.Path(out)
+    found = {}
+    if not plots:
+        return found
+    for key, rel in names.items():
+        if (out / rel).is_file():
+            found[key] = rel
+    for rid in record_ids:
+        rel = report.record_plot_name(rid)
+        if (out / rel).is_file():
+            found[("record", rid)] = rel
+    return found
+
