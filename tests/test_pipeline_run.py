@@ -416,9 +416,10 @@ def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
     assert main(["run", *subset, *BATCH_ARGS, "--out", str(out2), "--dask", "local", "--jobs", "2"]) == 1
     produced = tree(out2)
     for name in produced:
-        if name.endswith(".csv") and name not in ("summary.csv", "failures.csv", "pairs.csv", "suite.csv"):
+        if name.endswith(".csv") and name not in ("summary.csv", "failures.csv", "pairs.csv", "suite.csv",
+                                                              "design.csv"):
             assert produced[name] == (out / name).read_bytes(), name
-    assert sum(n.endswith(".csv") for n in produced) == 5 + 4  # records, summary, failures, pairs, suite
+    assert sum(n.endswith(".csv") for n in produced) == 5 + 5  # records, summary, failures, pairs, suite, design
     fail = read_csv(out2 / "failures.csv")
     assert fail == [f for f in read_csv(out / "failures.csv") if f["record"] == "missing"]
 
