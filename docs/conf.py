@@ -64,7 +64,9 @@ def _plain_docstring(app, what, name, obj, options, lines):
             joined[-1] = joined[-1].rstrip() + " " + line.strip()
         else:
             joined.append(line)
-    lines[:] = [_ABS.sub(r"\\|\1\\|", line) if "``" not in line else line for line in joined]
+    # only outside inline literals: split at ``, the odd parts are literals
+    lines[:] = ["``".join(part if k % 2 else _ABS.sub(r"\\|\1\\|", part) for k, part in enumerate(line.split("``")))
+                for line in joined]
 
 
 def setup(app):
