@@ -170,10 +170,10 @@ def _process_record(task: Task) -> dict:
         out["failure"] = failure(task, "internal", exc)
         return out
     if task.options.plots:
-        from .plots import record_figure_png
+        from .plots import run_figure_png
 
         try:
-            out["plot"] = _stage("plot", record_figure_png, task.record_id, *fit_parts)
+            out["plot"] = _stage("plot", run_figure_png, task.record_id, *fit_parts)
         except StageError as err:
             out["failure"] = failure(task, err.stage, err.exc)
     return out
@@ -547,12 +547,16 @@ def _process(task: Task):
         res31 = _stage("verify", _sim, block31, record, opts.plots)
         if opts.plots:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
-            histories.append((col.label, curves))
 
         # -- verified width: smallest width surviving the full record (islands respected) ---------
         if H not in verified_cache:
             verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact",
                                        cap_mass_ratio=gamma)
+        if opts.plots:  # the column at its verified width, for the figure
+            wv = float(verified_cache[H].width)
+            block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
+            curves.append((f"verified width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
+            histories.append((col.label, curves))
 
         row = dict(base)
         row.update(_column_fields(col))

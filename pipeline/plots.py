@@ -27,9 +27,11 @@ TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE = 11, 10, 9, 8
 #: most fitted pulses drawn on a record (``pipeline run`` keeps the shapes within FIT_TOLERANCE of
 #: the best: at most one per shape, four shapes)
 MAX_PULSES = 4
-#: most curves per rotation-history panel (the column as it stands and the Eq. 31 design)
-MAX_CURVES = 2
+#: most curves per rotation-history panel (the column as it stands, the Eq. 31 design, the
+#: verified width)
+MAX_CURVES = 3
 _PULSE_STYLES = ["-", "--", "-.", ":"]
+_CURVE_STYLES = ["-", "--", "-."]
 #: record figure in inches: margins (room for the y label and tick labels as wide as "-0.0075",
 #: the x tick labels and label, the first title), height of a panel, gap between panels (a title)
 _RECORD_LEFT, _RECORD_RIGHT, _RECORD_TOP, _RECORD_BOTTOM = 0.95, 0.15, 0.36, 0.55
@@ -64,7 +66,7 @@ def _style(ax) -> None:
     ax.tick_params(labelsize=TICK_SIZE)
 
 
-def record_figure(record_id, record, fit, fitting, histories) -> Figure:
+def record_figure(record_id, record, fit, fitting, histories, velocity=None) -> Figure:
     """The record with its fitted pulses (paper's Fig. 4) and rotation histories (Figs. 9, 11).
 
     Parameters
@@ -81,23 +83,30 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
         One panel per column: its label (metres, in the title) and at most :data:`MAX_CURVES`
         curves ``(curve label, block, result)``, the rotation drawn as theta / alpha.
 
+    velocity : pulses.PulseClassification, optional
+        The record's velocity-pulse classification (:func:`pulses.classify_pulse`): when given, a
+        panel under the record draws its velocity in the pulse's direction and the extracted
+        velocity pulse that decided whether it is pulse-like.
+
     Returns
     -------
     matplotlib.figure.Figure
-        ``1 + len(histories)`` panels sharing the time axis, 8 in wide.
+        ``1 + len(histories)`` panels (one more with ``velocity``) sharing the time axis, 8 in wide.
     """
     from pulses import G
 
     fitting = list(fitting)
     if len(fitting) > MAX_PULSES:
         raise ValueError(f"at most {MAX_PULSES} fitted pulses per record figure, got {len(fitting)}")
-    width, height = 8.0, _RECORD_TOP + _RECORD_BOTTOM + (1 + len(histories)) * _PANEL + len(histories) * _GAP
+    n_top = 1 if velocity is None else 2
+    n_gaps = len(histories) + n_top - 1
+    width, height = 8.0, _RECORD_TOP + _RECORD_BOTTOM + (n_top + len(histories)) * _PANEL + n_gaps * _GAP
     fig = _figure(width, height)
     # margins fixed in inches (room for these labels, checked by tests/test_plots.py): a layout
     # engine measures every text before drawing it, which made the figure half as costly again
     fig.subplots_adjust(left=_RECORD_LEFT / width, right=1.0 - _RECORD_RIGHT / width, top=1.0 - _RECORD_TOP / height,
                         bottom=_RECORD_BOTTOM / height, hspace=_GAP / _PANEL)
-    axes = fig.subplots(1 + len(histories), 1, sharex=True, squeeze=False)[:, 0]
+    axes = fig.subplots(n_top + len(histories), 1, sharex=True, squeeze=False)[:, 0]
     ax = axes[0]
     t = record.time
     ax.plot(*_thin(t, record.acc / G), color="0.55", lw=0.6, label="record")
@@ -108,13 +117,15 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
     # titles at a given height (y=1): matplotlib otherwise measures the axes' ticks to place them
     ax.set_title(f"{record_id}: record and fitted pulse{'s' if len(fitting) > 1 else ''}", fontsize=TITLE_SIZE,
                  y=1.0)
-    for ax, (label, curves) in zip(axes[1:], histories):
+    if velocity is not None:
+        _velocity_panel(axes[1], velocity)
+    for ax, (label, curves) in zip(axes[n_top:], histories):
         if len(curves) > MAX_CURVES:
             raise ValueError(f"at most {MAX_CURVES} curves per history panel, got {len(curves)}")
         for j, (curve_label, block, res) in enumerate(curves):
             verdict = "overturns" if res.overturned else f"max {res.max_rotation_ratio:.3g} alpha"
             ax.plot(*_thin(res.t, np.asarray(res.theta, dtype=float) / block.alpha), color=f"C{j}", lw=1.0,
-                    ls="-" if j == 0 else "--", label=f"{curve_label}: {verdict}")
+                    ls=_CURVE_STYLES[j], label=f"{curve_label}: {verdict}")
         ax.axhline(1.0, color="k", lw=0.5, ls=":")  # overturning starts past |theta| = alpha
         ax.axhline(-1.0, color="k", lw=0.5, ls=":")
         ax.set_ylabel("theta / alpha", fontsize=LABEL_SIZE)
@@ -130,10 +141,35 @@ def record_figure(record_id, record, fit, fitting, histories) -> Figure:
     return fig
 
 
-def record_figure_png(record_id, record, fit, fitting, histories) -> bytes:
+def _velocity_panel(ax, cls) -> None:
+    """The record's velocity in the pulse's direction and the extracted velocity pulse."""
+    t = cls.time
+    verdict = "pulse-like" if cls.is_pulse else "not pulse-like"
+    ax.plot(*_thin(t, cls.velocity), color="0.55", lw=0.6, label="ground velocity")
+    ax.plot(*_thin(t, cls.pulse), color="C3", lw=1.4,
+            label=f"velocity pulse: Tp {cls.tp:.3g} s, PI {cls.indicator:+.3g} ({verdict})")
+    ax.set_ylabel("velocity (m/s)", fontsize=LABEL_SIZE)
+    ax.set_title("velocity in the pulse's direction and the extracted velocity pulse (Shahi & Baker 2014)",
+                 fontsize=TITLE_SIZE - 1, y=1.0)
+
+
+def record_figure_png(record_id, record, fit, fitting, histories, velocity=None) -> bytes:
     """PNG bytes of :func:`record_figure` (same parameters)."""
     with _LOCK:
-        return _png(record_figure(record_id, record, fit, fitting, histories))
+        return _png(record_figure(record_id, record, fit, fitting, histories, velocity=velocity))
+
+
+def run_figure_png(record_id, record, fit, fitting, histories) -> bytes:
+    """The figure of ``pipeline run`` for one record: :func:`record_figure_png` with the record's
+    velocity pulse (classified here, on the record as designed: for a pair, the component in the
+    row's direction); without it where the record cannot be classified."""
+    import pulses
+
+    try:
+        velocity = pulses.classify_pulse(record)
+    except Exception:  # an unusual record: its rows say why; the figure is drawn without the panel
+        velocity = None
+    return record_figure_png(record_id, record, fit, fitting, histories, velocity=velocity)
 
 
 def _num(row, key):

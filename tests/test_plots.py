@@ -4,6 +4,7 @@ from __future__ import annotations
 import io
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from pipeline import plots
@@ -144,3 +145,31 @@ def test_summary_figure_without_columns_says_so():
     fig = plots.summary_figure([])
     assert [t.get_text() for t in fig.axes[0].texts] == ["no column as it stands (--block) in this run"]
     assert fig.axes[0].get_legend() is None and fig.axes[1].get_legend() is None
+
+
+def test_record_figure_velocity_pulse_and_verified_width(tmp_path):
+    """The run's figure adds the record's velocity with the extracted velocity pulse (the
+    classification's own arrays) and the column at its verified width (the row's width)."""
+    import pulses
+
+    path = write_good(tmp_path, 4)
+    task, = make_tasks([str(path)], [Column(7.5, 1.8)], Options())
+    rows, (record, fit, fitting, histories) = _process(task)
+    (label, curves), = histories
+    assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "verified width"]
+    _, block_v, res_v = curves[2]
+    assert block_v.width == pytest.approx(rows[0]["verified_width_m"], rel=1e-12)
+    assert not res_v.overturned  # the verified width survives the record
+    cls = pulses.classify_pulse(record)
+    fig = plots.record_figure(task.record_id, record, fit, fitting, histories, velocity=cls)
+    top, vel, rot = fig.axes
+    ground, pulse = vel.get_lines()[:2]
+    np.testing.assert_array_equal(ground.get_ydata(), cls.velocity)
+    np.testing.assert_array_equal(pulse.get_ydata(), cls.pulse)
+    assert f"Tp {cls.tp:.3g} s" in vel.get_legend().get_texts()[1].get_text()
+    assert len(rot.get_legend().get_texts()) == 3
+    # the run's figure is this one, drawn the same way every time
+    png = plots.run_figure_png(task.record_id, record, fit, fitting, histories)
+    assert png == plots.record_figure_png(task.record_id, record, fit, fitting, histories, velocity=cls)
+    assert _png_info(png)[1][1] > _png_info(plots.record_figure_png(task.record_id, record, fit, fitting,
+                                                                     histories))[1][1]
