@@ -168,7 +168,9 @@ def columns_markdown() -> str:
     cell = lambda text: text.replace("|", "\\|")
     lines = ["", "## Columns of `design.csv`", "",
              "One row per record (a pair once, by its governing direction) and column: the answer of "
-             "the run, also printed at its end. `summary.csv` has every value.", "",
+             "the run, also printed at its end. `summary.csv` has every value. `report.html` shows "
+             "these rows (a click on a heading sorts them), every record's classification, fitted "
+             "pulse, verdicts and figure, and the failures: open it in a browser from this folder.", "",
              "| column | unit | meaning |", "|---|---|---|"]
     lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in DESIGN_COLUMNS.columns]
     return "\n".join(lines) + "\n"

@@ -48,8 +48,8 @@ document.querySelectorAll("table.sortable").forEach(function (table) {
       th.classList.add(asc ? "asc" : "desc");
       var body = table.tBodies[0], rows = Array.prototype.slice.call(body.rows);
       function key(row) {
-        var v = row.cells[col].getAttribute("data-v"), x = parseFloat(v);
-        return v === "" ? null : (isNaN(x) || String(x) !== v ? v : x);
+        var v = row.cells[col].getAttribute("data-v"), x = Number(v);
+        return v === "" ? null : (isNaN(x) ? v : x);
       }
       rows.sort(function (a, b) {
         var x = key(a), y = key(b);
@@ -83,7 +83,7 @@ def _num(value):
 
 
 def _sort_value(value) -> str:
-    """The ``data-v`` of a cell: a number as ``repr`` (parsed back to itself by the page), else text."""
+    """The ``data-v`` of a cell: a number as ``repr`` (read back as that number by the page), else text."""
     v = _num(value)
     if v is not None and not isinstance(value, bool):
         return repr(v) if v != int(v) or abs(v) >= 1e15 else str(int(v))
