@@ -157,7 +157,7 @@ def record_width_check(folder=None, heights=(6.0, 7.5)) -> dict:
     highest answer of two uniform brute-force scans (1500 and 6000 widths up to the no-uplift
     width).  For each setting of :data:`RECORD_WIDTH_SETTINGS`: how many answers are below the
     reference by more than 0.5 % and 2 %, the worst, and the solver runs (median, largest).
-    Prints a markdown table (the README's) and returns the rows.
+    Prints a markdown table (that of docs/design.md) and returns the rows.
     """
     import pathlib
 

@@ -1,10 +1,10 @@
-"""Accuracy of the pulse fitter on synthetic records: the README's error-against-noise table.
+"""Accuracy of the pulse fitter on synthetic records: the error-against-noise tables of docs/fitting.md.
 
 ``python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain] [seed=K]`` prints a Markdown table (N
 records per shape, Tp and noise level; default 10, fixed seeds; with a noise band LOW-HIGH Hz,
 only the rows pooled over Tp; ``plain``: the fitter's plain least squares, ``weighting="plain"``,
 instead of its weighted ones; ``seed=K``: every seed shifted by K, other records than the
-README's, to check that a change is not fitted to those).  Each record (:func:`pulses.synthetic.synthetic_record`):
+tables', to check that a change is not fitted to those).  Each record (:func:`pulses.synthetic.synthetic_record`):
 one pulse of random polarity, amplitude 2-8 m/s^2 and arrival; 20 s long (8 Tp for long pulses)
 at 200 Hz; background motion band-passed to 0.5-10 Hz whose RMS over the record is the stated
 fraction of ap.  Columns:
