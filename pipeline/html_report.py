@@ -23,13 +23,14 @@ from .design_table import pulse_text, survives_text
 REPORT_HTML = "report.html"
 
 _CSS = """
-body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.5em auto;max-width:76em;
+body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.5em auto;max-width:90em;
 padding:0 1em;color:#222;line-height:1.4}
 h1{font-size:1.5em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ccc}h3{font-size:1.05em}
 table{border-collapse:collapse;font-size:.9em;margin:.5em 0}
 th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left;vertical-align:top}
 td.n{text-align:right;font-variant-numeric:tabular-nums}
-thead th{background:#f0f0f0;cursor:pointer;user-select:none;white-space:nowrap}
+thead th{background:#f0f0f0;cursor:pointer;user-select:none}
+.wide{overflow-x:auto}
 thead th.asc::after{content:" \\25B2"}thead th.desc::after{content:" \\25BC"}
 tr.no td{background:#fde8e8}tr.island td{background:#fff6dc}
 img{max-width:100%;height:auto;border:1px solid #ddd}
@@ -118,11 +119,12 @@ def _anchor(record_id) -> str:
 
 
 def _batch_table(design, anchors) -> list[str]:
-    heads = ["record", "column", "direction (deg)", "pulse-like", "velocity Tp (s)", "governing pulse",
-             "ap (g)", "Tp (s)", "Eq. 31 width (m)", "verified width (m)", "width (m)", "survives",
-             "max theta/alpha"]
-    out = ['<table class="sortable" id="batch"><thead><tr>' + "".join(f"<th>{_e(h)}</th>" for h in heads)
-           + "</tr></thead><tbody>"]
+    directions = any(r["direction_deg"] is not None for r in design)  # pairs in the run
+    heads = ["record", "column"] + (["direction (deg)"] if directions else []) + [
+        "pulse-like", "velocity Tp (s)", "governing pulse", "ap (g)", "Tp (s)", "Eq. 31 width (m)",
+        "verified width (m)", "width (m)", "survives", "max theta/alpha"]
+    out = ['<div class="wide"><table class="sortable" id="batch"><thead><tr>'
+           + "".join(f"<th>{_e(h)}</th>" for h in heads) + "</tr></thead><tbody>"]
     for r in design:
         surv = survives_text(r)
         cls = {"NO": ' class="no"', "yes, safe island": ' class="island"'}.get(surv, "")
@@ -133,7 +135,7 @@ def _batch_table(design, anchors) -> list[str]:
             f"<tr{cls}>"
             f'<td data-v="{_e(r["record"])}">{name}</td>'
             + _cell(r["column"])
-            + _cell(r["direction_deg"], _fixed(r["direction_deg"], 1), numeric=True)
+            + (_cell(r["direction_deg"], _fixed(r["direction_deg"], 1), numeric=True) if directions else "")
             + _cell(r["pulse_like"], _yes(r["pulse_like"]))
             + _cell(r["velocity_tp_s"], _fixed(r["velocity_tp_s"], 2), numeric=True)
             + _cell(r["governing_shape"])
@@ -145,7 +147,7 @@ def _batch_table(design, anchors) -> list[str]:
             + _cell(surv if r["survives"] is not None else None, surv)
             + _cell(r["max_theta_ratio"], _fixed(r["max_theta_ratio"]), numeric=True)
             + "</tr>")
-    out.append("</tbody></table>")
+    out.append("</tbody></table></div>")
     return out
 
 
