@@ -38,7 +38,9 @@ def add_parser(subparsers) -> None:
         "run", help="records in, verified column designs out",
         description="For every record: read it, fit its pulse (every shape), size each column by "
                     "Eq. 31, the envelope rule and the exact criterion, and verify the designs with "
-                    "time histories under the full record. Writes <record>.csv, summary.csv, "
+                    "time histories under the full record. Prints the answer (a table per record and "
+                    "column) and writes design.csv (the same), report.html (the batch to review in a "
+                    "browser), <record>.csv, summary.csv, "
                     "failures.csv, columns.md and plots into --out, and pipeline-manifest.txt, the "
                     "files it wrote: the only ones a later run replaces or removes. Exit status 0 when every record "
                     "was processed, 1 when some failed (listed in failures.csv), 2 for bad arguments, "

@@ -367,9 +367,12 @@ def columns_markdown(columns, failure_columns) -> str:
         "- `<record>.csv`: one per record, one row per column (`--block`) or height (`--height`).",
         "- `summary.csv`: the rows of every record's report, in input order (one row per record and column).",
         "- `failures.csv`: records that could not be processed, with the reason (header only when none failed).",
-        "- `plots/<record>.png`: the record with its fitted pulses (paper's Fig. 4) and the rotation "
-        "histories of each column as it stands and of its Eq. 31 design under the full record "
-        "(Figs. 9, 11); `plots/summary.png`: required against actual tan(alpha) across records.",
+        "- `design.csv`: the answer, one row per record (a pair once) and column (below); printed at the end of the run.",
+        "- `report.html`: the batch to review in a browser, opened from this folder (no server, no network).",
+        "- `plots/<record>.png`: the record with its fitted pulses (paper's Fig. 4), its velocity with the "
+        "extracted velocity pulse, and the rotation histories of each column as it stands, of its Eq. 31 "
+        "design and at its verified width under the full record (Figs. 9, 11); `plots/summary.png`: "
+        "required against actual tan(alpha) across records.",
         "- `columns.md`: this file.",
         f"- `{MANIFEST}`: the files `pipeline run` wrote here (with a hash of their content). A later "
         "run into this folder replaces or removes only those, and only while their content is still "
