@@ -184,7 +184,10 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
             if r.get("column_kind") == "block":
                 surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
                                       "verified_adequate": r.get("verified_adequate")})
-                parts.append(f"as it stands: survives {surv}, max theta/alpha {_fixed(r.get('max_theta_ratio')) or '-'}")
+                verdict = {"yes": "survives", "NO": "overturns",
+                           "yes, safe island": "survives on a safe island (narrower than the verified width)"}
+                parts.append(f"as it stands: {verdict.get(surv, surv)}, max theta/alpha "
+                             f"{_fixed(r.get('max_theta_ratio')) or '-'}")
             out.append(f"<li>{_e('; '.join(parts))}</li>")
         out.append("</ul>")
     if failure:
