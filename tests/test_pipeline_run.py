@@ -175,8 +175,8 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     png = (alone / name).read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
     assert (after / name).read_bytes() == png
-    # in this process: drawn first, then again after the other records drew four pulses and two
-    # curves a panel; the target also with one pulse and one curve a panel
+    # in this process: drawn first, then again after the other records drew four pulses and three
+    # curves a panel; the target also with one pulse and one curve fewer a panel
     from pipeline import plots
     from pipeline.batch import _process
     from pipeline.runner import make_tasks
@@ -185,12 +185,12 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     parts = [_process(t)[1] for t in tasks]
     rec, fit, fitting, hist = parts[-1]
     few = (rec, fit, fitting[:1], [(label, curves[1:]) for label, curves in hist])
-    fresh = plots.record_figure_png(tasks[-1].record_id, *parts[-1])
+    fresh = plots.run_figure_png(tasks[-1].record_id, *parts[-1])  # as the run draws it
     fresh_few = plots.record_figure_png(tasks[-1].record_id, *few)
     for t, (r, f, fi, h) in zip(tasks, parts):
         plots.record_figure_png(t.record_id, r, f, (fi + fi)[:4], h)
     assert plots.record_figure_png(tasks[-1].record_id, *few) == fresh_few != fresh
-    assert plots.record_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
+    assert plots.run_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
 
 
 def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
