@@ -50,6 +50,14 @@ class SearchSettings:
     while either end came within ``record_near`` of tipping (``max|theta|/alpha >=
     record_near``: isolated failing bands of real records sit where the block nearly overturns);
     at most ``record_rounds`` rounds (a failure found above the candidate moves it up).
+
+    The check above a record's verified width ``w`` (docs/slivers.md, :func:`rocking.widths.check_above`):
+    ``check_runs`` widths from ``w`` to ``check_span`` times ``w`` or the no-uplift width, whichever
+    is smaller, jittered (one random width in each of equal strata; seeded from the record, so a
+    re-run gives the same widths; none on the search's grid): a share ``check_near`` of them
+    uniform in ``log(B / w - 1)`` from ``check_first`` up (failing slivers cluster just above
+    ``w``), the rest uniform in ``B``.  0 runs switch the check off.  The sizes were chosen from
+    ``benchmarks/bench_slivers.py`` (its table is in docs/slivers.md).
     """
 
     n_scan: int = 64
@@ -72,11 +80,24 @@ class SearchSettings:
     record_near: float = 0.6
     record_rounds: int = 12
     record_chunk: int = 32
+    check_runs: int = 800
+    check_span: float = 2.0
+    check_near: float = 0.5
+    check_first: float = 1e-4
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
             if getattr(self, name) < 1 + (name == "ksection"):
                 raise ValueError(f"SearchSettings.{name} is too small: {getattr(self, name)!r}")
+        if self.check_runs < 0:
+            raise ValueError(f"SearchSettings.check_runs must be 0 or more, got {self.check_runs!r}")
+        if not self.check_span > 1.0:
+            raise ValueError(f"SearchSettings.check_span must be above 1, got {self.check_span!r}")
+        if not 0.0 <= self.check_near <= 1.0:
+            raise ValueError(f"SearchSettings.check_near must be in [0, 1], got {self.check_near!r}")
+        if not 0.0 < self.check_first < self.check_span - 1.0:
+            raise ValueError("SearchSettings.check_first must be in (0, check_span - 1), got "
+                             f"{self.check_first!r}")
         if not self.rtol > 0:
             raise ValueError(f"SearchSettings.rtol must be positive, got {self.rtol!r}")
         if self.record_spacing not in ("geometric", "uniform"):
