@@ -2,6 +2,7 @@
 
     python benchmarks/bench_slivers.py            # ~20 min on 2 busy cores; needs ../shared
     python benchmarks/bench_slivers.py --quick    # the 15 top-level records, one seed
+    python benchmarks/bench_slivers.py --variants "near + follow (default)"   # one layout
     python benchmarks/bench_slivers.py --figure docs/slivers_barcode.png
 
 The verified width ``w`` (``rocking.required_width(H, record, rule="exact")``) is followed by a
@@ -39,16 +40,37 @@ if str(ROOT) not in sys.path:
 RECORDS = pathlib.Path(os.environ.get("ROCKING_RECORDS", ROOT.parent / "shared" / "records" / "raw"))
 HEIGHT = 7.5
 DENSE = 6000
-NS = (50, 100, 200, 400, 800, 1600)
-NEARS = (0.0, 0.5, 1.0)
+NS = (50, 100, 200, 400, 800, 1500)
+#: layouts of the check: (share log-spaced near w, share placed by the second stage)
+VARIANTS = {"uniform": (0.0, 0.0), "near": (0.5, 0.0), "all near": (1.0, 0.0),
+            "near + follow (default)": (0.5, 0.5)}
+NEARS = tuple(VARIANTS)
 SEEDS = (1, 2)
 
 
-def _verdicts(record, widths):
+def _run(record, widths):
     import rocking
 
     blocks = [rocking.Block.from_dimensions(HEIGHT, float(b)) for b in widths]
-    return np.asarray(rocking.simulate_many(blocks, record).overturned, dtype=bool)
+    res = rocking.simulate_many(blocks, record)
+    return np.asarray(res.overturned, dtype=bool), np.asarray(res.max_rotation_ratio, dtype=float)
+
+
+def _verdicts(record, widths):
+    return _run(record, widths)[0]
+
+
+def _check(record, v, top, near, follow, n, seed):
+    """The package's check (``rocking.widths``) with these sizes above the verified width ``v``."""
+    import dataclasses
+
+    import rocking
+    from rocking import widths as rw
+
+    res = dataclasses.replace(v)
+    settings = rocking.search.SearchSettings(check_runs=n, check_near=near, check_follow=follow)
+    rw._add_check(res, top, lambda x: _run(record, x), settings, seed)
+    return res.failing_share, res.widest_failing_width
 
 
 def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
@@ -57,9 +79,9 @@ def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
     import pulses
     import rocking
     from pulses import G
-    from rocking import widths as rw
-
     out = []
+    cache = os.environ.get("BENCH_SLIVERS_DENSE")        # an earlier run's JSON: its dense grids
+    cached = {r["record"]: r for r in json.loads(pathlib.Path(cache).read_text())} if cache else {}
     for path in paths:
         record = pulses.read_record(path)
         t = time.perf_counter()
@@ -69,20 +91,21 @@ def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
         top = HEIGHT * record.pga / G
         w = v.width
         hi = min(2.0 * w, top)
-        x = np.linspace(w, hi, DENSE + 1)[1:]
-        t = time.perf_counter()
-        f = _verdicts(record, x)
-        t_dense = time.perf_counter() - t
+        old = cached.get(pathlib.Path(path).stem)
+        if old is not None and old["w"] == w:
+            dense_fail, t_dense = old["dense_fail"], old["t_dense"]
+        else:
+            x = np.linspace(w, hi, DENSE + 1)[1:]
+            t = time.perf_counter()
+            f = _verdicts(record, x)
+            t_dense = time.perf_counter() - t
+            dense_fail = x[f].tolist()
         row = dict(record=pathlib.Path(path).stem, w=w, top=top, runs=v.runs, t_search=t_search,
-                   t_dense=t_dense, dense_fail=x[f].tolist(), checks={})
+                   t_dense=t_dense, dense_fail=dense_fail, checks={})
         for q in nears:
             for n in ns:
                 for s in seeds:
-                    settings = rocking.search.SearchSettings(check_runs=n, check_near=q)
-                    cx = rw.check_widths(w, top, settings, seed=s)
-                    cf = _verdicts(record, cx)
-                    row["checks"][f"{q}/{n}/{s}"] = (float(cf.mean()),
-                                                    float(cx[cf].max()) if cf.any() else None)
+                    row["checks"][f"{q}/{n}/{s}"] = _check(record, v, top, *VARIANTS[q], n, s)
         out.append(row)
         dense = (max(row["dense_fail"]) / w - 1) * 100 if row["dense_fail"] else 0.0
         print(f"{row['record']:28s} w {w:.4f} m, search {v.runs} runs {t_search:.1f} s, dense "
@@ -99,7 +122,7 @@ def table(rows, seeds=SEEDS, ns=NS, nears=NEARS):
              f"more than 1 % above w on {len(far)} ({', '.join(r['record'] for r in far)}). "
              f"Each check size run with {len(seeds)} seeds: counts are over records x seeds.",
              "",
-             "| share near w | N | far records: widest >= 1.01 w | far records: none found "
+             "| layout | N | far records: widest >= 1.01 w | far records: none found "
              "| records with a dense failure: check finds one | median (widest - w) / (dense widest - w) "
              "| median failing share (records with a dense failure) |",
              "|---|---|---|---|---|---|---|"]
@@ -118,7 +141,7 @@ def table(rows, seeds=SEEDS, ns=NS, nears=NEARS):
                         ge += widest is not None and widest >= 1.01 * r["w"]
                         none += widest is None
             nf, na = len(far) * len(seeds), len(anyf) * len(seeds)
-            lines.append(f"| {q:g} | {n} | {ge}/{nf} | {none}/{nf} | {found}/{na} | "
+            lines.append(f"| {q} | {n} | {ge}/{nf} | {none}/{nf} | {found}/{na} | "
                          f"{np.median(ratios):.2f} | {np.median(shares):.4f} |")
     runs = np.array([r["runs"] for r in rows])
     lines += ["", f"Verified width's own search: {runs.min()}-{runs.max()} runs per record, median "
@@ -154,11 +177,14 @@ def main(argv=None):
         return 0
     paths = sorted(RECORDS.glob("*.AT2")) + ([] if quick else sorted(RECORDS.glob("*/*.AT2")))
     seeds = SEEDS[:1] if quick else SEEDS
-    rows = measure(paths, seeds=seeds)
+    nears = NEARS
+    if "--variants" in argv:       # e.g. --variants "near + follow (default)"
+        nears = tuple(argv[argv.index("--variants") + 1].split(","))
+    rows = measure(paths, seeds=seeds, nears=nears)
     dump = pathlib.Path(os.environ.get("BENCH_SLIVERS_JSON", "")) if os.environ.get("BENCH_SLIVERS_JSON") else None
     if dump:
         dump.write_text(json.dumps(rows))
-    print("\n".join(table(rows, seeds=seeds)))
+    print("\n".join(table(rows, seeds=seeds, nears=nears)))
     return 0
 
 

@@ -56,8 +56,13 @@ class SearchSettings:
     is smaller, jittered (one random width in each of equal strata; seeded from the record, so a
     re-run gives the same widths; none on the search's grid): a share ``check_near`` of them
     uniform in ``log(B / w - 1)`` from ``check_first`` up (failing slivers cluster just above
-    ``w``), the rest uniform in ``B``.  0 runs switch the check off.  The sizes were chosen from
-    ``benchmarks/bench_slivers.py`` (its table is in docs/slivers.md).
+    ``w``), the rest uniform in ``B``; a share ``check_follow`` of the runs is then placed by a
+    second stage, over ``check_bins`` equal bins of the span with weights
+    ``(mean min(max|theta|/alpha, 1))**check_power`` of the first stage's widths in each bin
+    (failing slivers far above ``w`` sit where neighbouring widths rock hardest: on the real
+    records, the ratio averaged over 0.5 % of width around a dense grid's failures is in the top
+    third of the span's, often the top 5 %).  0 runs switch the check off.  The sizes were chosen
+    from ``benchmarks/bench_slivers.py`` (its table is in docs/slivers.md).
     """
 
     n_scan: int = 64
@@ -84,6 +89,9 @@ class SearchSettings:
     check_span: float = 2.0
     check_near: float = 0.5
     check_first: float = 1e-4
+    check_follow: float = 0.5
+    check_bins: int = 50
+    check_power: float = 4.0
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -98,6 +106,9 @@ class SearchSettings:
         if not 0.0 < self.check_first < self.check_span - 1.0:
             raise ValueError("SearchSettings.check_first must be in (0, check_span - 1), got "
                              f"{self.check_first!r}")
+        if not 0.0 <= self.check_follow < 1.0 or self.check_bins < 1:
+            raise ValueError("SearchSettings.check_follow must be in [0, 1) and check_bins at "
+                             f"least 1, got {self.check_follow!r}, {self.check_bins!r}")
         if not self.rtol > 0:
             raise ValueError(f"SearchSettings.rtol must be positive, got {self.rtol!r}")
         if self.record_spacing not in ("geometric", "uniform"):

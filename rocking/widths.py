@@ -189,7 +189,7 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                             settings=settings)
         res.cap_mass_ratio = gamma
         if not res.below_scan and settings.check_runs > 0:
-            _add_check(res, top, lambda widths: evaluate_record(widths)[0], settings,
+            _add_check(res, top, evaluate_record, settings,
                        _record_seed(excitation, height, criterion, eta, gamma))
         return res
     settings = settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol)
@@ -233,10 +233,17 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         runs=runs, eta=eta, below_scan=below_scan, cap_mass_ratio=gamma)
 
 
-def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
-    """The widths (m, ascending) the check above a verified ``width`` runs (docs/slivers.md).
+def _first_runs(settings) -> int:
+    n = int(settings.check_runs)
+    return n - int(round(settings.check_follow * n))
 
-    ``settings.check_runs`` widths in ``(width, hi]``, ``hi = min(settings.check_span width,
+
+def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
+    """The widths (m, ascending) of the first stage of the check above a verified ``width``
+    (docs/slivers.md).
+
+    ``settings.check_runs`` less the second stage's share (``settings.check_follow``, see
+    :func:`follow_widths`) widths in ``(width, hi]``, ``hi = min(settings.check_span width,
     top)`` (``top``: the no-uplift width, above which nothing rocks): a share
     ``settings.check_near`` of them uniform in ``log d``, ``d = B / width - 1`` from
     ``settings.check_first`` to ``hi / width - 1`` (failing slivers cluster just above the
@@ -245,7 +252,7 @@ def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
     from ``numpy.random.default_rng(seed)``, so that the widths are spread evenly, never lie on
     the search's fixed grid, and are the same for the same seed.  Empty where ``hi <= width``.
     """
-    n = int(settings.check_runs)
+    n = _first_runs(settings)
     hi = min(settings.check_span * width, top)
     if n <= 0 or not hi > width * (1.0 + settings.check_first):
         return np.zeros(0)
@@ -261,6 +268,35 @@ def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
     return np.sort(np.concatenate([near, spread]))
 
 
+def follow_widths(width, top, widths, ratio, settings=DEFAULT_SETTINGS, seed=0):
+    """The widths (m, ascending) of the second stage of the check: ``settings.check_runs`` times
+    ``settings.check_follow`` of them over ``settings.check_bins`` equal bins of the span, each
+    bin's number in proportion to ``m ** settings.check_power``, ``m`` the mean
+    ``min(max|theta|/alpha, 1)`` of the first stage's ``widths`` in it (``ratio``; 1 in a bin
+    that has none), jittered within the bin (``seed`` as for :func:`check_widths`, a stream of
+    its own)."""
+    n = int(settings.check_runs) - _first_runs(settings)
+    hi = min(settings.check_span * width, top)
+    if n <= 0 or not hi > width * (1.0 + settings.check_first):
+        return np.zeros(0)
+    k = int(settings.check_bins)
+    edges = np.linspace(width, hi, k + 1)
+    widths, ratio = np.asarray(widths, dtype=float), np.minimum(np.asarray(ratio, dtype=float), 1.0)
+    idx = np.clip(np.searchsorted(edges, widths) - 1, 0, k - 1)
+    total = np.bincount(idx, weights=ratio, minlength=k)
+    count = np.bincount(idx, minlength=k)
+    mean = np.where(count > 0, total / np.maximum(count, 1), 1.0)
+    weight = mean ** settings.check_power
+    weight = weight / weight.sum() if weight.sum() > 0 else np.full(k, 1.0 / k)
+    share = weight * n
+    alloc = np.floor(share).astype(int)
+    alloc[np.argsort(alloc - share, kind="stable")[:n - alloc.sum()]] += 1   # largest remainders
+    rng = np.random.default_rng([seed, 1])
+    x = [edges[j] + (edges[j + 1] - edges[j]) * (np.arange(a) + rng.random(a)) / a
+         for j, a in enumerate(alloc) if a > 0]
+    return np.sort(np.concatenate(x))
+
+
 def _record_seed(record, height, criterion, eta, gamma) -> int:
     """A seed made from the record's samples and the column (the same run, the same check)."""
     h = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes())
@@ -268,12 +304,18 @@ def _record_seed(record, height, criterion, eta, gamma) -> int:
     return int.from_bytes(h.digest()[:8], "little")
 
 
-def _add_check(res, top, failed_at, settings, seed) -> None:
-    """Run the check above ``res.width`` (``failed_at(widths)``: verdicts, one batch) and store
-    its outcome in ``res``."""
-    x = check_widths(res.width, top, settings, seed)
+def _add_check(res, top, evaluate, settings, seed) -> None:
+    """Run the check above ``res.width`` (``evaluate(widths)``: verdicts and max|theta|/alpha,
+    one batch per stage) and store its outcome in ``res``."""
+    x1 = check_widths(res.width, top, settings, seed)
+    f1, r1 = evaluate(x1) if x1.size else (np.zeros(0, dtype=bool), np.zeros(0))
+    x2 = follow_widths(res.width, top, x1, r1, settings, seed)
+    f2 = evaluate(x2)[0] if x2.size else np.zeros(0, dtype=bool)
+    x = np.concatenate([x1, x2])
+    f = np.concatenate([np.asarray(f1, dtype=bool), np.asarray(f2, dtype=bool)])
+    order = np.argsort(x, kind="stable")
+    x, f = x[order], f[order]
     res.check_top = float(min(settings.check_span * res.width, top))
-    f = np.asarray(failed_at(x), dtype=bool) if x.size else np.zeros(0, dtype=bool)
     res.check_runs = int(x.size)
     res.failing_share = float(f.mean()) if x.size else 0.0
     res.widest_failing_width = float(x[f].max()) if f.any() else None

@@ -12,7 +12,7 @@ import rocking
 from pulses import G, make_pulse
 from rocking import Block
 from rocking.search import DEFAULT_SETTINGS, SearchSettings
-from rocking.widths import check_widths
+from rocking.widths import check_widths, follow_widths
 
 from .conftest import shared_record
 
@@ -38,23 +38,22 @@ def _chaotic_record(seed=8, duration=20.0, dt=0.01):
 
 
 def test_check_widths_layout():
-    """Jittered: one width per stratum of each part, inside the span, none on the search's grid,
-    the same for the same seed and different for another."""
+    """First stage jittered: one width per stratum of each part, inside the span, none on the
+    search's grid, the same for the same seed and different for another; the second stage puts
+    its widths where the first stage's widths rocked hardest."""
     s = DEFAULT_SETTINGS
     w, top = 1.0, 1.7                                  # the span ends at the no-uplift width
     x = check_widths(w, top, s, seed=5)
-    assert x.size == s.check_runs and np.all(np.diff(x) > 0)
+    n_follow = round(s.check_follow * s.check_runs)
+    n1 = s.check_runs - n_follow
+    assert x.size == n1 and np.all(np.diff(x) > 0)
     assert x[0] > w and x[-1] <= top
-    n_near = round(s.check_near * s.check_runs)
-    # the uniform part: exactly one width in each of its n - n_near equal strata of (w, top]
-    n_far = s.check_runs - n_near
-    near = w * (1 + s.check_first * ((top / w - 1) / s.check_first) ** ((np.arange(n_near + 1)) / n_near))
-    counts_log = np.histogram(x, bins=near)[0]
-    counts_lin = np.histogram(x, bins=np.linspace(w, top, n_far + 1))[0]
-    # every log stratum holds its own width (plus the uniform part's, at most a few per stratum)
-    assert counts_log.min() >= 1
-    # and every linear stratum at least its own (the log part adds more near w)
-    assert counts_lin.min() >= 1
+    n_near = round(s.check_near * n1)
+    n_far = n1 - n_near
+    near = w * (1 + s.check_first * ((top / w - 1) / s.check_first) ** (np.arange(n_near + 1) / n_near))
+    # every log stratum holds its own width, every linear stratum its own (and the other part's)
+    assert np.histogram(x, bins=near)[0].min() >= 1
+    assert np.histogram(x, bins=np.linspace(w, top, n_far + 1))[0].min() >= 1
     # not on the search's fixed fine grid top (1 + record_fine)^-k (a width there would repeat a run)
     k = np.log(top / x) / math.log1p(s.record_fine)
     assert np.min(np.abs(k - np.round(k))) > 1e-6
@@ -65,6 +64,15 @@ def test_check_widths_layout():
     # nothing to check where the verified width is the no-uplift width; 0 runs switch it off
     assert check_widths(1.0, 1.0, s).size == 0
     assert check_widths(1.0, 2.0, s.replace(check_runs=0)).size == 0
+    # second stage: first-stage ratios 1 in the bin (1.35, 1.364] and 0.5 elsewhere: that bin
+    # gets 2**power times the others' share (weights (mean ratio)**power), all n_follow placed
+    ratio = np.where((x > 1.35) & (x <= 1.364), 1.0, 0.5)
+    y = follow_widths(w, top, x, ratio, s, seed=5)
+    assert y.size == n_follow and y[0] > w and y[-1] <= top
+    per_bin = np.histogram(y, bins=np.linspace(w, top, s.check_bins + 1))[0]
+    expect = n_follow * 2.0 ** s.check_power / (2.0 ** s.check_power + s.check_bins - 1)
+    assert abs(per_bin[25] - expect) <= 1.0        # largest remainders: within one width
+    assert np.array_equal(y, follow_widths(w, top, x, ratio, s, seed=5))
     with pytest.raises(ValueError):
         SearchSettings(check_near=1.5)
     with pytest.raises(ValueError):
