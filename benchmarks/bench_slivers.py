@@ -3,6 +3,8 @@
     python benchmarks/bench_slivers.py            # ~20 min on 2 busy cores; needs ../shared
     python benchmarks/bench_slivers.py --quick    # the 15 top-level records, one seed
     python benchmarks/bench_slivers.py --variants "near + follow (default)"   # one layout
+    python benchmarks/bench_slivers.py --variants "near + follow (default)" --ns 800,1500 \
+        --seeds 8 --only RSN879_LANDERS_LCN345,RSN159_1,RSN250_1,RSN6_2,RSN77_2
     python benchmarks/bench_slivers.py --figure docs/slivers_barcode.png
 
 The verified width ``w`` (``rocking.required_width(H, record, rule="exact")``) is followed by a
@@ -177,14 +179,22 @@ def main(argv=None):
         return 0
     paths = sorted(RECORDS.glob("*.AT2")) + ([] if quick else sorted(RECORDS.glob("*/*.AT2")))
     seeds = SEEDS[:1] if quick else SEEDS
+    if "--seeds" in argv:          # e.g. --seeds 8: seeds 1..8
+        seeds = tuple(range(1, int(argv[argv.index("--seeds") + 1]) + 1))
+    if "--only" in argv:           # e.g. --only RSN159_1,RSN6_2: these records (file stems) only
+        only = set(argv[argv.index("--only") + 1].split(","))
+        paths = [p for p in paths if p.stem in only]
+    ns = NS
+    if "--ns" in argv:             # e.g. --ns 800,1500
+        ns = tuple(int(n) for n in argv[argv.index("--ns") + 1].split(","))
     nears = NEARS
     if "--variants" in argv:       # e.g. --variants "near + follow (default)"
         nears = tuple(argv[argv.index("--variants") + 1].split(","))
-    rows = measure(paths, seeds=seeds, nears=nears)
+    rows = measure(paths, seeds=seeds, nears=nears, ns=ns)
     dump = pathlib.Path(os.environ.get("BENCH_SLIVERS_JSON", "")) if os.environ.get("BENCH_SLIVERS_JSON") else None
     if dump:
         dump.write_text(json.dumps(rows))
-    print("\n".join(table(rows, seeds=seeds, nears=nears)))
+    print("\n".join(table(rows, seeds=seeds, nears=nears, ns=ns)))
     return 0
 
 

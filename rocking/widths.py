@@ -26,6 +26,9 @@ class RequiredWidth:
     as a fixed point in ``B`` (:attr:`iterations` steps); ``rule="exact"`` is the *verified
     width*: the smallest width that survives at that width and at every larger one, found by a
     scan over widths and bracketed refinement of every verdict change (:attr:`transitions`).
+    Under a record, failing slivers thinner than the scan's resolution can lie above it (the
+    response is chaotic near the verge of overturning): a check of jittered widths above it
+    reports what it finds (:attr:`failing_share`, :attr:`widest_failing_width`; docs/slivers.md).
     """
 
     width: float

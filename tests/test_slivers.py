@@ -132,3 +132,35 @@ def test_check_against_dense_scan_real_record():
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
                            model="reference", history=False)
     assert ref.overturned
+
+
+def test_pipeline_reports_the_check(tmp_path):
+    """`pipeline run`: the check's columns in the record's report equal `required_width`'s, the
+    suite's checked share follows from them, and the barcode figure is written where the check
+    found failing widths (the synthetic record above: it does)."""
+    import csv
+
+    from pipeline.cli import main
+
+    rec = _chaotic_record()
+    path = tmp_path / "chaotic.sac"
+    pulses.write_sac(pulses.Record(rec.acc, rec.dt, name="chaotic"), path)
+    out = tmp_path / "out"
+    # a column at the verified width (rounded up to 1 mm): verified, yet the check found wider
+    # failing widths (0.878 m verified, failing widths up to ~0.885 m)
+    ver = rocking.required_width(7.5, pulses.read_record(path), rule="exact")
+    width = math.ceil(ver.width * 1000) / 1000
+    assert ver.width <= width < ver.widest_failing_width
+    assert main(["run", str(path), "--block", f"7.5x{width}", "--out", str(out), "-q"]) == 0
+    row = next(csv.DictReader(open(out / "chaotic.csv")))
+    assert float(row["verified_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
+    assert float(row["failing_share"]) == pytest.approx(ver.failing_share, rel=1e-5)
+    assert float(row["widest_failing_width_m"]) == pytest.approx(ver.widest_failing_width, rel=1e-5)
+    assert int(float(row["check_runs"])) == ver.check_runs == DEFAULT_SETTINGS.check_runs
+    assert row["verified_adequate"] == "True"
+    suite = next(csv.DictReader(open(out / "suite.csv")))
+    assert suite["share_column_verified"] == "1" and suite["share_column_checked"] == "0"
+    assert (out / "plots" / "widths" / "chaotic.png").stat().st_size > 10_000
+    text = (out / "columns.md").read_text()
+    assert "`widest_failing_width_m`" in text and "docs/slivers.md" in text
+    assert "plots/widths/<record>.png" in text
