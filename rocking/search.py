@@ -51,18 +51,19 @@ class SearchSettings:
     record_near``: isolated failing bands of real records sit where the block nearly overturns);
     at most ``record_rounds`` rounds (a failure found above the candidate moves it up).
 
-    The check above a record's verified width ``w`` (docs/slivers.md, :func:`rocking.widths.check_above`):
-    ``check_runs`` widths from ``w`` to ``check_span`` times ``w`` or the no-uplift width, whichever
-    is smaller, jittered (one random width in each of equal strata; seeded from the record, so a
-    re-run gives the same widths; none on the search's grid): a share ``check_near`` of them
-    uniform in ``log(B / w - 1)`` from ``check_first`` up (failing slivers cluster just above
-    ``w``), the rest uniform in ``B``; a share ``check_follow`` of the runs is then placed by a
-    second stage, over ``check_bins`` equal bins of the span with weights
-    ``(mean min(max|theta|/alpha, 1))**check_power`` of the first stage's widths in each bin
-    (failing slivers far above ``w`` sit where neighbouring widths rock hardest: on the real
-    records, the ratio averaged over 0.5 % of width around a dense grid's failures is in the top
-    third of the span's, often the top 5 %).  0 runs switch the check off.  The sizes were chosen
-    from ``benchmarks/bench_slivers.py`` (its table is in docs/slivers.md).
+    The check above a record's verified width ``w`` (docs/slivers.md;
+    :func:`rocking.widths.check_widths`, :func:`rocking.widths.follow_widths`): ``check_runs``
+    widths from ``w`` to ``check_span`` times ``w`` or the no-uplift width, whichever is smaller,
+    jittered (one random width in each of equal strata; seeded from the record, so a re-run gives
+    the same widths; none on the search's grid).  A first stage: a share ``check_near`` of its
+    widths uniform in ``log(B / w - 1)`` from ``check_first`` up (failing slivers cluster just
+    above ``w``), the rest uniform in ``B``.  A second stage, a share ``check_follow`` of the
+    runs, over ``check_bins`` equal bins of the span weighted by ``(mean min(max|theta|/alpha,
+    1))**check_power`` of the first stage's widths in each bin (failing slivers far above ``w``
+    sit where neighbouring widths rock hard: on the real records, the ratio averaged over 0.5 %
+    of width around a dense grid's failures is above the 63rd percentile of the span's, on four
+    of six records above the 89th).  0 runs switch the check off.  The sizes were chosen from
+    ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
     """
 
     n_scan: int = 64
