@@ -141,7 +141,8 @@ def _sim(block, record, history):
 
 
 def process_record(task: Task) -> dict:
-    """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot", "seconds"}``.
+    """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot",
+    "widths_plot", "seconds"}``.
 
     ``seconds`` maps each stage (``"verify:required_width"``, ...) to the time it took; it is for
     benchmarks and never written to the reports (which must not depend on timing).
