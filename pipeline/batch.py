@@ -141,7 +141,8 @@ def _sim(block, record, history):
 
 
 def process_record(task: Task) -> dict:
-    """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot", "seconds"}``.
+    """Process one record; return ``{"index", "record", "file", "rows", "failure", "plot",
+    "widths_plot", "seconds"}``.
 
     ``seconds`` maps each stage (``"verify:required_width"``, ...) to the time it took; it is for
     benchmarks and never written to the reports (which must not depend on timing).
@@ -157,9 +158,9 @@ def process_record(task: Task) -> dict:
 
 def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
-           "failure": None, "plot": None}
+           "failure": None, "plot": None, "widths_plot": None}
     try:
-        rows, fit_parts = _process(task)
+        rows, fit_parts, verified = _process(task)
         out["rows"] = rows
     except StageError as err:
         out["failure"] = failure(task, err.stage, err.exc)
@@ -174,9 +175,18 @@ def _process_record(task: Task) -> dict:
 
         try:
             out["plot"] = _stage("plot", run_figure_png, task.record_id, *fit_parts)
+            out["widths_plot"] = _stage("plot", _widths_png, task.record_id, verified)
         except StageError as err:
             out["failure"] = failure(task, err.stage, err.exc)
     return out
+
+
+def _widths_png(record_id, verified):
+    """``plots/widths/<record>.png`` where the check above a verified width found failing widths
+    (docs/slivers.md); None elsewhere."""
+    from .plot_widths import record_widths_png
+
+    return record_widths_png(record_id, {f"{H:g} m": v for H, v in verified.items()})
 
 
 FAILURE_COLUMNS = Columns(
@@ -476,10 +486,34 @@ def _verified_fields(col: Column, ver) -> dict:
     })
 
 
+CHECK_COLUMNS = Columns(
+    ("failing_share", "-", "Resolution of the verified width (docs/slivers.md): the verified width is the "
+                           "smallest width above which every width the search examined survives; near "
+                           "it the response is chaotic and failing slivers thinner than the search's "
+                           "0.05 % grid may lie above it. After the search, a check runs `check_runs` "
+                           "jittered widths (seeded from the record, off the search's grid) from the "
+                           "verified width up to twice it or the no-uplift width (height x PGA / g), "
+                           "whichever is smaller, half of them log-spaced just above it: this is the "
+                           "share of them that overturn (0: none did; blank: no check)."),
+    ("widest_failing_width_m", "m", "The widest width the check found to overturn (a failing sliver "
+                                    "above the verified width; blank where none was found, which "
+                                    "does not prove there is none)."),
+    ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width."),
+)
+
+
+def _check_fields(ver) -> dict:
+    return CHECK_COLUMNS.row({
+        "failing_share": ver.failing_share, "widest_failing_width_m": ver.widest_failing_width,
+        "check_runs": ver.check_runs,
+    })
+
+
 #: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
 COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
            + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
            + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns
+           + CHECK_COLUMNS.columns
            + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns)
 FIELDS = [name for name, _, _ in COLUMNS]
 
@@ -564,10 +598,11 @@ def _process(task: Task):
         row.update(_as_stands_fields(block, designed, res))
         row.update(_eq31_design_fields(H, w31, res31))
         row.update(_verified_fields(col, verified_cache[H]))
+        row.update(_check_fields(verified_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
         rows.append(row)
 
-    return rows, (record, fit, fitting, histories)
+    return rows, (record, fit, fitting, histories), verified_cache
 
 
 def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:

@@ -27,6 +27,17 @@ def _governing(rows, label, key):
     return np.array(sorted(out.values()))
 
 
+def _governing_checked(rows, label):
+    """Per record (pair) of the column ``label``: the largest of its verified widths and the
+    failing widths the check above them found (docs/slivers.md), sorted."""
+    out = {}
+    for r in rows:
+        if r["column"] == label and r["verified_width_m"] is not None:
+            need = max(float(r["verified_width_m"]), float(r.get("widest_failing_width_m") or 0.0))
+            out[r["pair"]] = max(out.get(r["pair"], -np.inf), need)
+    return np.array(sorted(out.values()))
+
+
 def suite_figure(rows, suite):
     """One panel per column: share of the records whose governing verified width is at most
     ``B``, against ``B``; the column's width and the records' Eq. 31 widths marked."""
@@ -43,6 +54,12 @@ def suite_figure(rows, suite):
         x = np.concatenate([[0.0], widths])
         y = np.concatenate([[0.0], share])
         ax.step(x, y, where="post", color="C0", lw=2, label="records verified (governing direction)")
+        checked = _governing_checked(rows, label)
+        if checked.size and np.any(checked > widths):
+            # the same share with each record's widest failing width (the check above its
+            # verified width, docs/slivers.md) as its requirement
+            ax.step(np.concatenate([[0.0], checked]), y, where="post", color="C0", lw=1, ls="--",
+                    label="... and wider than every failing width the check found")
         for i, w in enumerate(eq31):
             ax.axvline(w, color="C1", lw=0.8, ls=":", label="Eq. 31 width of a record" if i == 0 else None)
         if s["width_m"] is not None:

@@ -354,6 +354,12 @@ def record_plot_name(record_id: str) -> str:
     return f"plots/{record_id}.png"
 
 
+def record_widths_plot_name(record_id: str) -> str:
+    """Path of a record's barcode of the widths checked above its verified width (a folder of
+    its own: ``plots/<record>_widths.png`` could be another record's figure)."""
+    return f"plots/widths/{record_id}.png"
+
+
 def columns_markdown(columns, failure_columns) -> str:
     """``columns.md``: the files of the output folder and every column of the reports.
 
@@ -373,6 +379,9 @@ def columns_markdown(columns, failure_columns) -> str:
         "extracted velocity pulse, and the rotation histories of each column as it stands, of its Eq. 31 "
         "design and at its verified width under the full record (Figs. 9, 11); `plots/summary.png`: "
         "required against actual tan(alpha) across records.",
+        "- `plots/widths/<record>.png` (only where the check above a verified width found failing "
+        "widths): the verdict against the width above the verified width, a barcode of the widths "
+        "that overturn (`failing_share`, `widest_failing_width_m`; docs/slivers.md).",
         "- `columns.md`: this file.",
         f"- `{MANIFEST}`: the files `pipeline run` wrote here (with a hash of their content). A later "
         "run into this folder replaces or removes only those, and only while their content is still "

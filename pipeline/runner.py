@@ -435,6 +435,7 @@ def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> rep
     written = fixed + [report.record_csv_name(t.record_id) for t in tasks]
     if plots:
         written += [report.record_plot_name(t.record_id) for t in tasks]
+        written += [report.record_widths_plot_name(t.record_id) for t in tasks]
     inputs = {}
     for t in tasks:
         for path in (t.path, t.path2):  # both files of a pair are inputs
@@ -479,6 +480,14 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
                 outputs.remove(report.record_plot_name(rid))
         except OSError as exc:
             problems.append(exc)
+        try:  # the barcode of the check above the verified width, where it found failing widths
+            if res.get("widths_plot"):
+                outputs.write(report.record_widths_plot_name(rid), res["widths_plot"])
+            else:
+                outputs.remove(report.record_widths_plot_name(rid))
+        except OSError as exc:
+            problems.append(exc)
+    res["widths_plot"] = None
     res["plot"] = None  # thousands of records: keep only the rows in memory
     for exc in problems:
         say(f"pipeline run: {rid}: {report.display(exc)}")
@@ -518,6 +527,7 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
              resume.RESUME] + site.output_files(options) + answer_files()
     names += [n for t in tasks for n in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id))]
+    names += [report.record_widths_plot_name(t.record_id) for t in tasks]
     resume.remove_stale_temporaries(out, names)  # left by a run killed while writing
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept

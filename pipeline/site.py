@@ -461,10 +461,23 @@ SUITE_COLUMNS = Columns(
                                    "overturn, in any direction (blank for `--height`)."),
     ("share_column_verified", "-", "Share of the records whose governing verified width the column as it "
                                    "stands reaches (so it survives them with no safe island)."),
+    ("share_column_checked", "-", "Share of the records whose governing verified width the column as it "
+                                  "stands reaches and that the check above the verified width "
+                                  "(`failing_share`, docs/slivers.md) found no failing width at or above "
+                                  "the column's width, in any direction: verified with the same check as "
+                                  "each record's `widest_failing_width_m` (blank for `--height`)."),
     ("share_eq31_survives", "-", "Share of the records under which the column's Eq. 31 design (for each "
                                  "direction, its own Eq. 31 width) does not overturn, in any direction."),
     ("share_envelope_survives", "-", "Same for the envelope-rule design (`envelope_width_m`)."),
 )
+
+
+def checked(row, width) -> bool:
+    """A column ``width`` wide reaches the row's verified width and is wider than every failing
+    width the check above it found (docs/slivers.md)."""
+    widest = row.get("widest_failing_width_m")
+    return (width is not None and float(width) >= float(row["verified_width_m"])
+            and (widest is None or float(width) > float(widest)))
 
 
 def suite_rows(rows) -> list[dict]:
@@ -496,6 +509,7 @@ def suite_rows(rows) -> list[dict]:
             "eq31_width_max_m": max(float(r["eq31_width_m"]) for r in crows),
             "share_column_survives": share(lambda r: not r["overturns"]) if is_block else None,
             "share_column_verified": share(lambda r: bool(r["verified_adequate"])) if is_block else None,
+            "share_column_checked": share(lambda r: checked(r, first["width_m"])) if is_block else None,
             "share_eq31_survives": share(lambda r: not r["eq31_width_overturns"]),
             "share_envelope_survives": share(lambda r: not r["envelope_width_overturns"]),
         }))

@@ -3,8 +3,9 @@
 (the *verified width*, under a pulse or a whole record)."""
 from __future__ import annotations
 
+import hashlib
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -25,6 +26,9 @@ class RequiredWidth:
     as a fixed point in ``B`` (:attr:`iterations` steps); ``rule="exact"`` is the *verified
     width*: the smallest width that survives at that width and at every larger one, found by a
     scan over widths and bracketed refinement of every verdict change (:attr:`transitions`).
+    Under a record, failing slivers thinner than the scan's resolution can lie above it (the
+    response is chaotic near the verge of overturning): a check of jittered widths above it
+    reports what it finds (:attr:`failing_share`, :attr:`widest_failing_width`; docs/slivers.md).
     """
 
     width: float
@@ -41,6 +45,17 @@ class RequiredWidth:
     #: answer is at most that width (the search halves the width down to ``2**-DOWN_HALVINGS``
     #: of the scan's narrowest before it gives up looking for a failure)
     below_scan: bool = False
+    #: the check above the verified width (a record's ``rule="exact"`` only; docs/slivers.md): the
+    #: share of the checked widths that fail (``None``: not checked), the widest of them (m;
+    #: ``None`` where none failed), the number of widths checked (runs on top of :attr:`runs`),
+    #: and the widest width checked (m)
+    failing_share: float | None = None
+    widest_failing_width: float | None = None
+    check_runs: int = 0
+    check_top: float | None = None
+    #: the widths checked (m, ascending) and whether each failed (for the barcode figure)
+    check_widths: np.ndarray | None = field(default=None, repr=False, compare=False)
+    check_failed: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @property
     def tan_alpha(self) -> float:
@@ -172,10 +187,13 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
             res = runs(widths)
             return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
 
+        settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
         res = _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
-                            settings=settings.replace(record_scan=n_scan, rtol=rtol,
-                                                      record_zone_points=n_zone))
+                            settings=settings)
         res.cap_mass_ratio = gamma
+        if not res.below_scan and settings.check_runs > 0:
+            _add_check(res, top, evaluate_record, settings,
+                       _record_seed(excitation, height, criterion, eta, gamma))
         return res
     settings = settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol)
     x = _scan_points(np.array([top]), settings.n_scan, settings.n_tail)
@@ -216,6 +234,98 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                    if below_scan else "")),
         criterion=criterion, transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br),
         runs=runs, eta=eta, below_scan=below_scan, cap_mass_ratio=gamma)
+
+
+def _first_runs(settings) -> int:
+    n = int(settings.check_runs)
+    return n - int(round(settings.check_follow * n))
+
+
+def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
+    """The widths (m, ascending) of the first stage of the check above a verified ``width``
+    (docs/slivers.md).
+
+    ``settings.check_runs`` less the second stage's share (``settings.check_follow``, see
+    :func:`follow_widths`) widths in ``(width, hi]``, ``hi = min(settings.check_span width,
+    top)`` (``top``: the no-uplift width, above which nothing rocks): a share
+    ``settings.check_near`` of them uniform in ``log d``, ``d = B / width - 1`` from
+    ``settings.check_first`` to ``hi / width - 1`` (failing slivers cluster just above the
+    verified width: ``benchmarks/bench_slivers.py``), the others uniform in ``B`` over the whole
+    span.  Each part is *jittered*: one uniformly random point in each of its equal strata, drawn
+    from ``numpy.random.default_rng(seed)``, so that the widths are spread evenly, never lie on
+    the search's fixed grid, and are the same for the same seed.  Empty where ``hi <= width``.
+    """
+    n = _first_runs(settings)
+    hi = min(settings.check_span * width, top)
+    if n <= 0 or not hi > width * (1.0 + settings.check_first):
+        return np.zeros(0)
+    rng = np.random.default_rng(seed)
+    n_near = int(round(settings.check_near * n))
+
+    def jittered(k):
+        return (np.arange(k) + rng.random(k)) / k
+
+    d_hi = hi / width - 1.0
+    near = width * (1.0 + settings.check_first * (d_hi / settings.check_first) ** jittered(n_near))
+    spread = width + (hi - width) * jittered(n - n_near)
+    return np.sort(np.concatenate([near, spread]))
+
+
+def follow_widths(width, top, widths, ratio, settings=DEFAULT_SETTINGS, seed=0):
+    """The widths (m, ascending) of the second stage of the check: ``settings.check_runs`` times
+    ``settings.check_follow`` of them over ``settings.check_bins`` equal bins of the span, each
+    bin's number in proportion to ``m ** settings.check_power``, ``m`` the mean
+    ``min(max|theta|/alpha, 1)`` of the first stage's ``widths`` in it (``ratio``; 1 in a bin
+    that has none), jittered within the bin (``seed`` as for :func:`check_widths`, a stream of
+    its own)."""
+    n = int(settings.check_runs) - _first_runs(settings)
+    hi = min(settings.check_span * width, top)
+    if n <= 0 or not hi > width * (1.0 + settings.check_first):
+        return np.zeros(0)
+    k = int(settings.check_bins)
+    edges = np.linspace(width, hi, k + 1)
+    widths, ratio = np.asarray(widths, dtype=float), np.minimum(np.asarray(ratio, dtype=float), 1.0)
+    idx = np.clip(np.searchsorted(edges, widths) - 1, 0, k - 1)
+    total = np.bincount(idx, weights=ratio, minlength=k)
+    count = np.bincount(idx, minlength=k)
+    mean = np.where(count > 0, total / np.maximum(count, 1), 1.0)
+    weight = mean ** settings.check_power
+    weight = weight / weight.sum() if weight.sum() > 0 else np.full(k, 1.0 / k)
+    share = weight * n
+    alloc = np.floor(share).astype(int)
+    alloc[np.argsort(alloc - share, kind="stable")[:n - alloc.sum()]] += 1   # largest remainders
+    rng = np.random.default_rng([seed, 1])
+    x = [edges[j] + (edges[j + 1] - edges[j]) * (np.arange(a) + rng.random(a)) / a
+         for j, a in enumerate(alloc) if a > 0]
+    return np.sort(np.concatenate(x))
+
+
+def _record_seed(record, height, criterion, eta, gamma) -> int:
+    """A seed made from the record's samples and the column (the same run, the same check)."""
+    h = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes())
+    h.update(repr((float(record.dt), float(height), criterion, eta, float(gamma))).encode())
+    return int.from_bytes(h.digest()[:8], "little")
+
+
+def _add_check(res, top, evaluate, settings, seed) -> None:
+    """Run the check above ``res.width`` (``evaluate(widths)``: verdicts and max|theta|/alpha,
+    one batch per stage) and store its outcome in ``res``."""
+    x1 = check_widths(res.width, top, settings, seed)
+    f1, r1 = evaluate(x1) if x1.size else (np.zeros(0, dtype=bool), np.zeros(0))
+    x2 = follow_widths(res.width, top, x1, r1, settings, seed)
+    f2 = evaluate(x2)[0] if x2.size else np.zeros(0, dtype=bool)
+    x = np.concatenate([x1, x2])
+    f = np.concatenate([np.asarray(f1, dtype=bool), np.asarray(f2, dtype=bool)])
+    order = np.argsort(x, kind="stable")
+    x, f = x[order], f[order]
+    res.check_top = float(min(settings.check_span * res.width, top))
+    res.check_runs = int(x.size)
+    res.failing_share = float(f.mean()) if x.size else 0.0
+    res.widest_failing_width = float(x[f].max()) if f.any() else None
+    res.check_widths, res.check_failed = x, f
+    res.method += (f"; check above it: {x.size} jittered widths up to {res.check_top:.4g} m, "
+                   f"{int(f.sum())} failed"
+                   + (f" (widest {res.widest_failing_width:.4g} m)" if f.any() else ""))
 
 
 #: how far below the scan's narrowest width (in halvings) the verified width looks for a failure

@@ -1,0 +1,166 @@
+"""The check above the verified width (docs/slivers.md): failing slivers above it, found and
+reported, against independent dense scans."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pulses
+import rocking
+from pulses import G, make_pulse
+from rocking import Block
+from rocking.search import DEFAULT_SETTINGS, SearchSettings
+from rocking.widths import check_widths, follow_widths
+
+from .conftest import shared_record
+
+
+def _verdicts(height, record, widths):
+    res = rocking.simulate_many([Block.from_dimensions(height, float(b)) for b in widths], record)
+    return np.asarray(res.overturned, dtype=bool)
+
+
+def _chaotic_record(seed=8, duration=20.0, dt=0.01):
+    """A 0.3 g sine pulse in 0.15 g of band-limited noise: under it a 7.5 m column has failing
+    widths above its verified width (0.878 m): a 3000-width linear scan of (w, 2w] finds three,
+    1.0, 1.5 and 2.7 % above it, and 4 % of 1500 log-spaced widths 0.01-1 % above it fail)."""
+    from scipy import signal
+
+    rng = np.random.default_rng(seed)
+    n = int(round(duration / dt)) + 1
+    t = dt * np.arange(n)
+    sos = signal.butter(4, (0.3, 10.0), btype="bandpass", fs=1.0 / dt, output="sos")
+    noise = signal.sosfiltfilt(sos, rng.standard_normal(n))
+    noise *= 0.15 * G / np.std(noise) * np.exp(-((t - 0.35 * duration) / (0.25 * duration)) ** 2)
+    return pulses.Record(noise + make_pulse("sine", 0.3 * G, 1.0, 0.3 * duration)(t), dt)
+
+
+def test_check_widths_layout():
+    """First stage jittered: one width per stratum of each part, inside the span, none on the
+    search's grid, the same for the same seed and different for another; the second stage puts
+    its widths where the first stage's widths rocked hardest."""
+    s = DEFAULT_SETTINGS
+    w, top = 1.0, 1.7                                  # the span ends at the no-uplift width
+    x = check_widths(w, top, s, seed=5)
+    n_follow = round(s.check_follow * s.check_runs)
+    n1 = s.check_runs - n_follow
+    assert x.size == n1 and np.all(np.diff(x) > 0)
+    assert x[0] > w and x[-1] <= top
+    n_near = round(s.check_near * n1)
+    n_far = n1 - n_near
+    near = w * (1 + s.check_first * ((top / w - 1) / s.check_first) ** (np.arange(n_near + 1) / n_near))
+    # every log stratum holds its own width, every linear stratum its own (and the other part's)
+    assert np.histogram(x, bins=near)[0].min() >= 1
+    assert np.histogram(x, bins=np.linspace(w, top, n_far + 1))[0].min() >= 1
+    # not on the search's fixed fine grid top (1 + record_fine)^-k (a width there would repeat a run)
+    k = np.log(top / x) / math.log1p(s.record_fine)
+    assert np.min(np.abs(k - np.round(k))) > 1e-6
+    assert np.array_equal(x, check_widths(w, top, s, seed=5))
+    assert not np.array_equal(x, check_widths(w, top, s, seed=6))
+    # span: at most check_span times the width
+    assert check_widths(1.0, 100.0, s, seed=1)[-1] <= s.check_span
+    # nothing to check where the verified width is the no-uplift width; 0 runs switch it off
+    assert check_widths(1.0, 1.0, s).size == 0
+    assert check_widths(1.0, 2.0, s.replace(check_runs=0)).size == 0
+    # second stage: first-stage ratios 1 in the bin (1.35, 1.364] and 0.5 elsewhere: that bin
+    # gets 2**power times the others' share (weights (mean ratio)**power), all n_follow placed
+    ratio = np.where((x > 1.35) & (x <= 1.364), 1.0, 0.5)
+    y = follow_widths(w, top, x, ratio, s, seed=5)
+    assert y.size == n_follow and y[0] > w and y[-1] <= top
+    per_bin = np.histogram(y, bins=np.linspace(w, top, s.check_bins + 1))[0]
+    expect = n_follow * 2.0 ** s.check_power / (2.0 ** s.check_power + s.check_bins - 1)
+    assert abs(per_bin[25] - expect) <= 1.0        # largest remainders: within one width
+    assert np.array_equal(y, follow_widths(w, top, x, ratio, s, seed=5))
+    with pytest.raises(ValueError):
+        SearchSettings(check_near=1.5)
+    with pytest.raises(ValueError):
+        SearchSettings(check_span=1.0)
+
+
+def test_check_against_dense_scans_synthetic():
+    """A synthetic chaotic record: the check changes nothing else, is repeatable, reports only
+    widths that overturn, and its share just above the verified width agrees with a dense
+    independent scan of the same stretch."""
+    height = 7.5
+    rec = _chaotic_record()
+    res = rocking.required_width(height, rec, rule="exact")
+    off = rocking.required_width(height, rec, rule="exact", settings=SearchSettings(check_runs=0))
+    # the verified width and the search are those of the search without the check
+    assert res.width == off.width and res.runs == off.runs and res.transitions == off.transitions
+    assert off.failing_share is None and off.widest_failing_width is None and off.check_runs == 0
+    again = rocking.required_width(height, rec, rule="exact")
+    assert np.array_equal(again.check_widths, res.check_widths)
+    assert again.failing_share == res.failing_share
+    top = height * rec.pga / G
+    assert res.check_runs == DEFAULT_SETTINGS.check_runs == res.check_widths.size
+    assert res.check_top == pytest.approx(min(2.0 * res.width, top), rel=1e-15)
+    assert res.failing_share == pytest.approx(res.check_failed.mean(), abs=0)
+    assert res.widest_failing_width is not None and res.widest_failing_width > res.width
+    # the widest failing width overturns in the reference model too (an independent integrator)
+    ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
+                           model="reference", history=False)
+    assert ref.overturned
+    # the check's log-spaced widths in d = B/w - 1 in [1e-4, 1e-2] against 1500 log-spaced widths
+    # of the same stretch (an independent deterministic grid): the check's count of failures
+    # there is binomial with the grid's share p; 4 standard deviations plus 2 for the grid's own
+    # sampling error (a 1500-point estimate of p) bound it (a chance of ~1e-4 to fail by luck)
+    d = res.check_widths / res.width - 1.0
+    sel = (d >= 1e-4) & (d <= 1e-2)
+    m, k = int(sel.sum()), int(res.check_failed[sel].sum())
+    grid = res.width * (1.0 + np.geomspace(1e-4, 1e-2, 1500))
+    p = _verdicts(height, rec, grid).mean()
+    assert m > 100 and 0.0 < p < 1.0
+    sigma = math.sqrt(m * p * (1 - p)) + math.sqrt(m * m * p * (1 - p) / grid.size)
+    assert abs(k - m * p) <= 4.0 * sigma + 2.0, (k, m, p)
+
+
+def test_check_against_dense_scan_real_record():
+    """Landers, Lucerne 345 (real, 7.5 m): an independent linear scan of 4000 widths of (w, 2w]
+    finds failing widths more than 1 % above the verified width; the check reports a widest
+    failing width at least that far up (not None), which overturns in the reference model."""
+    height = 7.5
+    rec = pulses.read_record(shared_record("RSN879_LANDERS_LCN345.AT2"))
+    res = rocking.required_width(height, rec, rule="exact")
+    assert res.width == pytest.approx(0.593261, rel=1e-5)      # the verified width of today's search
+    x = np.linspace(res.width, min(2.0 * res.width, height * rec.pga / G), 4001)[1:]
+    f = _verdicts(height, rec, x)
+    assert f.any() and x[f].max() > 1.01 * res.width
+    assert res.widest_failing_width is not None and res.widest_failing_width >= 1.01 * res.width
+    assert 0.0 < res.failing_share < 0.2
+    ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
+                           model="reference", history=False)
+    assert ref.overturned
+
+
+def test_pipeline_reports_the_check(tmp_path):
+    """`pipeline run`: the check's columns in the record's report equal `required_width`'s, the
+    suite's checked share follows from them, and the barcode figure is written where the check
+    found failing widths (the synthetic record above: it does)."""
+    import csv
+
+    from pipeline.cli import main
+
+    rec = _chaotic_record()
+    path = tmp_path / "chaotic.sac"
+    pulses.write_sac(pulses.Record(rec.acc, rec.dt, name="chaotic"), path)
+    out = tmp_path / "out"
+    # a column at the verified width (rounded up to 1 mm): verified, yet the check found wider
+    # failing widths (0.878 m verified, failing widths up to ~0.885 m)
+    ver = rocking.required_width(7.5, pulses.read_record(path), rule="exact")
+    width = math.ceil(ver.width * 1000) / 1000
+    assert ver.width <= width < ver.widest_failing_width
+    assert main(["run", str(path), "--block", f"7.5x{width}", "--out", str(out), "-q"]) == 0
+    row = next(csv.DictReader(open(out / "chaotic.csv")))
+    assert float(row["verified_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
+    assert float(row["failing_share"]) == pytest.approx(ver.failing_share, rel=1e-5)
+    assert float(row["widest_failing_width_m"]) == pytest.approx(ver.widest_failing_width, rel=1e-5)
+    assert int(float(row["check_runs"])) == ver.check_runs == DEFAULT_SETTINGS.check_runs
+    assert row["verified_adequate"] == "True"
+    suite = next(csv.DictReader(open(out / "suite.csv")))
+    assert suite["share_column_verified"] == "1" and suite["share_column_checked"] == "0"
+    assert (out / "plots" / "widths" / "chaotic.png").stat().st_size > 10_000
+    text = (out / "columns.md").read_text()
+    assert "`widest_failing_width_m`" in text and "docs/slivers.md" in text
+    assert "plots/widths/<record>.png" in text
