@@ -18,7 +18,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-from . import site
+from . import peer_inputs, site
 from .report import COLUMNS_MD, FAILURES, FIT_TOLERANCE, SHAPE_NAMES, SUMMARY, Columns, _shape_key
 
 #: record ids that would collide with the run's own reports (their names without extension)
@@ -74,6 +74,8 @@ class Task:
     pair: str = ""
     scale: float = 1.0
     pair_fields: tuple = ()
+    #: a record of a PEER download (pipeline.peer_inputs.PeerSource): where its files are read from
+    peer: object = None
 
 
 class StageError(Exception):
@@ -477,7 +479,8 @@ def _verified_fields(col: Column, ver) -> dict:
 
 
 #: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
-COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
+COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
+           + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
            + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
            + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns
            + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns)
@@ -501,6 +504,7 @@ def _process(task: Task):
     if warning:
         base["warnings"] = "; ".join(w for w in (base["warnings"], warning) if w)
     base.update(site_fields)
+    base.update(peer_inputs.fields(task))
 
     gamma = opts.cap_mass_ratio
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from . import site
+from . import peer_inputs, site
 from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
                    parse_shapes, record_options)
 
@@ -63,6 +63,7 @@ def add_parser(subparsers) -> None:
                         "worker), to watch a long batch")
     add_record_options(p)
     site.add_options(p)
+    peer_inputs.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -107,13 +108,20 @@ def main(args) -> int:
                            **record_options(args), **site.options_from_args(args))
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
-    paths = expand_inputs(args.records)
-    if not paths and not args.pair:
+    downloads, others = peer_inputs.split_inputs(args.records)
+    paths = expand_inputs(others)
+    if not paths and not args.pair and not downloads:
         from .report import display
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
-    tasks = site.tasks_from_args(args, paths, columns, options)
+    if downloads:
+        tasks = peer_inputs.tasks_from_args(args, downloads, paths, columns, options)
+    else:
+        if args.peer_scales:
+            raise ArgumentError("--peer-scales applies to PEER downloads (a .zip, or a folder holding "
+                                "_SearchResults.csv); none was given")
+        tasks = site.tasks_from_args(args, paths, columns, options)
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
                   quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
     return summary.exit_code
