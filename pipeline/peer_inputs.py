@@ -163,13 +163,12 @@ def make_tasks(downloads, columns, options, n_directions, scale, scales, peer_sc
 
     tasks = []
     for download in downloads:
-        d_display = download
         for entry, src in record_units(download, peer_scales, say):
             if entry is None:  # the download itself cannot be read: one failure for it
                 tasks.append(Task(0, _stem(download) + ".zip", download, tuple(columns), options,
                                   peer=src))
                 continue
-            d = open_download(d_display)
+            d = open_download(download)
             path1, path2 = d.display(src.h1), d.display(src.h2) if src.h2 else None
             pname = site.pair_name(path1, path2 or path1)
             k = float(entry.metadata.get("scale_factor") or 1.0) if peer_scales else 1.0
@@ -185,6 +184,10 @@ def make_tasks(downloads, columns, options, n_directions, scale, scales, peer_sc
                     angles = site.directions(fields.get("orientation_deg"), n_directions)
                 except RecordError:
                     pass  # the task fails at reading, with the reason
+            if src.missing:  # a failure of the record, not of a direction
+                tasks.append(Task(0, pname + ".pair", path1, tuple(columns), options, path2=path2,
+                                  pair=pname, scale=k, peer=src))
+                continue
             for angle, kind in angles:
                 tasks.append(Task(0, f"{pname}_{angle:05.1f}deg.dir", path1, tuple(columns), options,
                                   path2=path2, direction=angle, direction_kind=kind, pair=pname,
