@@ -192,10 +192,10 @@ class _Run:
         peak.terminal = stop_at_peak
         peak.direction = -s  # a peak away from the base: omega passes 0 from s to -s
         first_step = None
-        if self.theta == 0.0:  # a flight from theta = 0 must not end inside its first step
-            a = abs(rhs(t, [0.0, self.omega])[1])
+        if self.theta == 0.0 and self.omega != 0.0:  # a hop must not end inside its first step
+            a = abs(rhs(t, [0.0, 0.0])[1])
             if a > 0:
-                first_step = min(end - t, 0.05 * max(abs(self.omega), 1e-3 * blk.p * alpha) / a)
+                first_step = min(end - t, 0.05 * abs(self.omega) / a)
         sol = solve_ivp(rhs, (t, end), [self.theta, self.omega], method="DOP853", rtol=RTOL, atol=ATOL,
                         events=(impact, overturn, peak), first_step=first_step)
         if sol.status == -1:
