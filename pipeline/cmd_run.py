@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from . import peer_inputs, site
+from . import peer_inputs, site, vertical
 from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
                    parse_shapes, record_options)
 
@@ -64,6 +64,7 @@ def add_parser(subparsers) -> None:
     add_record_options(p)
     site.add_options(p)
     peer_inputs.add_options(p)
+    vertical.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -105,11 +106,13 @@ def main(args) -> int:
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
     options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
-                           **record_options(args), **site.options_from_args(args))
+                           vertical=args.vertical, **record_options(args), **site.options_from_args(args))
+    triplets = {(str(a), str(b)): str(v) for a, b, v in args.triplet}
+    args.pair = list(args.pair) + [[a, b] for a, b in triplets]  # a triplet's horizontals are a pair
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     downloads, others = peer_inputs.split_inputs(args.records)
-    paths = expand_inputs(others)
+    paths = [p for p in expand_inputs(others) if p not in set(triplets.values())]
     if not paths and not args.pair and not downloads:
         from .report import display
 
@@ -122,6 +125,15 @@ def main(args) -> int:
             raise ArgumentError("--peer-scales applies to PEER downloads (a .zip, or a folder holding "
                                 "_SearchResults.csv); none was given")
         tasks = site.tasks_from_args(args, paths, columns, options)
+    if tasks is not None and args.vertical == "auto":
+        found = {}
+        if args.pairs == "auto":
+            from .args import record_options as _ro
+
+            say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
+            rest = [p for p in paths if p not in {q for ab in args.pair for q in ab}]
+            found = vertical.auto_verticals(rest, _ro(args), say)
+        tasks = vertical.attach(tasks, {**found, **triplets})
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
                   quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
     return summary.exit_code

@@ -38,8 +38,7 @@ PEER_COLUMNS = Columns(
     ("peer_scaled", "-", "True when `--peer-scales` applied `peer_scale_factor` (then in `scale`); "
                          "False: the record as recorded, unscaled (the default)."),
     ("peer_vertical_file", "-", "The record's vertical component as the report lists it (blank: none); "
-                                "not used by the designs of this version (the verdicts are for the "
-                                "horizontal motion alone)."),
+                                "with `--vertical auto` it is used in the vertical_* columns."),
 )
 #: the report's metadata key behind each column (pulses.peer.METADATA)
 _KEYS = {"peer_rsn": "rsn", "peer_event": "event", "peer_year": "year", "peer_station": "station",
@@ -70,7 +69,7 @@ class PeerSource:
     def inputs(self) -> list[str]:
         """The files whose content the record's results depend on (for :mod:`pipeline.resume`)."""
         if os.path.isdir(self.download):
-            return [os.path.join(self.download, n) for n in (self.h1, self.h2) if n]
+            return [os.path.join(self.download, n) for n in (self.h1, self.h2, self.vertical) if n]
         return [self.download]
 
 
@@ -211,15 +210,26 @@ def combine(*groups) -> list:
 
 
 # -- in the worker -----------------------------------------------------------------------------------
-def read_task(task):
-    """The ground motion of a PEER task: the pair's component in the task's direction, scaled."""
-    from pulses import RecordError, check_pair, component
+def read_components(task, vertical: bool = True):
+    """``(first, second, vertical or None, vertical's name)`` of a PEER task, as read (unscaled,
+    not yet checked as a pair); a record with files missing raises :class:`pulses.RecordError`."""
+    from pulses import RecordError
 
     src = task.peer
     if src.missing:
         raise RecordError(src.missing)
     d = open_download(src.download)
-    first, second = check_pair(d.read_component(src.h1), d.read_component(src.h2))
+    first, second = d.read_component(src.h1), d.read_component(src.h2)
+    vert = d.read_component(src.vertical) if (vertical and src.vertical) else None
+    return first, second, vert, (d.display(src.vertical) if src.vertical else None)
+
+
+def read_task(task):
+    """The ground motion of a PEER task: the pair's component in the task's direction, scaled."""
+    from pulses import check_pair, component
+
+    first, second, _, _ = read_components(task, vertical=False)
+    first, second = check_pair(first, second)
     record = component(first, second, task.direction or 0.0)
     return record.scaled(task.scale) if task.scale != 1.0 else record
 

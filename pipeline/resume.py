@@ -66,7 +66,8 @@ def task_key(task, version: str) -> str | None:
     import dataclasses
 
     peer = getattr(task, "peer", None)  # a record of a PEER download: its download's files
-    inputs = peer.inputs() if peer is not None else (task.path, getattr(task, "path2", None))
+    inputs = peer.inputs() if peer is not None else (task.path, getattr(task, "path2", None),
+                                                     getattr(task, "vertical", None))
     contents = [file_digest(p) for p in inputs if p is not None]
     if None in contents:
         return None
