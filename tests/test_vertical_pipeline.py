@@ -49,7 +49,12 @@ def test_triplet_adds_the_response_with_the_vertical(files, tmp_path):
         up = pulses.Record(-5 * raw.acc[:n], raw.dt)
         ref = rocking.simulate_vertical_reference(block, comp, up)
         assert r["vertical_overturns"] == str(ref.overturned)
-        assert float(r["vertical_max_theta_ratio"]) == pytest.approx(ref.max_rotation_ratio, rel=1e-5, abs=1e-12)
+        # the recorded components' directions (0, 90) are exact; the pulse direction is written with
+        # 6 significant digits (76.0844 deg), which moves the component by ~1e-6 rad and the peak
+        # rotation by ~1e-4 of itself
+        exact = r["direction_kind"].startswith("component")
+        assert float(r["vertical_max_theta_ratio"]) == pytest.approx(ref.max_rotation_ratio,
+                                                                      rel=1e-5 if exact else 1e-3, abs=1e-9)
         assert float(r["vertical_pga_g"]) == pytest.approx(5 * np.max(np.abs(raw.acc)) / pulses.G, rel=1e-5)
         assert r["vertical_lifts_off"] == "False"
 
