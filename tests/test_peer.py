@@ -269,3 +269,24 @@ def test_peer_scales_without_a_download_is_an_argument_error(tmp_path):
     rec = tmp_path / "a.AT2"
     rec.write_text(at2_text(pulse_values(0), "0"))
     assert main(["run", str(rec), *RUN_ARGS, "--out", str(tmp_path / "o"), "--peer-scales"]) == 2
+
+
+def test_check_triplet_cuts_to_one_axis_and_refuses_what_is_not_a_vertical(tmp_path):
+    def rec(name, component, n=300, dt=0.01):
+        path = tmp_path / name
+        path.write_text(at2_text(pulse_values(0 if component in ("0", "UP", "DWN", "V1") else 90, n=n), component, dt))
+        return pulses.read_record(path)
+
+    h1, h2 = rec("S000.AT2", "0", n=305), rec("S090.AT2", "90", n=310)
+    a, b, up = pulses.check_triplet(h1, h2, rec("SDWN.AT2", "DWN", n=300))
+    assert a.npts == b.npts == up.npts == 300
+    np.testing.assert_array_equal(up.acc, -pulses.read_record(tmp_path / "SDWN.AT2").acc)
+    assert up.metadata["polarity"] == "DWN"
+    with pytest.raises(RecordError, match="polarity"):
+        pulses.check_triplet(h1, h2, rec("S-V1.AT2", "V1"))
+    with pytest.raises(RecordError, match="horizontal component, not a vertical"):
+        pulses.check_triplet(h1, h2, rec("S180.AT2", "180"))
+    with pytest.raises(RecordError, match="time steps differ"):
+        pulses.check_triplet(h1, h2, rec("S2-UP.AT2", "UP", dt=0.02))
+    with pytest.raises(RecordError, match="lengths differ"):
+        pulses.check_triplet(h1, h2, rec("S3-UP.AT2", "UP", n=250))
