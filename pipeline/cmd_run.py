@@ -45,7 +45,8 @@ def add_parser(subparsers) -> None:
                     "130 (143) when stopped by Ctrl-C (SIGTERM).")
     p.add_argument("records", nargs="*", metavar="RECORD",
                    help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
-                        "...) or folders of them")
+                        "...), folders of them, or PEER NGA-West2 downloads (a .zip, or a folder "
+                        "holding _SearchResults.csv; see docs/peer.md)")
     p.add_argument("--block", action="append", default=[], metavar="HxW",
                    help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
