@@ -290,3 +290,13 @@ def test_check_triplet_cuts_to_one_axis_and_refuses_what_is_not_a_vertical(tmp_p
         pulses.check_triplet(h1, h2, rec("S2-UP.AT2", "UP", dt=0.02))
     with pytest.raises(RecordError, match="lengths differ"):
         pulses.check_triplet(h1, h2, rec("S3-UP.AT2", "UP", n=250))
+
+
+def test_a_zip_that_is_not_a_peer_download_is_a_failure_not_a_crash(tmp_path):
+    path = tmp_path / "other.zip"
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("readme.txt", "no search report here")
+    out = tmp_path / "out"
+    assert main(["run", str(path), *RUN_ARGS, "--out", str(out)]) == 1
+    fails = list(csv.DictReader(open(out / "failures.csv")))
+    assert len(fails) == 1 and "no _SearchResults.csv in the zip" in fails[0]["reason"]

@@ -133,3 +133,14 @@ def test_real_three_component_records(rsn, h1, h2, v, polarity):
     flipped = simulate_vertical_reference(block, hor, raw if polarity < 0 else up.scaled(-1), duration=window)
     # the polarity matters: the wrong sign gives another response
     assert (with_v.max_rotation, with_v.t_overturn) != (flipped.max_rotation, flipped.t_overturn)
+
+
+def test_simulate_with_a_vertical_says_which_model_answered():
+    block = rocking.Block.from_dimensions(3.0, 0.9)
+    rec = record()
+    up = pulses.Record(0.2 * G * np.sin(3 * rec.time), rec.dt)
+    res = rocking.simulate(block, rec, vertical=up)
+    ref = simulate_vertical_reference(block, rec, up)
+    assert res.model == "reference-vertical" and res.max_rotation == ref.max_rotation
+    with pytest.raises(rocking.errors.RockingInputError):
+        rocking.simulate(block, pulses.make_pulse("sine", 3.0, 1.0), vertical=up)
