@@ -123,10 +123,6 @@ def record_ids(paths) -> list[str]:
 
 
 # -- the work ---------------------------------------------------------------------------------------
-def _read(task: Task):
-    return site.read_task(task)
-
-
 def _g(x):
     from pulses import G
 

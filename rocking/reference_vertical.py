@@ -114,7 +114,7 @@ class _Run:
         """Carry the state over ``[ta, tb]``; False once overturned, lifted off or (``stop_at_peak``)
         past the first peak."""
         blk = self.block
-        tan_a, alpha, eta, p2 = blk.tan_alpha, blk.alpha, blk.eta, self.p2
+        tan_a = blk.tan_alpha
         su, sv = (ub - ua) / (tb - ta), (vb - va) / (tb - ta)
 
         def u(t):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import pathlib
 import zipfile
 
@@ -14,7 +13,7 @@ import pytest
 
 import pulses
 from pipeline.cli import main
-from pulses import G, RecordError
+from pulses import RecordError
 from pulses import peer
 
 #: ``../shared/records/peer_download`` beside the checkout: a real PEER search report and the files
