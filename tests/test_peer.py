@@ -299,3 +299,18 @@ def test_a_zip_that_is_not_a_peer_download_is_a_failure_not_a_crash(tmp_path):
     assert main(["run", str(path), *RUN_ARGS, "--out", str(out)]) == 1
     fails = list(csv.DictReader(open(out / "failures.csv")))
     assert len(fails) == 1 and "no _SearchResults.csv in the zip" in fails[0]["reason"]
+
+
+def test_a_download_zipped_inside_a_folder_is_read_next_to_its_report(tmp_path):
+    path = tmp_path / "nested.zip"
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("PEERNGARecords_Unscaled/" + peer.SEARCH_RESULTS,
+                    report_text([(1, "A000.AT2", "A090.AT2", "A-UP.AT2")]))
+        zf.writestr("PEERNGARecords_Unscaled/A000.AT2", at2_text(pulse_values(0), "0"))
+        zf.writestr("PEERNGARecords_Unscaled/A090.AT2", at2_text(pulse_values(90), "90"))
+        zf.writestr("elsewhere/A-UP.AT2", at2_text(pulse_values(0), "UP"))  # not beside the report
+    d = peer.PeerDownload(path)
+    (entry,) = d.search.entries
+    assert d.missing(entry) == ["A-UP.AT2"]
+    assert d.read_component("A090.AT2").metadata["source"] == f"{path}/PEERNGARecords_Unscaled/A090.AT2"
+    assert entry.metadata["scale_factor"] == 2.0 and entry.metadata["tp_s"] is None
