@@ -18,7 +18,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-from . import site
+from . import peer_inputs, site, vertical
 from .report import COLUMNS_MD, FAILURES, FIT_TOLERANCE, SHAPE_NAMES, SUMMARY, Columns, _shape_key
 
 #: record ids that would collide with the run's own reports (their names without extension)
@@ -58,6 +58,8 @@ class Options:
     cap_mass_ratio: float = 0.0
     fragility: bool = False
     up_to: float = 10.0
+    #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
+    vertical: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,10 @@ class Task:
     pair: str = ""
     scale: float = 1.0
     pair_fields: tuple = ()
+    #: a record of a PEER download (pipeline.peer_inputs.PeerSource): where its files are read from
+    peer: object = None
+    #: the vertical component's file of a pair (pipeline.vertical: --triplet, --pairs auto)
+    vertical: str | None = None
 
 
 class StageError(Exception):
@@ -117,10 +123,6 @@ def record_ids(paths) -> list[str]:
 
 
 # -- the work ---------------------------------------------------------------------------------------
-def _read(task: Task):
-    return site.read_task(task)
-
-
 def _g(x):
     from pulses import G
 
@@ -510,11 +512,12 @@ def _check_fields(ver) -> dict:
 
 
 #: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
-COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
+COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
+           + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
            + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
            + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns
            + CHECK_COLUMNS.columns
-           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns)
+           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns + vertical.VERTICAL_COLUMNS.columns)
 FIELDS = [name for name, _, _ in COLUMNS]
 
 
@@ -522,7 +525,7 @@ def _process(task: Task):
     import rocking
 
     opts = task.options
-    record = _stage("read", _read, task)
+    record, up, vertical_note = _stage("read", vertical.read_task, task)
     fit = _stage("fit", _fit, record, opts.shapes, opts.weighting)
     best = fit.best
     candidates = list(fit.candidates)
@@ -535,6 +538,10 @@ def _process(task: Task):
     if warning:
         base["warnings"] = "; ".join(w for w in (base["warnings"], warning) if w)
     base.update(site_fields)
+    base.update(peer_inputs.fields(task))
+    if vertical_note:
+        base["warnings"] = "; ".join(w for w in (base["warnings"], vertical_note) if w)
+    shown_vertical = None if up is None else (up.metadata.get("source") or task.vertical)
 
     gamma = opts.cap_mass_ratio
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
@@ -600,6 +607,7 @@ def _process(task: Task):
         row.update(_verified_fields(col, verified_cache[H]))
         row.update(_check_fields(verified_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical))
         rows.append(row)
 
     return rows, (record, fit, fitting, histories), verified_cache

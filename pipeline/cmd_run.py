@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from . import site
+from . import peer_inputs, site, vertical
 from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
                    parse_shapes, record_options)
 
@@ -47,7 +47,8 @@ def add_parser(subparsers) -> None:
                     "130 (143) when stopped by Ctrl-C (SIGTERM).")
     p.add_argument("records", nargs="*", metavar="RECORD",
                    help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
-                        "...) or folders of them")
+                        "...), folders of them, or PEER NGA-West2 downloads (a .zip, or a folder "
+                        "holding _SearchResults.csv; see docs/peer.md)")
     p.add_argument("--block", action="append", default=[], metavar="HxW",
                    help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
@@ -65,6 +66,8 @@ def add_parser(subparsers) -> None:
                         "worker), to watch a long batch")
     add_record_options(p)
     site.add_options(p)
+    peer_inputs.add_options(p)
+    vertical.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -106,16 +109,34 @@ def main(args) -> int:
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
     options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
-                           **record_options(args), **site.options_from_args(args))
+                           vertical=args.vertical, **record_options(args), **site.options_from_args(args))
+    triplets = {(str(a), str(b)): str(v) for a, b, v in args.triplet}
+    args.pair = list(args.pair) + [[a, b] for a, b in triplets]  # a triplet's horizontals are a pair
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
-    paths = expand_inputs(args.records)
-    if not paths and not args.pair:
+    downloads, others = peer_inputs.split_inputs(args.records)
+    paths = [p for p in expand_inputs(others) if p not in set(triplets.values())]
+    if not paths and not args.pair and not downloads:
         from .report import display
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
-    tasks = site.tasks_from_args(args, paths, columns, options)
+    if downloads:
+        tasks = peer_inputs.tasks_from_args(args, downloads, paths, columns, options)
+    else:
+        if args.peer_scales:
+            raise ArgumentError("--peer-scales applies to PEER downloads (a .zip, or a folder holding "
+                                "_SearchResults.csv); none was given")
+        tasks = site.tasks_from_args(args, paths, columns, options)
+    if tasks is not None and args.vertical == "auto":
+        found = {}
+        if args.pairs == "auto":
+            from .args import record_options as _ro
+
+            say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
+            rest = [p for p in paths if p not in {q for ab in args.pair for q in ab}]
+            found = vertical.auto_verticals(rest, _ro(args), say)
+        tasks = vertical.attach(tasks, {**found, **triplets})
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
                   quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
     return summary.exit_code

@@ -65,7 +65,10 @@ def task_key(task, version: str) -> str | None:
     the batch, the content of its file(s) and ``version``; None when a file cannot be read."""
     import dataclasses
 
-    contents = [file_digest(p) for p in (task.path, getattr(task, "path2", None)) if p is not None]
+    peer = getattr(task, "peer", None)  # a record of a PEER download: its download's files
+    inputs = peer.inputs() if peer is not None else (task.path, getattr(task, "path2", None),
+                                                     getattr(task, "vertical", None))
+    contents = [file_digest(p) for p in inputs if p is not None]
     if None in contents:
         return None
     text = repr((version, contents, dataclasses.replace(task, index=0)))

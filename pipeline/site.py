@@ -21,6 +21,7 @@ import math
 import os
 import pathlib
 
+from . import peer_inputs
 from .args import ArgumentError
 from .report import Columns
 
@@ -58,6 +59,9 @@ SITE_COLUMNS = Columns(
     ("velocity_pulse_indicator", "-", "Shahi & Baker's pulse indicator PI (pulse-like when above 0, "
                                       "with an early enough arrival)."),
     ("velocity_tp_s", "s", "Pseudo-period Tp of the extracted velocity pulse."),
+    ("peer_tp_s", "s", "PEER's pulse period of the record (`Tp-Pulse Period` of a PEER download's "
+                       "`_SearchResults.csv`), to compare with `velocity_tp_s`; blank when PEER gives "
+                       "none (`-`: not pulse-like in its search) or the record is not from a PEER download."),
     ("orientation_deg", "deg", "Direction of the strongest velocity pulse, from the first component "
                                "towards the second (0 for a single component)."),
     ("azimuth_deg", "deg", "Azimuth of the strongest velocity pulse, clockwise from north (0..180), "
@@ -123,6 +127,7 @@ def site_fields(task, record) -> tuple[dict, str | None]:
               "direction_azimuth_deg": az, "scale": float(task.scale),
               "cap_mass_ratio": float(task.options.cap_mass_ratio)}
     fields.update(cls)
+    fields["peer_tp_s"] = peer_inputs.tp(task)
     return SITE_COLUMNS.row(fields), warning
 
 
@@ -130,6 +135,8 @@ def read_task(task):
     """The ground motion of a task: one file, or the component of a pair in its direction; scaled."""
     import pulses
 
+    if getattr(task, "peer", None) is not None:
+        return peer_inputs.read_task(task)
     opts = task.options
     kw = dict(format=opts.format, units=opts.units, dt=opts.dt, column=opts.column, trace=opts.trace)
     if task.path2 is None:
@@ -216,6 +223,16 @@ def options_from_args(args) -> dict:
 def tasks_from_args(args, paths, columns, options):
     """The tasks of ``pipeline run`` when pairs or scales are asked for; None otherwise (the
     runner's own tasks, one per file)."""
+    n, scale, scales = settings_from_args(args)
+    if not args.pair and args.pairs == "none" and scale == 1.0 and scales is None:
+        return None
+    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
+    return make_tasks(paths, [tuple(p) for p in args.pair], args.pairs, columns, options, n, scale,
+                      scales, say=say)
+
+
+def settings_from_args(args):
+    """``(directions N, --scale factor, --scales table or None)``, checked."""
     try:
         n = int(str(args.directions))
     except ValueError:
@@ -226,11 +243,7 @@ def tasks_from_args(args, paths, columns, options):
         raise SiteError("give --scale or --scales, not both")
     scale = 1.0 if args.scale is None else _number(args.scale, "--scale", 1e-3, MAX_SCALE)
     scales = None if args.scales is None else read_scales(args.scales)
-    if not args.pair and args.pairs == "none" and scale == 1.0 and scales is None:
-        return None
-    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
-    return make_tasks(paths, [tuple(p) for p in args.pair], args.pairs, columns, options, n, scale,
-                      scales, say=say)
+    return n, scale, scales
 
 
 def output_files(options) -> list[str]:

@@ -26,6 +26,9 @@ __all__ = [
 
 from .velocity import PulseCandidate, PulseClassification, classify_pulse
 from .pairs import Pairing, check_pair, component, pair_files, read_pair, rotate_pair
+from . import peer
+from .peer import PeerDownload
+from .triplets import check_triplet
 
 __all__ += ["classify_pulse", "PulseClassification", "PulseCandidate", "read_pair", "check_pair",
-            "component", "rotate_pair", "pair_files", "Pairing"]
+            "component", "rotate_pair", "pair_files", "Pairing", "peer", "PeerDownload", "check_triplet"]

@@ -172,36 +172,42 @@ def read_at2_file(path, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, flo
     path = os.fspath(path)
     try:
         with open(path, "r", encoding="utf-8-sig", errors="replace") as fh:
-            lines = [fh.readline() for _ in range(4)]
-            lines = [ln for ln in lines if ln]
-            if not "".join(lines).strip() and not _rest_has_text(fh):
-                raise RecordError(f"{path}: the file is empty")
-            if len(lines) < 4:
-                raise RecordError(f"{path}: truncated PEER AT2 file: {len(lines)} line(s), the header alone has 4")
-            npts_dt = parse_npts_dt(lines[3])
-            if npts_dt is None:
-                raise RecordError(f"{path}: not a PEER AT2 file: line 4 should give NPTS and DT "
-                                  f"(e.g. 'NPTS=  1991, DT= .0100 SEC'), found {lines[3].strip()[:60]!r}")
-            npts, dt = npts_dt
-            if npts > max_samples:
-                raise RecordError(too_long(path, max_samples, npts))
-            blocks, count, lineno = [], 0, 4
-            while True:
-                block = fh.readlines(_BLOCK_CHARS)
-                if not block:
-                    break
-                values = _parse_block(path, block, lineno)
-                lineno += len(block)
-                count += values.size
-                if count > max_samples:
-                    raise RecordError(too_long(path, max_samples))
-                blocks.append(values)
+            return read_at2_stream(fh, path, max_samples)
     except FileNotFoundError:
         raise RecordError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise RecordError(f"{path}: is a directory, not a record file") from None
     except OSError as exc:
         raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
+
+
+def read_at2_stream(fh, path: str, max_samples: int = MAX_SAMPLES) -> tuple[np.ndarray, float, dict]:
+    """:func:`read_at2_file` on an open text stream ``fh`` (a file, or ``io.StringIO`` of a
+    member read in memory from a zip); ``path`` names it in messages."""
+    lines = [fh.readline() for _ in range(4)]
+    lines = [ln for ln in lines if ln]
+    if not "".join(lines).strip() and not _rest_has_text(fh):
+        raise RecordError(f"{path}: the file is empty")
+    if len(lines) < 4:
+        raise RecordError(f"{path}: truncated PEER AT2 file: {len(lines)} line(s), the header alone has 4")
+    npts_dt = parse_npts_dt(lines[3])
+    if npts_dt is None:
+        raise RecordError(f"{path}: not a PEER AT2 file: line 4 should give NPTS and DT "
+                          f"(e.g. 'NPTS=  1991, DT= .0100 SEC'), found {lines[3].strip()[:60]!r}")
+    npts, dt = npts_dt
+    if npts > max_samples:
+        raise RecordError(too_long(path, max_samples, npts))
+    blocks, count, lineno = [], 0, 4
+    while True:
+        block = fh.readlines(_BLOCK_CHARS)
+        if not block:
+            break
+        values = _parse_block(path, block, lineno)
+        lineno += len(block)
+        count += values.size
+        if count > max_samples:
+            raise RecordError(too_long(path, max_samples))
+        blocks.append(values)
     data = join_blocks(blocks)
     style = "NPTS=, DT=" if _NPTS_DT_NEW.search(lines[3]) else "NPTS, DT"
     if data.size != npts:
@@ -277,6 +283,11 @@ def read(path: str, options: formats.ReadOptions) -> formats.Reading:
         units or units that are not acceleration, and every error of :func:`read_at2_file`.
     """
     values, dt, header = read_at2_file(path, max_samples=options.max_samples)
+    return reading_of(path, values, dt, header)
+
+
+def reading_of(path: str, values, dt: float, header: dict) -> formats.Reading:
+    """The :class:`pulses.formats.Reading` of AT2 samples and header (see :func:`read`)."""
     if header["quantity"] in ("velocity", "displacement"):
         raise RecordError(f"{path}: this is a {header['quantity']} record ({header['lines'][2].strip()}); "
                           f"give the acceleration record (.AT2) instead")

@@ -126,6 +126,17 @@ def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
         unit_factor(units)  # refuse unknown or velocity units before reading
     reading = fmt.read(path, ReadOptions(column=column, trace=trace, max_samples=int(max_samples),
                                          format=format))
+    return record_from_reading(path, reading, units, dt, name, column_suffix=True)
+
+
+def record_from_reading(path: str, reading, units=None, dt=None, name=None, *,
+                        column_suffix: bool = False) -> Record:
+    """The checks every record gets, on what a format's reader found (``reading``, a
+    :class:`pulses.formats.Reading`): units (never guessed), time step, finite samples, plausible
+    peak.  ``path`` names the source in messages and in ``metadata["source"]``; it need not be a
+    file (a member of a zip read in memory, :mod:`pulses.peer`)."""
+    if units is not None:
+        unit_factor(units)
     meta = reading.metadata
     meta.setdefault("warnings", [])
     used_units, units_source = _units(path, reading, units)
@@ -136,7 +147,9 @@ def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
         meta.setdefault(key, "")
     _validate(path, acc, reading.values, used_units, units_source, meta)
     if name is None:
-        name = printable(p.name) + (f":col{meta['column']}" if meta.get("columns", 1) > 1 else "")
+        name = printable(pathlib.PurePath(path).name)
+        if column_suffix and meta.get("columns", 1) > 1:
+            name += f":col{meta['column']}"
     return Record(acc, dt, name=name, t_start=float(meta.pop("t_start", 0.0)), metadata=meta)
 
 

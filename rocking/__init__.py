@@ -15,6 +15,9 @@ __all__ += [
 from .solver import BatchResult, RockingResult, linear_error_estimate, simulate, simulate_many
 
 __all__ += ["BatchResult", "RockingResult", "linear_error_estimate", "simulate", "simulate_many"]
+from .reference_vertical import VerticalRockingResult, simulate_vertical_reference
+
+__all__ += ["VerticalRockingResult", "simulate_vertical_reference"]
 from .frame import equivalent_size, eta_frame, frame_p
 
 __all__ += ["equivalent_size", "eta_frame", "frame_p"]

@@ -171,7 +171,7 @@ def _choose_model(model: str, block: Block, tol: float) -> str:
 def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: float = 0.0,
              duration: float | None = None, model: str = "auto", tol: float = 1e-6,
              history: bool = True, zeno_tol: float = ZENO_TOL, method: str = "taylor",
-             ph_max: float | None = None) -> RockingResult:
+             ph_max: float | None = None, vertical: Record | None = None) -> RockingResult:
     """Rocking response of ``block`` to ``excitation``.
 
     Parameters
@@ -203,11 +203,23 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
     ph_max : float, optional
         Fast engine only: largest ``p_eff * h`` of a step (default :data:`PH_MAX`, or
         :data:`PH_MAX_RK4` for ``method="rk4"``); smaller means more sub-steps per sample.
+    vertical : pulses.Record, optional
+        Upward ground acceleration (m/s^2) on the excitation's time axis (docs/theory.md section
+        10).  The compiled engine does not take it yet: the response is the reference model's
+        (:func:`rocking.simulate_vertical_reference`, ``model="reference-vertical"``, slow), with
+        ``lifts_off`` where ``g + av < 0``.
 
     Returns
     -------
     RockingResult
     """
+    if vertical is not None:
+        if not isinstance(excitation, Record) or theta0 != 0.0 or omega0 != 0.0:
+            raise RockingInputError("simulate: a vertical record goes with a horizontal pulses.Record "
+                                    "and the block at rest")
+        from .reference_vertical import simulate_vertical_reference
+
+        return simulate_vertical_reference(block, excitation, vertical, duration=duration, zeno_tol=zeno_tol)
     if not isinstance(block, Block):
         raise TypeError("block must be a rocking.Block")
     for name, value in (("theta0", theta0), ("omega0", omega0)):

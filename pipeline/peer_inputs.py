@@ -1,0 +1,269 @@
+"""PEER NGA-West2 downloads as inputs of ``pipeline run``: ``pipeline run DOWNLOAD.zip --block HxW``
+(or the folder it was unpacked into).
+
+The search report ``_SearchResults.csv`` (:mod:`pulses.peer`) says which files form a record: each
+record with both horizontals in the download is designed as a pair, in every direction
+(:mod:`pipeline.site`, as ``--pair`` does), with the report's metadata in every row
+(:data:`PEER_COLUMNS`, and ``peer_tp_s`` next to the package's ``velocity_tp_s``).  A record whose
+listed files are not all in the download fails, with the files it lacks, in ``failures.csv``: the
+run goes on and exits with status 1.  Records are designed as recorded unless ``--peer-scales``
+applies the search's scale factors; the ``peer_scaled`` column says which.
+
+A zip is read in memory, never unpacked (:class:`pulses.peer.PeerDownload`).  A task of a PEER
+record carries a :class:`PeerSource` (plain data): the worker reads its files from the download.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import os
+from dataclasses import dataclass
+
+from .report import Columns
+
+PEER_COLUMNS = Columns(
+    ("peer_rsn", "-", "PEER record sequence number (RSN) of the record, from the download's "
+                      "`_SearchResults.csv`; blank for records that do not come from a PEER download."),
+    ("peer_event", "-", "Earthquake name as the search report writes it (PEER writes `_` for commas)."),
+    ("peer_year", "-", "Year of the earthquake (search report)."),
+    ("peer_station", "-", "Station name (search report)."),
+    ("peer_magnitude", "-", "Moment magnitude (search report)."),
+    ("peer_mechanism", "-", "Fault mechanism (search report)."),
+    ("peer_rjb_km", "km", "Joyner-Boore distance Rjb (search report)."),
+    ("peer_rrup_km", "km", "Rupture distance Rrup (search report)."),
+    ("peer_vs30_m_s", "m/s", "Vs30 of the station (search report)."),
+    ("peer_lowest_usable_freq_hz", "Hz", "Lowest usable frequency of the record's processing (search "
+                                         "report): pulses much longer than its inverse are not in the data."),
+    ("peer_scale_factor", "-", "The search's scale factor for the record (`Scale Factor` of the report)."),
+    ("peer_scaled", "-", "True when `--peer-scales` applied `peer_scale_factor` (then in `scale`); "
+                         "False: the record as recorded, unscaled (the default)."),
+    ("peer_vertical_file", "-", "The record's vertical component as the report lists it (blank: none); "
+                                "with `--vertical auto` it is used in the vertical_* columns."),
+)
+#: the report's metadata key behind each column (pulses.peer.METADATA)
+_KEYS = {"peer_rsn": "rsn", "peer_event": "event", "peer_year": "year", "peer_station": "station",
+         "peer_magnitude": "magnitude", "peer_mechanism": "mechanism", "peer_rjb_km": "rjb_km",
+         "peer_rrup_km": "rrup_km", "peer_vs30_m_s": "vs30_m_s",
+         "peer_lowest_usable_freq_hz": "lowest_usable_freq_hz", "peer_scale_factor": "scale_factor"}
+#: the site column holding PEER's pulse period (declared in pipeline.site, next to ours)
+PEER_TP = "peer_tp_s"
+
+
+@dataclass(frozen=True)
+class PeerSource:
+    """Where a task's ground motion comes from in a PEER download (plain, picklable data).
+
+    ``download`` is the zip or folder as given; ``h1``, ``h2``, ``vertical`` the file names the
+    report lists; ``missing`` why the record cannot be read (blank when it can); ``fields`` the
+    :data:`PEER_COLUMNS` values and ``tp`` PEER's pulse period.
+    """
+
+    download: str
+    h1: str | None
+    h2: str | None
+    vertical: str | None = None
+    missing: str = ""
+    fields: tuple = ()
+    tp: float | None = None
+
+    def inputs(self) -> list[str]:
+        """The files whose content the record's results depend on (for :mod:`pipeline.resume`)."""
+        if os.path.isdir(self.download):
+            return [os.path.join(self.download, n) for n in (self.h1, self.h2, self.vertical) if n]
+        return [self.download]
+
+
+def add_options(parser) -> None:
+    """``--peer-scales`` of ``pipeline run``."""
+    parser.add_argument("--peer-scales", action="store_true",
+                        help="PEER downloads: multiply each record by the search's scale factor "
+                             "(_SearchResults.csv); by default records are designed as recorded")
+
+
+def split_inputs(items) -> tuple[list[str], list[str]]:
+    """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``."""
+    from pulses.peer import is_peer_download
+
+    downloads, others = [], []
+    for item in items:
+        (downloads if is_peer_download(str(item)) else others).append(str(item))
+    return downloads, others
+
+
+@functools.lru_cache(maxsize=8)
+def _open(path: str, stamp):
+    from pulses.peer import PeerDownload
+
+    return PeerDownload(path)
+
+
+def open_download(path: str):
+    """The :class:`pulses.peer.PeerDownload` at ``path``, parsed once per process (per content)."""
+    try:
+        st = os.stat(path)
+        stamp = (st.st_mtime_ns, st.st_size, st.st_ino)
+    except OSError:
+        stamp = None
+    return _open(path, stamp)
+
+
+# -- tasks -------------------------------------------------------------------------------------------
+def _fields(entry, scaled: bool) -> tuple:
+    meta = entry.metadata
+    values = {col: meta.get(key) for col, key in _KEYS.items()}
+    values.update(peer_scaled=bool(scaled), peer_vertical_file=entry.vertical)
+    return tuple(PEER_COLUMNS.row(values).items())
+
+
+def record_units(download, scaled: bool, say) -> list[tuple]:
+    """``(entry, PeerSource)`` for every record the report lists, in its order."""
+    from pulses import RecordError
+
+    try:
+        d = open_download(download)
+    except RecordError as exc:
+        return [(None, PeerSource(download, None, None, missing=str(exc)))]
+    entries = d.search.entries
+    units = []
+    n_missing = 0
+    for e in entries:
+        lacking = d.missing(e)
+        why = ""
+        if e.h1 is None or e.h2 is None:
+            why = f"RSN {e.rsn}: the search report lists no {'Horizontal-1' if e.h1 is None else 'Horizontal-2'} file"
+        elif lacking:
+            reasons = [d.refusal(f) for f in lacking]
+            named = ", ".join(f + (f" ({r})" if r else "") for f, r in zip(lacking, reasons))
+            why = (f"RSN {e.rsn}: listed in _SearchResults.csv (line {e.line}) but not in the "
+                   f"download: {named}")
+        n_missing += bool(why)
+        units.append((e, PeerSource(download, d.find(e.h1) or e.h1 if e.h1 else None,
+                                    d.find(e.h2) or e.h2 if e.h2 else None,
+                                    d.find(e.vertical) or e.vertical if e.vertical else None,
+                                    missing=why, fields=_fields(e, scaled),
+                                    tp=e.metadata.get("tp_s"))))
+    scaling = "scaled by the search's factors (--peer-scales)" if scaled else \
+        "as recorded, unscaled (--peer-scales applies the search's factors)"
+    for member, why in d.refused.items():
+        say(f"pipeline run: note: {d.path}: {why}")
+    say(f"pipeline run: PEER download {d.path}: {len(entries)} records listed, "
+        f"{len(entries) - n_missing} complete, {n_missing} incomplete (failures); designed {scaling}")
+    return units
+
+
+def make_tasks(downloads, columns, options, n_directions, scale, scales, peer_scales: bool, say):
+    """The tasks of the PEER downloads: each complete record a pair in every direction
+    (:func:`pipeline.site.directions`), each incomplete one a task that fails when read, with the
+    reason.  Indices and record ids are set by :func:`combine`."""
+    from pulses import RecordError, check_pair
+
+    from . import site
+    from .batch import Task
+
+    tasks = []
+    for download in downloads:
+        for entry, src in record_units(download, peer_scales, say):
+            if entry is None:  # the download itself cannot be read: one failure for it
+                tasks.append(Task(0, _stem(download) + ".zip", download, tuple(columns), options,
+                                  peer=src))
+                continue
+            d = open_download(download)
+            path1, path2 = d.display(src.h1), d.display(src.h2) if src.h2 else None
+            pname = site.pair_name(path1, path2 or path1)
+            k = float(entry.metadata.get("scale_factor") or 1.0) if peer_scales else 1.0
+            names = [path1, pname, f"RSN{entry.rsn}", src.h1 or ""]
+            if scales is not None:
+                k *= site._scale_for(scales, 1.0, names)
+            k *= scale
+            fields, angles = {}, [(0.0, "component-1")]
+            if not src.missing:
+                try:
+                    first, second = check_pair(d.read_component(src.h1), d.read_component(src.h2))
+                    fields = site._pair_classification(first, second)
+                    angles = site.directions(fields.get("orientation_deg"), n_directions)
+                except RecordError:
+                    pass  # the task fails at reading, with the reason
+            if src.missing:  # a failure of the record, not of a direction
+                tasks.append(Task(0, pname + ".pair", path1, tuple(columns), options, path2=path2,
+                                  pair=pname, scale=k, peer=src))
+                continue
+            for angle, kind in angles:
+                tasks.append(Task(0, f"{pname}_{angle:05.1f}deg.dir", path1, tuple(columns), options,
+                                  path2=path2, direction=angle, direction_kind=kind, pair=pname,
+                                  scale=k, pair_fields=tuple(fields.items()), peer=src))
+    return tasks
+
+
+def _stem(path) -> str:
+    return os.path.splitext(os.path.basename(os.path.normpath(str(path))))[0] or "download"
+
+
+def combine(*groups) -> list:
+    """Tasks of several sources as one batch: indices in order, record ids unique over all."""
+    from .batch import record_ids
+
+    tasks = [t for g in groups for t in g]
+    # a PEER task's id is still its name with an extension (``.dir``); the others' are final
+    names = [t.record_id if t.peer is not None else t.record_id + ".id" for t in tasks]
+    ids = record_ids(names)
+    return [dataclasses.replace(t, index=i, record_id=rid) for i, (t, rid) in enumerate(zip(tasks, ids))]
+
+
+# -- in the worker -----------------------------------------------------------------------------------
+def read_components(task, vertical: bool = True):
+    """``(first, second, vertical or None, vertical's name)`` of a PEER task, as read (unscaled,
+    not yet checked as a pair); a record with files missing raises :class:`pulses.RecordError`."""
+    from pulses import RecordError
+
+    src = task.peer
+    if src.missing:
+        raise RecordError(src.missing)
+    d = open_download(src.download)
+    first, second = d.read_component(src.h1), d.read_component(src.h2)
+    vert = d.read_component(src.vertical) if (vertical and src.vertical) else None
+    return first, second, vert, (d.display(src.vertical) if src.vertical else None)
+
+
+def read_task(task):
+    """The ground motion of a PEER task: the pair's component in the task's direction, scaled."""
+    from pulses import check_pair, component
+
+    first, second, _, _ = read_components(task, vertical=False)
+    first, second = check_pair(first, second)
+    record = component(first, second, task.direction or 0.0)
+    return record.scaled(task.scale) if task.scale != 1.0 else record
+
+
+def fields(task) -> dict:
+    """The :data:`PEER_COLUMNS` of a task's rows (blank for a task that is not a PEER record)."""
+    src = getattr(task, "peer", None)
+    if src is None or not src.fields:
+        return PEER_COLUMNS.blank()
+    return PEER_COLUMNS.row(dict(src.fields))
+
+
+def tp(task):
+    """PEER's pulse period of a task's record (None: not a PEER record, or not pulse-like in PEER's search)."""
+    src = getattr(task, "peer", None)
+    return None if src is None else src.tp
+
+
+# -- command line ------------------------------------------------------------------------------------
+def tasks_from_args(args, downloads, paths, columns, options):
+    """Every task of ``pipeline run`` when PEER downloads are among the inputs: the other files as
+    :func:`pipeline.site.tasks_from_args` makes them (one per file, or pairs), then the downloads'."""
+    import sys
+
+    from . import runner, site
+    from .args import ArgumentError
+
+    n, scale, scales = site.settings_from_args(args)
+    if scales is not None and args.peer_scales:
+        raise ArgumentError("give --scales or --peer-scales, not both")
+    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=sys.stderr))
+    others = []
+    if paths or args.pair:
+        others = site.tasks_from_args(args, paths, columns, options)
+        if others is None:
+            others = runner.make_tasks(paths, columns, options)
+    return combine(others, make_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say))

@@ -1,0 +1,156 @@
+"""The vertical component in ``pipeline run``: ``--vertical auto|none`` and ``--triplet H1 H2 V``.
+
+A task has a vertical when its record is a PEER record whose search report lists one
+(:mod:`pipeline.peer_inputs`), a ``--triplet``, or a pair found by ``--pairs auto`` with exactly one
+vertical of the same station.  With ``--vertical auto`` (the default) the three components are read
+on one time axis (:func:`pulses.check_triplet`: cut to the shortest, the vertical made upward by
+its stated polarity), and for every column as it stands the response with the vertical is computed
+beside the horizontal-only one (:data:`VERTICAL_COLUMNS`).  The compiled engine does not take a
+vertical yet: that response is the reference model's (:func:`rocking.simulate_vertical_reference`,
+slow), so the verified width and the design rules stay those of the horizontal motion alone.  A
+vertical whose polarity is not stated is not used, and the row's ``warnings`` says why.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from .report import Columns
+
+VERTICAL_COLUMNS = Columns(
+    ("vertical_file", "-", "The vertical component used with this record (`--vertical auto`: a PEER "
+                           "record's vertical, a `--triplet`, or the vertical `--pairs auto` found "
+                           "for the pair); blank when none was used (then every vertical_* is blank)."),
+    ("vertical_polarity", "-", "`UP` or `DWN`, as the vertical's file name and header state it (a "
+                               "`DWN` record is multiplied by -1 to give the upward acceleration)."),
+    ("vertical_pga_g", "g", "Peak absolute vertical acceleration (scaled as the record, `scale`)."),
+    ("vertical_min_effective_gravity", "-", "Smallest 1 + av/g over the record (av upward): below 0 "
+                                            "the ground falls away faster than gravity (free flight)."),
+    ("vertical_overturns", "-", "The column as it stands overturns under the horizontal motion of this "
+                                "row together with the vertical (docs/theory.md section 10); compare "
+                                "`overturns` (horizontal alone). Blank for `--height`."),
+    ("vertical_max_theta_ratio", "-", "max|theta|/alpha of the column as it stands with the vertical; "
+                                      "compare `max_theta_ratio`."),
+    ("vertical_lifts_off", "-", "g + av < 0 before the response ended: the block leaves the ground, "
+                                "which the rocking model does not describe; the response with the "
+                                "vertical stops there and its verdict is not a verdict."),
+    ("vertical_t_lift_off_s", "s", "First time of g + av < 0 (blank when it never happens)."),
+    ("vertical_model", "-", "Model that answered with the vertical: `reference-vertical` (scipy DOP853 "
+                            "with located events, `rocking.simulate_vertical_reference`)."),
+)
+
+
+def add_options(parser) -> None:
+    """``--vertical`` and ``--triplet`` of ``pipeline run``."""
+    parser.add_argument("--vertical", choices=["auto", "none"], default="auto",
+                        help="auto (default): where a record's vertical is known (PEER downloads, "
+                             "--triplet, --pairs auto), add the response of each column as it stands "
+                             "with it (vertical_* columns); none: horizontal motion only")
+    parser.add_argument("--triplet", nargs=3, action="append", default=[], metavar=("H1", "H2", "V"),
+                        help="design H1 and H2 as a pair (as --pair) with V as their vertical; V must "
+                             "state its polarity (UP or DWN in its name or header); repeatable")
+
+
+def attach(tasks, verticals: dict) -> list:
+    """``tasks`` with ``vertical`` set for those whose ``(path, path2)`` is in ``verticals``."""
+    out = []
+    for t in tasks:
+        v = verticals.get((t.path, t.path2)) if t.path2 is not None else None
+        out.append(dataclasses.replace(t, vertical=v) if v else t)
+    return out
+
+
+def auto_verticals(paths, opts: dict, say) -> dict:
+    """``{(first, second): vertical}`` for ``--pairs auto``: a pair with exactly one vertical of the
+    same station (as :func:`pulses.pair_files` groups them)."""
+    import pulses
+    from pulses.pairs import _group_key
+
+    meta = {}
+    for p in paths:
+        try:
+            meta[p] = pulses.read_record(p, **opts).metadata
+        except Exception:
+            pass
+    found = pulses.pair_files(paths, metadata=meta)
+    by_key = {}
+    for v in found.verticals:
+        by_key.setdefault(_group_key(v, meta.get(v)), []).append(v)
+    out = {}
+    for a, b in found.pairs:
+        vs = by_key.get(_group_key(a, meta.get(a)), [])
+        if len(vs) == 1:
+            out[(str(a), str(b))] = str(vs[0])
+        elif len(vs) > 1:
+            say(f"pipeline run: note: {len(vs)} verticals for {a} and {b}: none used (name one with --triplet)")
+    return out
+
+
+# -- in the worker -----------------------------------------------------------------------------------
+def read_task(task):
+    """``(horizontal record, upward vertical or None, note or None)`` of a task: the component in
+    the task's direction, and the vertical on its time axis, both scaled by ``task.scale``."""
+    import pulses
+
+    from . import peer_inputs, site
+
+    want = task.options.vertical != "none"
+    src = getattr(task, "peer", None)
+    if src is not None:
+        first, second, vert, vname = peer_inputs.read_components(task, vertical=want)
+    elif want and getattr(task, "vertical", None) and task.path2 is not None:
+        o = task.options
+        kw = dict(format=o.format, units=o.units, dt=o.dt, column=o.column, trace=o.trace)
+        first, second = (pulses.read_record(p, **kw) for p in (task.path, task.path2))
+        vname = task.vertical
+        try:
+            vert = pulses.read_record(vname, **kw)
+        except pulses.RecordError as exc:
+            first, second = pulses.check_pair(first, second)
+            return _directed(task, first, second, None), None, f"vertical not used: {exc}"
+    else:
+        return site.read_task(task), None, None
+    note = None
+    up = None
+    if vert is not None:
+        try:
+            first, second, up = pulses.check_triplet(first, second, vert, vname)
+        except pulses.RecordError as exc:
+            note = f"vertical not used: {exc}"
+    if up is None:
+        first, second = pulses.check_pair(first, second)
+    return _directed(task, first, second, up), scaled(task, up), note
+
+
+def _directed(task, first, second, up):
+    import pulses
+
+    record = pulses.component(first, second, task.direction or 0.0)
+    return record.scaled(task.scale) if task.scale != 1.0 else record
+
+
+def scaled(task, up):
+    return up.scaled(task.scale) if (up is not None and task.scale != 1.0) else up
+
+
+def fields(block, record, up, shown_file) -> dict:
+    """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical)."""
+    import numpy as np
+
+    import rocking
+    from pulses import G
+
+    if up is None:
+        return VERTICAL_COLUMNS.blank()
+    polarity = up.metadata.get("polarity")
+    values = {"vertical_file": shown_file, "vertical_polarity": polarity,
+              "vertical_pga_g": float(np.max(np.abs(up.acc))) / G,
+              "vertical_min_effective_gravity": float(np.min(1.0 + up.acc / G)),
+              "vertical_overturns": None, "vertical_max_theta_ratio": None, "vertical_lifts_off": None,
+              "vertical_t_lift_off_s": None, "vertical_model": None}
+    if block is not None:
+        res = rocking.simulate_vertical_reference(block, record, up)
+        values.update(vertical_overturns=bool(res.overturned), vertical_max_theta_ratio=float(res.max_rotation_ratio),
+                      vertical_lifts_off=bool(res.lifts_off),
+                      vertical_t_lift_off_s=None if not res.lifts_off else float(res.t_lift_off),
+                      vertical_model=str(res.model))
+    return VERTICAL_COLUMNS.row(values)

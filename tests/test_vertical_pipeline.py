@@ -1,0 +1,82 @@
+"""``pipeline run`` with the vertical component: --triplet, --pairs auto triplets, --vertical none,
+a vertical whose polarity is not stated (refused, and said), on the shared PEER files."""
+from __future__ import annotations
+
+import csv
+import pathlib
+
+import numpy as np
+import pytest
+
+import pulses
+import rocking
+from pipeline.cli import main
+
+DOWNLOAD = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "records" / "peer_download"
+RUN_ARGS = ["--block", "3x0.3", "--shapes", "sine", "--no-plots", "--quiet"]
+#: RSN 41 (Lytle Creek, Castaic): short (3203 samples), a DWN vertical
+H1, H2, V = "RSN41_LYTLECR_ORR021.AT2", "RSN41_LYTLECR_ORR291.AT2", "RSN41_LYTLECR_ORRDWN.AT2"
+
+
+@pytest.fixture
+def files():
+    if not (DOWNLOAD / V).is_file():
+        pytest.skip(f"the shared PEER download is not available: {DOWNLOAD} is absent")
+    return [str(DOWNLOAD / n) for n in (H1, H2, V)]
+
+
+def rows(out, name="summary.csv"):
+    return list(csv.DictReader(open(out / name)))
+
+
+def test_triplet_adds_the_response_with_the_vertical(files, tmp_path):
+    out = tmp_path / "out"
+    # scaled by 5 (PGA 0.1 to 0.13 g): the column rocks in some directions; the vertical is scaled too
+    assert main(["run", "--triplet", *files, *RUN_ARGS, "--scale", "5", "--out", str(out)]) == 0
+    summary = rows(out)
+    assert any(float(r["vertical_max_theta_ratio"]) > 0.01 for r in summary)
+    assert len(summary) >= 2  # the pair's directions
+    first, second = pulses.read_pair(files[0], files[1])
+    raw = pulses.read_record(files[2])
+    block = rocking.Block.from_dimensions(3.0, 0.3)
+    for r in summary:
+        assert r["vertical_file"] == files[2] and r["vertical_polarity"] == "DWN"
+        assert r["vertical_model"] == "reference-vertical"
+        # an independent reading: the component, the vertical times -1 (DWN), cut to one length
+        n = min(first.npts, raw.npts)
+        comp = pulses.component(first, second, float(r["direction_deg"]))
+        comp = pulses.Record(5 * comp.acc[:n], comp.dt)
+        up = pulses.Record(-5 * raw.acc[:n], raw.dt)
+        ref = rocking.simulate_vertical_reference(block, comp, up)
+        assert r["vertical_overturns"] == str(ref.overturned)
+        # the recorded components' directions (0, 90) are exact; the pulse direction is written with
+        # 6 significant digits (76.0844 deg), which moves the component by ~1e-6 rad and the peak
+        # rotation by ~1e-4 of itself
+        exact = r["direction_kind"].startswith("component")
+        assert float(r["vertical_max_theta_ratio"]) == pytest.approx(ref.max_rotation_ratio,
+                                                                      rel=1e-5 if exact else 1e-3, abs=1e-9)
+        assert float(r["vertical_pga_g"]) == pytest.approx(5 * np.max(np.abs(raw.acc)) / pulses.G, rel=1e-5)
+        assert r["vertical_lifts_off"] == "False"
+
+
+def test_pairs_auto_finds_the_vertical_and_none_leaves_it_out(files, tmp_path):
+    out = tmp_path / "auto"
+    assert main(["run", *files, "--pairs", "auto", *RUN_ARGS, "--out", str(out)]) == 0
+    summary = rows(out)
+    assert summary and all(r["vertical_file"] == files[2] for r in summary)
+    assert all(r["file2"] for r in summary)  # designed as a pair, the vertical not as a record
+    out = tmp_path / "none"
+    assert main(["run", *files, "--pairs", "auto", "--vertical", "none", *RUN_ARGS, "--out", str(out)]) == 0
+    assert all(r["vertical_file"] == "" and r["vertical_overturns"] == "" for r in rows(out))
+
+
+def test_a_vertical_without_polarity_is_not_used_and_said(files, tmp_path):
+    text = pathlib.Path(files[2]).read_text().splitlines()
+    text[1] = text[1].replace("DWN", "V1")  # the header no longer states the polarity
+    unknown = tmp_path / "RSN41_LYTLECR_ORR-V1.AT2"
+    unknown.write_text("\n".join(text) + "\n")
+    out = tmp_path / "out"
+    assert main(["run", "--triplet", files[0], files[1], str(unknown), *RUN_ARGS, "--out", str(out)]) == 0
+    for r in rows(out):
+        assert r["vertical_file"] == ""
+        assert "vertical not used" in r["warnings"] and "polarity" in r["warnings"]
