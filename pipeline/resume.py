@@ -120,13 +120,8 @@ class Journal:
         self.folder = pathlib.Path(folder)
         self.path = self.folder / RESUME
         self.entries: dict[str, tuple[str, str, str]] = {}  # record id -> (key, report, figure)
-        raw = report._regular_file_bytes(self.path)
-        if raw is None and os.path.lexists(self.path):
-            raise report.NotOurs(f"{report.display(self.path)} is not a file pipeline run wrote")
-        if raw is not None:
-            text = raw.decode("utf-8", "replace")
-            if not text.startswith(_HEADER):
-                raise report.NotOurs(f"{report.display(self.path)} was not written by pipeline run")
+        text = report.read_journal(self.path, _HEADER)
+        if text is not None:
             for line in text.splitlines()[1:]:  # a line cut by a killed run does not match
                 m = _LINE.match(line)
                 if m:

@@ -14,7 +14,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import interrupts, joblog, report, resume, site
+from . import interrupts, joblog, outlock, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
@@ -510,6 +510,13 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     out = pathlib.Path(out)
     if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)
+    with outlock.locked(output_folder(out)):  # one run at a time in one folder
+        return _run_locked(out, tasks, options=options, jobs=jobs, dask=dask, quiet=quiet,
+                           progress=progress, force=force, log=log)
+
+
+def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log) -> RunSummary:
+    """:func:`run`, the folder locked."""
     outputs = prepare_output(out, tasks, options.plots, options)
     try:
         journal = resume.Journal(out)
