@@ -212,6 +212,8 @@ def output_folder(path, what: str = "--out") -> pathlib.Path:
     """An output folder, created if needed and checked writable before any work is done."""
     from .report import display
 
+    if path is None or not str(path).strip():  # pathlib would make "" the current folder
+        raise ArgumentError(f"{what}: an empty folder name; name a folder (. for this one)")
     out = pathlib.Path(path)
     if os.path.lexists(out) and not out.is_dir():
         raise ArgumentError(f"{what} {display(out)} exists and is not a folder")

@@ -70,6 +70,10 @@ def _excitation(args):
 def run(args) -> int:
     import rocking
 
+    from .outpaths import check_file_options
+
+    check_file_options(args, "simulate", inputs=[getattr(args, "record", None)])
+
     height, width = parse_block(args.block)
     eta = None
     if args.eta is not None:
@@ -110,9 +114,14 @@ def run(args) -> int:
 def _write_history(path, res) -> None:
     import numpy as np
 
+    import io
+
+    from .outpaths import write_output
+
     data = np.column_stack([res.t, res.theta, res.omega])
-    np.savetxt(path, data, delimiter=",", header="t_s,theta_rad,omega_rad_s", comments="",
-               fmt="%.10g")
+    buf = io.StringIO()
+    np.savetxt(buf, data, delimiter=",", header="t_s,theta_rad,omega_rad_s", comments="", fmt="%.10g")
+    write_output(path, buf.getvalue(), "csv")
 
 
 def _plot(path, res, block, label) -> None:
@@ -132,5 +141,8 @@ def _plot(path, res, block, label) -> None:
     ax2.set_ylabel(r"$\dot\theta/p$")
     ax2.set_xlabel("t (s)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    from .outpaths import figure_png, write_output
+
+    data = figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110, metadata={"Software": None}))
     plt.close(fig)
+    write_output(path, data, "png")

@@ -111,13 +111,35 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
         raise RecordError(str(exc).replace(path, shown)) from None  # messages print and write safely
 
 
+def _check_entry(path) -> None:
+    """A :class:`RecordError` saying why ``path`` is no file that can be read, if it is not: missing,
+    a symbolic link to nothing or in a loop, in a folder without search permission, a folder."""
+    import errno
+    import stat
+
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        if exc.errno == errno.ENOENT and os.path.islink(path):
+            raise RecordError(f"{path}: a symbolic link to a file that does not exist "
+                              f"({printable(os.readlink(path))})") from None
+        if exc.errno == errno.ENOENT:
+            raise RecordError(f"{path}: no such file") from None
+        if exc.errno == errno.ELOOP:
+            raise RecordError(f"{path}: a loop of symbolic links") from None
+        raise RecordError(f"{path}: cannot be read: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(st.st_mode):
+        try:
+            os.listdir(path)
+        except OSError as exc:
+            raise RecordError(f"{path}: a folder whose files cannot be listed: {exc.strerror or exc}") from None
+        raise RecordError(f"{path}: is a directory, not a record file")
+
+
 def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
     """:func:`read_record` on a ``str`` path: dispatch to the format, then the common checks."""
     p = pathlib.Path(path)
-    if not p.exists():
-        raise RecordError(f"{path}: no such file")
-    if p.is_dir():
-        raise RecordError(f"{path}: is a directory, not a record file")
+    _check_entry(path)
     if p.stat().st_size == 0:
         raise RecordError(f"{path}: the file is empty")
     fmt = formats.detect(path) if format is None else (formats.by_name(format) or

@@ -147,3 +147,160 @@ def test_a_full_disk_error_names_the_file(recs, tmp_path, monkeypatch, capsys):
     assert code == 1 and "No space left on device" in err and report.MANIFEST in err, err
     monkeypatch.undo()
     assert main(["run", recs[0], *SAFE_ARGS, "--out", str(out)]) == 0  # space freed: usable
+
+
+# -- 3. outputs checked against inputs, the run's own files and users' files ---------------------------
+def test_classify_csv_never_replaces_a_record(tmp_path, capsys):
+    """``classify --csv a.sac b.sac`` (a forgotten file name) replaced the record a.sac with a CSV."""
+    a, b = write_good(tmp_path, 1), write_good(tmp_path, 2)
+    before = a.read_bytes()
+    assert main(["classify", "--csv", str(a), str(b)]) == 2
+    assert "exists and was not written by pipeline classify" in _one_line_error(capsys, "classify")
+    assert a.read_bytes() == before
+    link = tmp_path / "link.csv"  # the input by another name
+    link.symlink_to(b)
+    assert main(["classify", str(b), "--csv", str(link)]) == 2
+    assert "is the input" in _one_line_error(capsys, "classify")
+    # its own CSV is replaced by the next run, as before
+    table = tmp_path / "table.csv"
+    assert main(["classify", str(a), str(b), "--pairs", "none", "--csv", str(table)]) == 0
+    first = table.read_text()
+    assert main(["classify", str(a), "--csv", str(table)]) == 0
+    assert table.read_text() != first and len(read_csv(table)) == 1
+
+
+def test_run_log_never_onto_an_input_or_the_runs_own_files(tmp_path, capsys):
+    a, b = write_good(tmp_path, 1), write_good(tmp_path, 2)
+    before = a.read_bytes()
+    out = tmp_path / "out"
+    assert main(["run", str(b), *SAFE_ARGS, "--log", str(a), "--out", str(out)]) == 2
+    assert "exists and was not written by pipeline run" in _one_line_error(capsys)
+    assert main(["run", str(a), str(b), *SAFE_ARGS, "--log", str(a), "--out", str(out)]) == 2
+    assert "is the input" in _one_line_error(capsys)
+    assert a.read_bytes() == before
+    for own in (report.SUMMARY, "good02.csv", report.MANIFEST):
+        assert main(["run", str(b), *SAFE_ARGS, "--log", str(out / own), "--out", str(out)]) == 2
+        assert "one of this run's own outputs" in _one_line_error(capsys)
+    assert not out.exists() or not any(out.iterdir())  # refused before anything was written
+    log = out / "run.log"  # a log of its own beside the reports is fine, and appended to
+    for _ in range(2):
+        assert main(["run", str(b), *SAFE_ARGS, "--log", str(log), "--out", str(out)]) == 0
+    assert [line.count('"record"') for line in log.read_text().splitlines()] == [1, 1]
+    assert main(["run", str(b), *SAFE_ARGS, "--out", str(out)]) == 0  # the folder is usable
+
+
+def test_classify_plot_never_replaces_a_users_png(tmp_path, capsys):
+    """``classify --plot DIR`` replaced a user's PNG of the same name; now only its own PNGs."""
+    a = write_good(tmp_path, 1)
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    mine = plots / "good01.png"
+    mine.write_bytes(b"\x89PNG\r\n\x1a\nmy own picture")
+    assert main(["classify", str(a), "--plot", str(plots)]) == 1
+    err = capsys.readouterr().err
+    assert "good01.png exists and was not written by this package" in err
+    assert mine.read_bytes() == b"\x89PNG\r\n\x1a\nmy own picture"
+    mine.unlink()
+    assert main(["classify", str(a), "--plot", str(plots)]) == 0
+    drawn = mine.read_bytes()
+    from pipeline.outpaths import is_ours
+
+    assert is_ours(mine, "png") and drawn.startswith(b"\x89PNG")
+    assert main(["classify", str(a), "--plot", str(plots)]) == 0  # its own: replaced
+    assert mine.read_bytes() == drawn
+
+
+def test_every_command_checks_its_file_outputs_the_same_way(tmp_path, capsys, monkeypatch):
+    """fit, simulate, spectrum, chart: --csv and --plot over a file they did not write, or onto
+    their input, are refused in one line; ``--out ""`` (it wrote into the current folder) too;
+    convert never writes onto an input."""
+    monkeypatch.chdir(tmp_path)  # where --out "" wrote
+    a = write_good(tmp_path, 1)
+    before = a.read_bytes()
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    cases = [
+        ("fit", ["fit", str(a), "--shapes", "sine", "--csv", str(a)]),
+        ("fit", ["fit", str(a), "--shapes", "sine", "--csv", str(notes)]),
+        ("simulate", ["simulate", "--block", "7.5x1.8", "--record", str(a), "--csv", str(a)]),
+        ("simulate", ["simulate", "--block", "7.5x1.8", "--record", str(a), "--plot", str(notes)]),
+        ("spectrum", ["spectrum", "--alpha", "14deg", "--grid", "3x3", "--csv", str(notes)]),
+        ("chart", ["chart", "--pulse", "sine", "--ptp", "2", "--apg", "1", "--plot", str(notes)]),
+        ("run", ["run", str(a), *SAFE_ARGS, "--out", ""]),
+    ]
+    for command, argv in cases:
+        assert main(argv) == 2, argv
+        _one_line_error(capsys, command)
+    assert a.read_bytes() == before and notes.read_text() == "my notes\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["good01.sac", "notes.txt"]
+    assert main(["convert", str(a), "--to", "sac", "--out", str(tmp_path)]) == 1  # good01.sac is a
+    assert "is the input" in capsys.readouterr().err
+    assert a.read_bytes() == before
+
+
+# -- 4. folder inputs: broken entries are failed records, never skipped -----------------------------
+def test_broken_entries_of_a_folder_are_failed_records(tmp_path, capsys):
+    """A dangling link and a link loop in a folder were skipped (exit 0); given by a glob they failed.
+    Now both ways give the same failed records, with the reason."""
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    write_good(recs, 1)
+    (recs / "gone.sac").symlink_to(tmp_path / "nowhere.sac")
+    (recs / "loop1.sac").symlink_to(recs / "loop2.sac")
+    (recs / "loop2.sac").symlink_to(recs / "loop1.sac")
+    (recs / "sub").mkdir()  # a folder inside: not a record (folders give the files directly in them)
+    out = tmp_path / "out"
+    assert main(["run", str(recs), *SAFE_ARGS, "--out", str(out)]) == 1
+    fails = {f["record"]: f for f in read_csv(out / "failures.csv")}
+    assert sorted(fails) == ["gone", "loop1", "loop2"]
+    assert all(f["stage"] == "read" for f in fails.values())
+    assert "symbolic link to a file that does not exist" in fails["gone"]["reason"]
+    assert "loop of symbolic links" in fails["loop1"]["reason"]
+    assert [r["record"] for r in read_csv(out / "summary.csv")] == ["good01"]
+    by_glob = tmp_path / "out2"
+    assert main(["run", *sorted(str(p) for p in recs.glob("*.sac")), *SAFE_ARGS, "--out", str(by_glob)]) == 1
+    assert read_csv(by_glob / "failures.csv") == read_csv(out / "failures.csv")
+
+
+def test_a_folder_that_cannot_be_listed_fails_alone(tmp_path, monkeypatch):
+    """An unreadable folder stopped the whole batch with no failures.csv; now it is one failed
+    record and the others are processed."""
+    import pipeline.runner as runner_module
+
+    good = tmp_path / "good"
+    good.mkdir()
+    write_good(good, 1)
+    shut = tmp_path / "shut"
+    shut.mkdir()
+    real = os.listdir
+
+    def listdir(path="."):
+        if os.path.abspath(path) == str(shut):
+            raise PermissionError(errno.EACCES, "Permission denied", str(path))
+        return real(path)
+
+    monkeypatch.setattr(os, "listdir", listdir)
+    assert runner_module.expand_inputs([str(shut), str(good)]) == [str(shut), str(good / "good01.sac")]
+    out = tmp_path / "out"
+    assert main(["run", str(shut), str(good), *SAFE_ARGS, "--out", str(out)]) == 1
+    fails = read_csv(out / "failures.csv")
+    assert [(f["record"], f["stage"]) for f in fails] == [("shut", "read")]
+    assert "cannot be listed: Permission denied" in fails[0]["reason"]
+    assert [r["record"] for r in read_csv(out / "summary.csv")] == ["good01"]
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() == 0,
+                    reason="permissions do not apply to root: the monkeypatched test above covers it")
+def test_files_of_a_folder_without_search_permission_are_failed_records(tmp_path):
+    recs = tmp_path / "recs"
+    recs.mkdir()
+    write_good(recs, 1)
+    recs.chmod(0o600)  # names can be listed, files not looked at
+    try:
+        out = tmp_path / "out"
+        assert main(["run", str(recs), *SAFE_ARGS, "--out", str(out)]) == 1
+        fails = read_csv(out / "failures.csv")
+        assert [(f["record"], f["stage"]) for f in fails] == [("good01", "read")]
+        assert "Permission denied" in fails[0]["reason"]
+    finally:
+        recs.chmod(0o700)
