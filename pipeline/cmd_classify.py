@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import sys
 
-from .args import ArgumentError, add_pair_options, add_record_options, record_options
+from .args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
 
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
@@ -77,6 +77,7 @@ def main(args) -> int:
     if not args.files and not args.pair:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
     opts = record_options(args)
+    args.pair = pair_files(args.pair)
     files = expand_inputs(args.files)
     inputs = files + [p for pair in args.pair for p in pair]
     _check_outputs(args, inputs)

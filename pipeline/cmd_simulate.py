@@ -13,7 +13,7 @@ import json
 import math
 import sys
 
-from .args import (ArgumentError, ShapeNames, add_record_options, parse_acceleration, parse_block,
+from .args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration, parse_block,
                    parse_positive, record_options)
 
 
@@ -53,12 +53,7 @@ def _excitation(args):
         ap = parse_acceleration(args.ap)
         tp = parse_positive(args.tp, "--tp (s)")
         return pulses.make_pulse(args.pulse, ap, tp), f"{args.pulse} pulse ap={args.ap} tp={tp:g} s"
-    try:
-        scale = float(args.scale)
-    except ValueError:
-        raise ArgumentError(f"--scale: expected a number, got {args.scale!r}") from None
-    if not math.isfinite(scale) or scale == 0:
-        raise ArgumentError(f"--scale must be a non-zero finite number, got {args.scale!r}")
+    scale = parse_scale(args.scale, "--scale", signed=True)  # the one rule for scales
     try:
         record = pulses.read_record(args.record, **record_options(args))
     except pulses.RecordError as exc:

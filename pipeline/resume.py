@@ -169,6 +169,8 @@ def remove_stale_temporaries(folder, names) -> int:
         prefixes.setdefault(p.parent, set()).add(f".{p.name[:40]}.")
     removed = 0
     for parent, starts in prefixes.items():
+        if not report._real_folder(parent, folder):  # a link out of the folder: not ours to clean
+            continue
         try:
             listing = os.listdir(parent)
         except OSError:

@@ -304,3 +304,77 @@ def test_files_of_a_folder_without_search_permission_are_failed_records(tmp_path
         assert "Permission denied" in fails[0]["reason"]
     finally:
         recs.chmod(0o700)
+
+
+# -- 5. one range rule for every way a scale reaches a record -----------------------------------------
+@pytest.mark.parametrize("table", ["record,scale\ngood01,1e6\n", "record,scale\ngood01,1e-9\n",
+                                   "record,scale\ngood01,nan\n", "record,scale\ngood01,-2\n",
+                                   "record,scale\ngood01,2\ngood01,3\n",
+                                   "record,scale\ngood01,2\ngood01.sac,3\n"],
+                         ids=["huge", "tiny", "nan", "negative", "twice", "two-names"])
+def test_scales_obey_the_scale_rule(table, tmp_path, capsys, monkeypatch):
+    """--scales 1e6 ran to the end at 874,060 g (exit 0), 1e-9 failed deep inside after 18 s; rows
+    for one record were resolved silently.  Now each is refused at once, in one line."""
+    from pipeline import runner
+
+    def no_work(task):
+        raise AssertionError("a record was processed")
+
+    monkeypatch.setattr(runner, "process_record", no_work)
+    a = write_good(tmp_path, 1)
+    scales = tmp_path / "scales.csv"
+    scales.write_text(table)
+    out = tmp_path / "out"
+    assert main(["run", str(a), *SAFE_ARGS, "--scales", str(scales), "--out", str(out)]) == 2
+    err = _one_line_error(capsys)
+    assert "must lie between 0.001 and 1000" in err or "two rows for good01" in err or "several scales" in err
+    assert not out.exists()
+
+
+def test_scale_options_share_the_rule(tmp_path, capsys):
+    a = write_good(tmp_path, 1)
+    for argv in (["run", str(a), *SAFE_ARGS, "--scale", "1e6"], ["run", str(a), *SAFE_ARGS, "--scale", "1e-9"],
+                 ["run", str(a), *SAFE_ARGS, "--fragility", "--up-to", "1e6"],
+                 ["simulate", "--block", "7.5x1.8", "--record", str(a), "--scale", "1e6"],
+                 ["simulate", "--block", "7.5x1.8", "--record", str(a), "--scale=-1e-9"]):
+        assert main([*argv, "--out", str(tmp_path / "o")] if argv[0] == "run" else argv) == 2, argv
+        assert "must lie" in _one_line_error(capsys, argv[0])
+
+
+# -- 6. --pair A A ------------------------------------------------------------------------------------
+def test_a_pair_of_one_file_is_refused(tmp_path, capsys):
+    """``--pair A A`` was designed as a pair (45 deg: the file times sqrt 2; 135 deg: zeros)."""
+    a = write_good(tmp_path, 1)
+    link = tmp_path / "again.sac"
+    link.symlink_to(a)
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    other_path = str(sub / ".." / a.name)
+    out = tmp_path / "out"
+    for second in (str(a), str(link), other_path):
+        assert main(["run", "--pair", str(a), second, *SAFE_ARGS, "--out", str(out)]) == 2
+        assert "both name one file" in _one_line_error(capsys)
+        assert main(["classify", "--pair", str(a), second]) == 2
+        assert "both name one file" in _one_line_error(capsys, "classify")
+    assert not out.exists()
+
+
+# -- 8. no clean-up through a link out of --out ----------------------------------------------------------
+def test_stale_temporaries_are_not_removed_through_a_link(tmp_path):
+    """With --no-plots and OUT/plots a link to another folder, the clean-up of stale temporary
+    files followed the link and deleted matching names there."""
+    a = write_good(tmp_path, 1)
+    victim = tmp_path / "elsewhere"
+    victim.mkdir()
+    names = [".good01.png.abcd1234.tmp", ".summary.png.x1y2z3w4.tmp"]
+    for name in names:
+        (victim / name).write_text("someone else's")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "plots").symlink_to(victim)
+    (out / ".summary.csv.ab12cd_9.tmp").write_text("left by a killed run")  # its own: removed
+    assert main(["run", str(a), *SAFE_ARGS, "--out", str(out)]) == 0
+    assert sorted(p.name for p in victim.iterdir()) == sorted(names)
+    assert not (out / ".summary.csv.ab12cd_9.tmp").exists()
+    assert resume.remove_stale_temporaries(out, ["plots/good01.png", "plots/summary.png"]) == 0
+    assert sorted(p.name for p in victim.iterdir()) == sorted(names)
