@@ -216,6 +216,28 @@ def _time_step(path, reading, dt):
                       f"(--dt on the command line)")
 
 
+#: a record whose samples sit this fraction of their motion away from zero (median against the
+#: largest departure from it) is reported: ground acceleration swings about zero (a fling's
+#: permanent velocity moves the median of a real record by well under 1 % of its peak), so such an
+#: offset is a baseline or a sensor's static reading (1 g: gravity on a vertical sensor), which
+#: every design would otherwise take for ground motion
+OFFSET_WARN_FRACTION = 0.1
+
+
+def _check_offset(path, acc, meta) -> None:
+    """Warn of a large constant offset (:data:`OFFSET_WARN_FRACTION`); refuse a record that is one
+    constant throughout (no motion at all: nothing to design for)."""
+    offset = float(np.median(acc))
+    motion = float(np.max(np.abs(acc - offset)))
+    if motion == 0.0:
+        raise RecordError(f"{path}: every sample is {offset / G:.4g} g: a constant, no ground motion")
+    if abs(offset) > OFFSET_WARN_FRACTION * motion:
+        meta["warnings"].append(
+            f"the samples sit {offset / G:+.3g} g from zero (median), {abs(offset) / motion:.0%} of their "
+            "motion: a constant offset (baseline, gravity) is designed for as ground motion; "
+            "remove it if it is not")
+
+
 def _validate(path, acc, raw, units, units_source, meta):
     bad = ~np.isfinite(acc)
     if bad.any():
@@ -237,3 +259,4 @@ def _validate(path, acc, raw, units, units_source, meta):
                           f"for an accelerogram (outside {PLAUSIBLE_MIN_G:g} to {PLAUSIBLE_MAX_G:g} g); {fix}")
     if peak_g > WARN_PEAK_G:
         meta["warnings"].append(f"peak acceleration {peak_g:.3g} g is above {WARN_PEAK_G:g} g: check the units")
+    _check_offset(path, acc, meta)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -378,3 +379,49 @@ def test_stale_temporaries_are_not_removed_through_a_link(tmp_path):
     assert not (out / ".summary.csv.ab12cd_9.tmp").exists()
     assert resume.remove_stale_temporaries(out, ["plots/good01.png", "plots/summary.png"]) == 0
     assert sorted(p.name for p in victim.iterdir()) == sorted(names)
+
+
+# -- the smaller wrongs ---------------------------------------------------------------------------------
+def test_a_constant_offset_is_reported_and_a_constant_refused(tmp_path):
+    """A record with a 1 g offset was designed as if the offset were ground motion, silently (the
+    verified width went from 1.84 to 8.30 m).  Now every report of it says so; a record that is
+    one constant throughout has no motion and is refused."""
+    import numpy as np
+
+    import pulses
+
+    a = write_good(tmp_path, 1)
+    rec = pulses.read_record(a)
+    assert not [w for w in rec.metadata["warnings"] if "from zero" in w]
+    shifted = tmp_path / "shifted.sac"
+    pulses.write_sac(pulses.Record(rec.acc + pulses.G, rec.dt, name="shifted"), shifted)
+    warned = pulses.read_record(shifted).metadata["warnings"]
+    assert any(re.search(r"sit \+(0\.99|1\.0)\d* g from zero \(median\)", w) and "constant offset" in w
+               for w in warned), warned
+    out = tmp_path / "out"
+    assert main(["run", str(shifted), *SAFE_ARGS, "--out", str(out)]) == 0
+    (row,) = read_csv(out / "summary.csv")
+    assert "constant offset" in row["warnings"]
+    flat = tmp_path / "flat.sac"
+    pulses.write_sac(pulses.Record(np.full(500, 0.3 * pulses.G), 0.01, name="flat"), flat)
+    with pytest.raises(pulses.RecordError, match="a constant, no ground motion"):
+        pulses.read_record(flat)
+
+
+@pytest.mark.parametrize("iftype", ["irlim", "iamph", "ixy"])
+def test_a_sac_file_that_is_no_time_series_is_refused(iftype, tmp_path):
+    """A SAC file whose iftype says spectrum or x-y data was read as a time series."""
+    import numpy as np
+    from obspy.io.sac import SACTrace
+
+    import pulses
+
+    path = tmp_path / "spectrum.sac"
+    trace = SACTrace(data=(np.sin(np.arange(800) / 20.0) * 1e9).astype(np.float32), delta=0.01)
+    trace.idep, trace.iftype = "iacc", iftype
+    trace.write(str(path))
+    with pytest.raises(pulses.RecordError, match="iftype says this file is not a time series"):
+        pulses.read_record(path)
+    trace.iftype = "itime"
+    trace.write(str(path))
+    assert pulses.read_record(path).acc.size == 800
