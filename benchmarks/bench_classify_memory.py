@@ -31,10 +31,11 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 _CLASSIFY = r"""
-import sys
+import importlib, sys
 import pulses
+classify = importlib.import_module(sys.argv[2]).classify_pulse
 rec = pulses.read_record(sys.argv[1])
-res = pulses.classify_pulse(rec)
+res = classify(rec)
 print(res.is_pulse, res.tp, res.indicator)
 """
 
@@ -55,12 +56,13 @@ def make_record(path, n: int, dt: float, seed: int = 24) -> None:
     pulses.write_sac(pulses.Record(acc, dt, name="long"), path)
 
 
-def run(mode: str = "classify", samples: int = 2_000_000, dt: float = 1e-4) -> dict:
+def run(mode: str = "classify", samples: int = 2_000_000, dt: float = 1e-4,
+        module: str = "pulses.velocity") -> dict:
     with tempfile.TemporaryDirectory(prefix="bench-classify-memory-") as tmp:
         path = pathlib.Path(tmp) / "long.sac"
         make_record(path, samples, dt)
         if mode == "classify":
-            cmd = [sys.executable, "-c", _CLASSIFY, str(path)]
+            cmd = [sys.executable, "-c", _CLASSIFY, str(path), module]
         else:
             cmd = [sys.executable, "-m", "pipeline", "run", str(path), "--block", "7.5x1.8", "--shapes",
                    "sine", "--no-plots", "--jobs", "1", "-q", "--out", str(pathlib.Path(tmp) / "out")]
@@ -79,8 +81,11 @@ def main(argv=None) -> None:
     ap.add_argument("mode", nargs="?", choices=["classify", "run"], default="classify")
     ap.add_argument("--samples", type=int, default=2_000_000)
     ap.add_argument("--dt", type=float, default=1e-4)
+    ap.add_argument("--module", default="pulses.velocity",
+                    help="classify: the module whose classify_pulse is measured (a saved copy of an "
+                         "earlier version, to compare)")
     args = ap.parse_args(argv)
-    print(json.dumps(run(args.mode, args.samples, args.dt)))
+    print(json.dumps(run(args.mode, args.samples, args.dt, args.module)))
 
 
 if __name__ == "__main__":
