@@ -425,3 +425,80 @@ def test_a_sac_file_that_is_no_time_series_is_refused(iftype, tmp_path):
     trace.iftype = "itime"
     trace.write(str(path))
     assert pulses.read_record(path).acc.size == 800
+
+
+# -- 7. memory in proportion to the record ---------------------------------------------------------------
+def test_byte_bounded_cache_keeps_within_its_budget():
+    import numpy as np
+
+    from pulses.bytecache import byte_lru
+
+    calls = []
+
+    @byte_lru(10 * 8000)
+    def block(k):
+        calls.append(k)
+        return np.zeros(1000)  # 8000 bytes
+
+    for k in range(25):
+        block(k)
+    assert block.cache_bytes() == 10 * 8000  # the last ten kept, the others dropped
+    block(24)
+    block(0)
+    assert calls.count(24) == 1 and calls.count(0) == 2
+    big = byte_lru(100)(lambda n: np.zeros(n))
+    assert big(1000).size == 1000 and big.cache_bytes() == 0  # larger than the budget: not kept
+
+
+def test_the_strongest_map_gives_what_the_whole_map_gives():
+    """The classification keeps per time the strongest coefficient over the scales instead of the
+    (51, n) maps: the candidates it picks (with numpy.argmax's first index on ties, and after
+    clearing) are those of the whole map, value for value."""
+    import math
+
+    import numpy as np
+
+    from pulses.velocity import _StrongestMap
+
+    rng = np.random.default_rng(24)
+    for pair in (False, True):
+        n, rows = 400, 7
+        coefs = np.round(rng.standard_normal((2 if pair else 1, rows, n)), 1)  # many exact ties
+        coefs[:, :, 50:60] = 0.0  # columns of zeros
+        power = (coefs ** 2).sum(axis=0)
+        strongest = _StrongestMap(n, rows, pair)
+        for i in rng.permutation(rows):  # rows come in the order of their FFT sizes
+            strongest.add(int(i), coefs[:, i] if pair else coefs[0, i])
+        peak = power.max(axis=0)
+        for _ in range(60):  # until everything is cleared, and beyond
+            row, col, a, b = strongest.strongest()
+            cols = np.flatnonzero(peak == peak.max())
+            if cols.size == 1:
+                ref = int(np.argmax(power[:, cols[0]])), int(cols[0])
+            else:
+                ref = tuple(int(v) for v in np.unravel_index(int(np.argmax(power)), power.shape))
+            assert (row, col) == ref
+            assert (a, b) == (coefs[0, row, col], coefs[1, row, col] if pair else 0.0)
+            cleared = slice(max(0, math.floor(col - 4.5) + 1), max(0, math.ceil(col + 4.5)))
+            power[:, cleared] = 0.0
+            peak[cleared] = 0.0
+            strongest.clear(cleared)
+
+
+def test_classification_caches_stay_within_their_bytes():
+    """A 10 kHz record: the filters' caches hold at most their budgets (they held 10.9 GB after a
+    2e6-sample record)."""
+    import numpy as np
+
+    import pulses
+    from pulses import velocity
+
+    dt = 1e-4
+    t = np.arange(60_000) * dt
+    acc = np.where((t > 2.0) & (t < 2.5), np.sin(2 * np.pi * (t - 2.0) / 0.5), 0.0) * 3.0
+    acc += 0.05 * np.sin(2 * np.pi * 7.0 * t)
+    res = pulses.classify_pulse(pulses.Record(acc, dt, name="fine"))
+    assert res.tp > 0
+    for cache in (velocity.difference_filter, velocity._point_filter, velocity._unit_wavelet,
+                  velocity._filter_spectrum):
+        assert 0 < cache.cache_bytes() <= cache.max_bytes
