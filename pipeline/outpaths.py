@@ -108,7 +108,8 @@ def check_output_file(path, what: str, kind: str, *, inputs=(), reserved=(), com
         raise ArgumentError(f"{what} {display(path)} is a folder; name a file")
     same = _same(path, inputs)
     if same is not None:
-        raise ArgumentError(f"{what} {display(path)} is the input {display(same)}; name another file")
+        raise ArgumentError(f"{what} {display(path)} is one of the input records ({display(same)}); "
+                            "name another file")
     same = _same(path, reserved)
     if same is not None:
         raise ArgumentError(f"{what} {display(path)} is one of this run's own outputs; name another file")
@@ -155,7 +156,7 @@ def write_output(path, data, kind: str, *, what: str = "output", inputs=()) -> p
     path = pathlib.Path(path)
     same = _same(path, inputs)
     if same is not None:
-        raise NotOurs(f"{display(path)} is the input {display(same)}: not written")
+        raise NotOurs(f"{display(path)} is one of the input records ({display(same)}): not written")
     if os.path.lexists(path) and (not path.is_file() or not is_ours(path, kind)):
         raise NotOurs(f"{display(path)} exists and was not written by this package: left as it is")
     if kind == "png":

@@ -161,7 +161,7 @@ def test_classify_csv_never_replaces_a_record(tmp_path, capsys):
     link = tmp_path / "link.csv"  # the input by another name
     link.symlink_to(b)
     assert main(["classify", str(b), "--csv", str(link)]) == 2
-    assert "is the input" in _one_line_error(capsys, "classify")
+    assert "is one of the input records" in _one_line_error(capsys, "classify")
     # its own CSV is replaced by the next run, as before
     table = tmp_path / "table.csv"
     assert main(["classify", str(a), str(b), "--pairs", "none", "--csv", str(table)]) == 0
@@ -177,7 +177,7 @@ def test_run_log_never_onto_an_input_or_the_runs_own_files(tmp_path, capsys):
     assert main(["run", str(b), *SAFE_ARGS, "--log", str(a), "--out", str(out)]) == 2
     assert "exists and was not written by pipeline run" in _one_line_error(capsys)
     assert main(["run", str(a), str(b), *SAFE_ARGS, "--log", str(a), "--out", str(out)]) == 2
-    assert "is the input" in _one_line_error(capsys)
+    assert "is one of the input records" in _one_line_error(capsys)
     assert a.read_bytes() == before
     for own in (report.SUMMARY, "good02.csv", report.MANIFEST):
         assert main(["run", str(b), *SAFE_ARGS, "--log", str(out / own), "--out", str(out)]) == 2
@@ -235,7 +235,7 @@ def test_every_command_checks_its_file_outputs_the_same_way(tmp_path, capsys, mo
     assert a.read_bytes() == before and notes.read_text() == "my notes\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["good01.sac", "notes.txt"]
     assert main(["convert", str(a), "--to", "sac", "--out", str(tmp_path)]) == 1  # good01.sac is a
-    assert "is the input" in capsys.readouterr().err
+    assert "is one of the input records" in capsys.readouterr().err
     assert a.read_bytes() == before
 
 
