@@ -8,11 +8,25 @@ synthetic record (a one-sine pulse of 0.4 g, Tp 1 s, at 20 s, in a stationary ba
 memory (``ru_maxrss`` of the child, from :func:`resource.getrusage` ``RUSAGE_CHILDREN``) and its
 wall time.  :func:`run` returns the dict.
 
-Target: at most 2 GB of peak memory for the record the reading limits accept.  Measured on 2
-shared cores (load about 5): see the end of this docstring, kept up to date by hand.
+Target: at most 2 GB of peak memory for the record the reading limits accept.
 
-- before (the (51, n) maps of coefficients and power kept whole; filters' caches bounded by
-  entries): classify 2.93 GB... (see benchmarks/RESULTS.md and the issue's report)
+Measured on 2 shared cores (load 10 to 12, so the times are 5 to 10 times an idle machine's),
+peak resident memory of the child process:
+
+| record | code | classify | ``pipeline run`` |
+|---|---|---|---|
+| dt 1e-4 s, 2e6 samples | before (issue 24, measured by the issue) | - | 12.9 GB, 80 s |
+| dt 1e-4 s, 2e6 samples | now | 802 MB, 726 s | 947 MB, 659 s, exit 0 |
+| dt 1e-3 s, 2e5 samples | before (a saved copy of the earlier ``pulses/velocity.py``, ``--module``) | 1369 MB, 52 s | - |
+| dt 1e-3 s, 2e5 samples | now | 300 MB, 33 s | - |
+
+The earlier code at dt 1e-4 s was not run again here: its filter caches alone would have held
+about 11 GB on a machine shared with other jobs.  What went: the (51, n) maps of coefficients
+and power (1.6 GB for one component, 2.4 GB for a pair at 2e6 samples), the filter spectra cached
+16 sets at a time (1.1 GB a set) and up to 4096 refined filters of up to 6 MB each; now the map
+is kept as four arrays of n and every filter cache is bounded in bytes
+(:data:`pulses.velocity.FILTER_CACHE_BYTES`, :data:`pulses.velocity.SPECTRUM_CACHE_BYTES`).  The
+candidates and their numbers are the same, bit for bit.
 """
 from __future__ import annotations
 
