@@ -85,6 +85,50 @@ def parse_dt(text) -> float:
     return dt
 
 
+#: scale factors accepted on a record, however given (``--scale``, a row of ``--scales``, ``--up-to``,
+#: ``simulate --scale``): a thousandth to a thousand times the record; beyond them a typing error
+#: is likelier (1e6 designed a column for 874,060 g), and the solver's tested range is left
+SCALE_RANGE = (1e-3, 1e3)
+
+
+def parse_scale(text, what: str = "--scale", *, signed: bool = False, low: float | None = None) -> float:
+    """A scale factor on a record within :data:`SCALE_RANGE` (its magnitude, when ``signed``: a
+    negative factor reverses the record's polarity); ``low`` raises the lower bound (``--up-to``
+    must exceed 1).  The one rule for every way a scale reaches a record."""
+    try:
+        value = float(str(text).strip())
+    except ValueError:
+        raise ArgumentError(f"{what}: expected a number, got {text!r}") from None
+    lo, hi = SCALE_RANGE
+    lo = lo if low is None else low
+    size = abs(value) if signed else value
+    if not (math.isfinite(value) and lo <= size <= hi):
+        sign = "in magnitude " if signed else ""
+        raise ArgumentError(f"{what} must lie {sign}between {lo:g} and {hi:g}, got {text!r}")
+    return value
+
+
+def pair_files(pairs, what: str = "--pair") -> list[tuple[str, str]]:
+    """The ``--pair A B`` couples, each checked to name two files: both names one file (the same
+    name, another path to it, a link to it) is an :class:`ArgumentError` (designing a file as its
+    own pair doubles it in one direction and cancels it in the other)."""
+    out = []
+    for a, b in pairs:
+        same = os.path.realpath(a) == os.path.realpath(b)
+        if not same:
+            try:
+                same = os.path.samefile(a, b)
+            except (OSError, ValueError):
+                pass
+        if same:
+            from .report import display
+
+            raise ArgumentError(f"{what} {display(a)} {display(b)}: both name one file; a pair is "
+                                "two components of one station")
+        out.append((str(a), str(b)))
+    return out
+
+
 def parse_column(text):
     """``--column``: a column number counted from 1, None when not given."""
     if text is None:
@@ -212,6 +256,8 @@ def output_folder(path, what: str = "--out") -> pathlib.Path:
     """An output folder, created if needed and checked writable before any work is done."""
     from .report import display
 
+    if path is None or not str(path).strip():  # pathlib would make "" the current folder
+        raise ArgumentError(f"{what}: an empty folder name; name a folder (. for this one)")
     out = pathlib.Path(path)
     if os.path.lexists(out) and not out.is_dir():
         raise ArgumentError(f"{what} {display(out)} exists and is not a folder")

@@ -39,6 +39,10 @@ def run(args) -> int:
     import rocking
     from rocking.spectrum import CHART_APG, CHART_PTP
 
+    from .outpaths import check_file_options
+
+    check_file_options(args, "chart")
+
     shapes = ShapeNames().names() if args.pulse == "all" else [args.pulse]
     ptp = _floats(args.ptp, "--ptp") if args.ptp else CHART_PTP
     apg = _floats(args.apg, "--apg") if args.apg else CHART_APG
@@ -53,10 +57,12 @@ def run(args) -> int:
         k = sub["ratio"].idxmax()
         print(f"{shape:<12} {x:>6g} {sub['ratio'].max():>10.3f} {sub.loc[k, 'ap_over_g']:>8.3g} "
               f"{sub['ratio'].min():>10.3f} {int((sub['islands'] > 0).sum()):>8d}")
+    from .outpaths import figure_png, write_output
+
     if args.csv:
-        frame.to_csv(args.csv, index=False)
+        write_output(args.csv, frame.to_csv(index=False), "csv")
         print(f"wrote {args.csv}")
     if args.plot:
-        rocking.plot_chart(frame, args.plot)
+        write_output(args.plot, figure_png(lambda buf: rocking.plot_chart(frame, buf)), "png")
         print(f"wrote {args.plot}")
     return 0

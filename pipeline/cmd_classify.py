@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import sys
 
-from .args import ArgumentError, add_pair_options, add_record_options, record_options
+from .args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
 
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
@@ -77,8 +77,10 @@ def main(args) -> int:
     if not args.files and not args.pair:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
     opts = record_options(args)
+    args.pair = pair_files(args.pair)
     files = expand_inputs(args.files)
-    _check_outputs(args, files + [p for pair in args.pair for p in pair])
+    inputs = files + [p for pair in args.pair for p in pair]
+    _check_outputs(args, inputs)
     records, failures = {}, 0
     for path in files + [p for pair in args.pair for p in pair]:
         if path in records:
@@ -139,7 +141,7 @@ def main(args) -> int:
                 try:
                     plot_classification(result, args.plot, records[x],
                                         records[y] if y is not None else None,
-                                        stem=_unique_stem(result.name, stems))
+                                        stem=_unique_stem(result.name, stems), inputs=inputs)
                 except OSError as exc:  # one plot that cannot be written fails its row only
                     print(f"pipeline classify: {_message(x, exc)}", file=sys.stderr)
                     failures += 1
@@ -148,9 +150,11 @@ def main(args) -> int:
     elif rows:
         print(format_rows(rows))
     if args.csv and rows:
-        from .report import csv_text, write_atomic
+        from .outpaths import write_output
+        from .report import csv_text
 
-        write_atomic(args.csv, csv_text(COLUMNS, [{c: row[c] for c in COLUMNS} for row in rows]))
+        write_output(args.csv, csv_text(COLUMNS, [{c: row[c] for c in COLUMNS} for row in rows]), "csv",
+                     inputs=inputs)
     return 1 if failures else 0
 
 
@@ -168,23 +172,14 @@ def _unique_stem(name, taken) -> str:
 
 
 def _check_outputs(args, inputs) -> None:
-    """Argument errors before any work: ``--csv`` that is a folder or one of the inputs, ``--plot``
-    that is a file."""
-    import os
+    """Argument errors before any work (:mod:`pipeline.outpaths`): ``--csv`` that is a folder, one
+    of the inputs or a file this command did not write; ``--plot`` that is not a folder."""
+    from .outpaths import check_output_dir, check_output_file
 
-    if args.csv:
-        if os.path.isdir(args.csv):
-            raise ArgumentError(f"--csv {args.csv}: is a folder; name a CSV file")
-        if os.path.exists(args.csv):
-            for path in inputs:
-                try:
-                    if os.path.samefile(args.csv, path):
-                        raise ArgumentError(f"--csv {args.csv}: is one of the input records; "
-                                            "name another file")
-                except OSError:
-                    continue
-    if args.plot and os.path.exists(args.plot) and not os.path.isdir(args.plot):
-        raise ArgumentError(f"--plot {args.plot}: is a file; name a folder")
+    if args.csv is not None:
+        check_output_file(args.csv, "--csv", "csv", inputs=inputs, command="classify")
+    if args.plot is not None:
+        check_output_dir(args.plot, "--plot", inputs=inputs)
 
 
 def format_rows(rows) -> str:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pathlib
 import sys
 
-from .args import add_record_options, output_folder, record_options
+from .args import ArgumentError, add_record_options, record_options
 from .cmd_fit import _with_path
 
 
@@ -55,7 +55,9 @@ def main(args) -> int:
     import pulses
 
     opts = record_options(args)
-    out = output_folder(args.out)
+    from .outpaths import check_output_dir, check_output_file
+
+    out = check_output_dir(args.out, "--out", inputs=args.files)
     failures = 0
     for path in args.files:
         try:
@@ -65,6 +67,12 @@ def main(args) -> int:
             failures += 1
             continue
         target = out / output_name(record, path, "." + args.to)
+        try:  # never onto one of the inputs (pipeline.outpaths)
+            check_output_file(target, "--out: the file", "record", inputs=args.files, command="convert")
+        except ArgumentError as exc:
+            print(f"pipeline convert: {path}: {exc}", file=sys.stderr)
+            failures += 1
+            continue
         if args.to == "sac":
             pulses.write_sac(record, target)
             print(f"{path} -> {target} (SAC, acceleration in nm/s^2, idep = iacc)")

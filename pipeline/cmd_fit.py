@@ -10,12 +10,10 @@ are those of :func:`pipeline.args.add_record_options`, shared with the other sub
 from __future__ import annotations
 
 import json
-import os
 import sys
 
-from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, output_folder, parse_shapes,
-                   record_options)
-from .report import display, text_cell
+from .args import ShapeNames, add_record_options, add_weighting_option, parse_shapes, record_options
+from .report import text_cell
 
 
 def add_parser(subparsers) -> None:
@@ -42,12 +40,12 @@ def main(args) -> int:
 
     shapes = parse_shapes(args.shapes)
     opts = record_options(args)
-    if args.plot:
-        output_folder(args.plot, "--plot")
-    if args.csv:
-        if os.path.isdir(args.csv):
-            raise ArgumentError(f"--csv {display(args.csv)} is a folder; give a file name")
-        output_folder(os.path.dirname(os.path.abspath(args.csv)), "--csv: the folder of")
+    from .outpaths import check_output_dir, check_output_file
+
+    if args.plot is not None:
+        check_output_dir(args.plot, "--plot", inputs=args.files)
+    if args.csv is not None:
+        check_output_file(args.csv, "--csv", "csv", inputs=args.files, command="fit")
     fits, rows, failures = [], [], 0
     for path in args.files:
         try:
@@ -64,7 +62,11 @@ def main(args) -> int:
         frame["warnings"] = "; ".join(record.metadata.get("warnings", []))
         rows.append(frame)
         if args.plot:
-            plot_fit(record, fit, args.plot)
+            try:
+                plot_fit(record, fit, args.plot, inputs=args.files)
+            except OSError as exc:  # a file in the way: that plot only
+                print(f"pipeline fit: {_with_path(path, exc)}", file=sys.stderr)
+                failures += 1
     if args.json:
         out = []
         for path, record, fit in fits:
@@ -82,7 +84,9 @@ def main(args) -> int:
         frame = pd.concat(rows, ignore_index=True)
         for name in frame.columns:  # text cells a spreadsheet would evaluate: see report.text_cell
             frame[name] = frame[name].map(lambda v: text_cell(v) if isinstance(v, str) else v)
-        frame.to_csv(args.csv, index=False, float_format="%.6g")
+        from .outpaths import write_output
+
+        write_output(args.csv, frame.to_csv(index=False, float_format="%.6g"), "csv", inputs=args.files)
     return 1 if failures else 0
 
 
@@ -110,7 +114,7 @@ def format_fit(record, fit) -> str:
     return "\n".join(lines)
 
 
-def plot_fit(record, fit, folder) -> str:
+def plot_fit(record, fit, folder, inputs=()) -> str:
     """Record with every fitted pulse over it, like the paper's Fig. 4: acceleration (g) above,
     velocity below (the record's after the baseline correction of :mod:`pulses.baseline`)."""
     import pathlib
@@ -152,6 +156,9 @@ def plot_fit(record, fit, folder) -> str:
     fig.tight_layout()
     safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in record.name)
     path = folder / f"{safe}.png"
-    fig.savefig(path, dpi=110)
+    from .outpaths import figure_png, write_output
+
+    data = figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110, metadata={"Software": None}))
     plt.close(fig)
+    write_output(path, data, "png", what="--plot", inputs=inputs)
     return str(path)

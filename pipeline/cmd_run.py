@@ -42,7 +42,8 @@ def add_parser(subparsers) -> None:
                     "column) and writes design.csv (the same), report.html (the batch to review in a "
                     "browser), <record>.csv, summary.csv, "
                     "failures.csv, columns.md and plots into --out, and pipeline-manifest.txt, the "
-                    "files it wrote: the only ones a later run replaces or removes. Exit status 0 when every record "
+                    "files it wrote: the only ones a later run replaces or removes; one run at a time in "
+                    "one --out (another run into it meanwhile is refused). Exit status 0 when every record "
                     "was processed, 1 when some failed (listed in failures.csv), 2 for bad arguments, "
                     "130 (143) when stopped by Ctrl-C (SIGTERM).")
     p.add_argument("records", nargs="*", metavar="RECORD",

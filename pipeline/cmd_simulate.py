@@ -13,7 +13,7 @@ import json
 import math
 import sys
 
-from .args import (ArgumentError, ShapeNames, add_record_options, parse_acceleration, parse_block,
+from .args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration, parse_block,
                    parse_positive, record_options)
 
 
@@ -53,12 +53,7 @@ def _excitation(args):
         ap = parse_acceleration(args.ap)
         tp = parse_positive(args.tp, "--tp (s)")
         return pulses.make_pulse(args.pulse, ap, tp), f"{args.pulse} pulse ap={args.ap} tp={tp:g} s"
-    try:
-        scale = float(args.scale)
-    except ValueError:
-        raise ArgumentError(f"--scale: expected a number, got {args.scale!r}") from None
-    if not math.isfinite(scale) or scale == 0:
-        raise ArgumentError(f"--scale must be a non-zero finite number, got {args.scale!r}")
+    scale = parse_scale(args.scale, "--scale", signed=True)  # the one rule for scales
     try:
         record = pulses.read_record(args.record, **record_options(args))
     except pulses.RecordError as exc:
@@ -69,6 +64,10 @@ def _excitation(args):
 
 def run(args) -> int:
     import rocking
+
+    from .outpaths import check_file_options
+
+    check_file_options(args, "simulate", inputs=[getattr(args, "record", None)])
 
     height, width = parse_block(args.block)
     eta = None
@@ -110,9 +109,14 @@ def run(args) -> int:
 def _write_history(path, res) -> None:
     import numpy as np
 
+    import io
+
+    from .outpaths import write_output
+
     data = np.column_stack([res.t, res.theta, res.omega])
-    np.savetxt(path, data, delimiter=",", header="t_s,theta_rad,omega_rad_s", comments="",
-               fmt="%.10g")
+    buf = io.StringIO()
+    np.savetxt(buf, data, delimiter=",", header="t_s,theta_rad,omega_rad_s", comments="", fmt="%.10g")
+    write_output(path, buf.getvalue(), "csv")
 
 
 def _plot(path, res, block, label) -> None:
@@ -132,5 +136,8 @@ def _plot(path, res, block, label) -> None:
     ax2.set_ylabel(r"$\dot\theta/p$")
     ax2.set_xlabel("t (s)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    from .outpaths import figure_png, write_output
+
+    data = figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110, metadata={"Software": None}))
     plt.close(fig)
+    write_output(path, data, "png")

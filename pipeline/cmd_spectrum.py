@@ -52,6 +52,9 @@ def run(args) -> int:
 
     import rocking
 
+    from .outpaths import check_file_options
+
+    check_file_options(args, "spectrum")
     alpha = parse_angle(args.alpha)
     nw, na = _grid(args.grid)
     w0, w1 = _range(args.wp_range, "--wp-range")
@@ -73,10 +76,12 @@ def run(args) -> int:
     for i in np.unique(np.linspace(0, nw - 1, min(nw, 8)).astype(int)):
         v = mins[i]
         print(f"{spec.wp_over_p[i]:>10.3f}  {('> %.3g' % a1) if np.isnan(v) else ('%.4g' % v):>33}")
+    from .outpaths import figure_png, write_output
+
     if args.csv:
-        spec.to_frame().to_csv(args.csv, index=False)
+        write_output(args.csv, spec.to_frame().to_csv(index=False), "csv")
         print(f"wrote {args.csv}")
     if args.plot:
-        spec.plot(args.plot)
+        write_output(args.plot, figure_png(spec.plot), "png")
         print(f"wrote {args.plot}")
     return 0

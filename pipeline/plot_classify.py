@@ -13,7 +13,7 @@ import pathlib
 
 import numpy as np
 
-from .report import write_atomic
+from .outpaths import write_output
 
 #: figure size in inches and resolution: 1100 x 720 pixels
 FIGSIZE, DPI = (11.0, 7.2), 100
@@ -23,7 +23,7 @@ def _safe(name: str) -> str:
     return "".join(ch if ch.isalnum() or ch in "-_.+" else "_" for ch in name)
 
 
-def plot_classification(result, folder, first=None, second=None, stem=None) -> str:
+def plot_classification(result, folder, first=None, second=None, stem=None, inputs=()) -> str:
     """Draw ``result`` (a :class:`pulses.PulseClassification`) into ``folder/<stem>.png``.
 
     Parameters
@@ -80,7 +80,9 @@ def plot_classification(result, folder, first=None, second=None, stem=None) -> s
     path = folder / f"{stem or _safe(result.name)}.png"
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
-    write_atomic(path, buf.getvalue())  # a temporary file and a rename: never half a PNG
+    # a temporary file and a rename (never half a PNG), and never over a file this package did
+    # not write (pipeline.outpaths)
+    write_output(path, buf.getvalue(), "png", what="--plot", inputs=inputs)
     return str(path)
 
 

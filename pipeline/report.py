@@ -162,7 +162,7 @@ def write_atomic(path, data) -> pathlib.Path:
     if _regular_file_bytes(path) == raw:
         return path
     path.parent.mkdir(parents=True, exist_ok=True)
-    with interrupts.deferred():
+    with interrupts.deferred(), named_errors(path):
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name[:40]}.", suffix=".tmp")
         try:
             with os.fdopen(fd, "wb") as fh:
@@ -226,13 +226,8 @@ class Outputs:
         self.folder = pathlib.Path(folder)
         self.path = self.folder / MANIFEST
         self._written: dict[str, set[str]] = {}
-        raw = _regular_file_bytes(self.path)
-        if raw is None and os.path.lexists(self.path):
-            raise NotOurs(f"{display(self.path)} is not a file pipeline run wrote")
-        if raw is not None:
-            text = raw.decode("utf-8", "replace")
-            if not text.startswith(_MANIFEST_HEADER):
-                raise NotOurs(f"{display(self.path)} was not written by pipeline run")
+        text = read_journal(self.path, _MANIFEST_HEADER)
+        if text is not None:
             for line in text.splitlines()[1:]:
                 digest, _, rel = line.partition("  ")
                 if len(digest) == 64 and rel:
@@ -303,25 +298,66 @@ class Outputs:
             write_atomic(self.path, _MANIFEST_HEADER + "".join(lines))
 
 
+def read_journal(path, header: str) -> str | None:
+    """The text of a journal this package keeps in an output folder (the manifest, the resume
+    journal), or None when there is none yet.
+
+    A file that is empty or holds only the start of ``header`` is what a run stopped by a full disk
+    (or killed) while starting the journal leaves: it holds nothing, and counts as no journal.  Any
+    other file that does not start with ``header`` was not written by ``pipeline run``:
+    :class:`NotOurs`."""
+    raw = _regular_file_bytes(path)
+    if raw is None:
+        if os.path.lexists(path):
+            raise NotOurs(f"{display(path)} is not a file pipeline run wrote")
+        return None
+    text = raw.decode("utf-8", "replace")
+    if header.startswith(text):  # empty, or the header cut short
+        return None
+    if not text.startswith(header):
+        raise NotOurs(f"{display(path)} was not written by pipeline run")
+    return text
+
+
 def append_line(path, header: str, line: str) -> None:
     """Append ``line`` (ending in a newline) to the journal at ``path``, starting it with ``header``.
 
-    A last line cut by a killed run is ended first, so that it spoils no other line; Ctrl-C waits
-    until the line is written."""
+    A last line cut by a killed run is ended first, so that it spoils no other line; a journal
+    holding only part of its header (see :func:`read_journal`) is started again.  Ctrl-C waits
+    until the line is written.  A failure (a full disk ...) raises an :class:`OSError` naming the
+    file."""
     from . import interrupts
 
-    with interrupts.deferred():
+    head = header.encode("utf-8")
+    with interrupts.deferred(), named_errors(path):
         flags = os.O_RDWR | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
         fd = os.open(path, flags, 0o666)
         with os.fdopen(fd, "a+b") as fh:
             end = fh.seek(0, os.SEEK_END)
+            if end < len(head):
+                fh.seek(0)
+                if head.startswith(fh.read()):  # nothing yet, or the header cut short
+                    fh.truncate(0)
+                    end = 0
             if end == 0:
-                fh.write(header.encode("utf-8"))
+                fh.write(head)
             else:
                 fh.seek(end - 1)
                 if fh.read(1) != b"\n":
                     fh.write(b"\n")
             fh.write(line.encode("utf-8"))
+
+
+@contextlib.contextmanager
+def named_errors(path):
+    """Give an :class:`OSError` raised in the block the file's name where it has none (``No space
+    left on device`` from a write says not which file)."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is not None or isinstance(exc, NotOurs):
+            raise
+        raise type(exc)(exc.errno, f"{exc.strerror or exc}", display(path)) from exc
 
 
 def _digest(raw: bytes) -> str:

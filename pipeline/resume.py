@@ -123,13 +123,8 @@ class Journal:
         self.folder = pathlib.Path(folder)
         self.path = self.folder / RESUME
         self.entries: dict[str, tuple[str, str, str]] = {}  # record id -> (key, report, figure)
-        raw = report._regular_file_bytes(self.path)
-        if raw is None and os.path.lexists(self.path):
-            raise report.NotOurs(f"{report.display(self.path)} is not a file pipeline run wrote")
-        if raw is not None:
-            text = raw.decode("utf-8", "replace")
-            if not text.startswith(_HEADER):
-                raise report.NotOurs(f"{report.display(self.path)} was not written by pipeline run")
+        text = report.read_journal(self.path, _HEADER)
+        if text is not None:
             for line in text.splitlines()[1:]:  # a line cut by a killed run does not match
                 m = _LINE.match(line)
                 if m:
@@ -177,6 +172,8 @@ def remove_stale_temporaries(folder, names) -> int:
         prefixes.setdefault(p.parent, set()).add(f".{p.name[:40]}.")
     removed = 0
     for parent, starts in prefixes.items():
+        if not report._real_folder(parent, folder):  # a link out of the folder: not ours to clean
+            continue
         try:
             listing = os.listdir(parent)
         except OSError:

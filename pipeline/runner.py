@@ -14,7 +14,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import design_table, html_report, interrupts, joblog, report, resume, site
+from . import design_table, html_report, interrupts, joblog, outlock, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import (COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, Options, Task, failure, process_record,
                     record_ids)
@@ -34,10 +34,13 @@ class RunSummary:
 
 
 def expand_inputs(items) -> list[str]:
-    """File arguments as given; folders give their files (sorted); unexpanded wildcards are globbed.
+    """File arguments as given; folders give their entries (sorted; not hidden ones, not folders);
+    unexpanded wildcards are globbed.
 
     A path that does not exist stays in the list: it is reported as a failed record, not an argument
-    error, so one missing file does not stop a batch.
+    error, so one missing file does not stop a batch.  So are a folder's entries that cannot be
+    read (a symbolic link to nothing, a loop of links, files of a folder without search
+    permission), and a folder that cannot be listed: each fails at reading, with the reason.
     """
     paths: list[str] = []
     seen = set()
@@ -51,9 +54,16 @@ def expand_inputs(items) -> list[str]:
     for item in items:
         item = str(item)
         if os.path.isdir(item):
-            for name in sorted(os.listdir(item)):
+            try:
+                names = sorted(os.listdir(item))
+            except OSError:  # a folder that cannot be read: a failed record, with the reason
+                add(item)
+                continue
+            for name in names:
                 full = os.path.join(item, name)
-                if not name.startswith(".") and os.path.isfile(full):
+                # every entry but hidden ones and folders: a broken link, a link loop or a file
+                # that cannot be looked at is a failed record with the reason, never skipped
+                if not name.startswith(".") and not os.path.isdir(full):
                     add(full)
         elif not os.path.exists(item) and glob.has_magic(item):
             matches = sorted(glob.glob(item))
@@ -495,6 +505,15 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
         res["failure"] = failure(task, "write", problems[0])
 
 
+def _own_files(tasks, options) -> list[str]:
+    """Every file a run of ``tasks`` may write into its output folder (paths relative to it)."""
+    names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
+             resume.RESUME] + site.output_files(options) + answer_files()
+    return names + [n for t in tasks for n in (report.record_csv_name(t.record_id),
+                                               report.record_plot_name(t.record_id),
+                                               report.record_widths_plot_name(t.record_id))]
+
+
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None, tasks=None, force: bool = False,
@@ -516,19 +535,27 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         :func:`pipeline.interrupts.handling` is active): workers stopped, reports already written
         complete, no temporary file left.
     """
-    out = pathlib.Path(out)
+    out = output_folder(out)  # checked before the Path: pathlib makes "" the current folder
     if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)
+    with outlock.locked(out):  # one run at a time in one folder
+        return _run_locked(out, tasks, options=options, jobs=jobs, dask=dask, quiet=quiet,
+                           progress=progress, force=force, log=log)
+
+
+def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log) -> RunSummary:
+    """:func:`run`, the folder locked."""
     outputs = prepare_output(out, tasks, options.plots, options)
+    if log is not None:  # never onto an input or one of this run's own files (pipeline.outpaths)
+        from .outpaths import check_output_file
+
+        check_output_file(log, "--log", "log", inputs=[p for t in tasks for p in (t.path, t.path2)],
+                          reserved=[out / rel for rel in _own_files(tasks, options)], command="run")
     try:
         journal = resume.Journal(out)
     except report.NotOurs as exc:
         raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
-    names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
-             resume.RESUME] + site.output_files(options) + answer_files()
-    names += [n for t in tasks for n in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id))]
-    names += [report.record_widths_plot_name(t.record_id) for t in tasks]
-    resume.remove_stale_temporaries(out, names)  # left by a run killed while writing
+    resume.remove_stale_temporaries(out, _own_files(tasks, options))  # left by a run killed while writing
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch

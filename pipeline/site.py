@@ -22,7 +22,7 @@ import os
 import pathlib
 
 from . import peer_inputs
-from .args import ArgumentError
+from .args import SCALE_RANGE, ArgumentError, pair_files, parse_scale
 from .report import Columns
 
 #: directions closer than this (deg, modulo 180) are one direction
@@ -176,8 +176,8 @@ def extra_fields(H, block, record, fitting, options, cache) -> dict:
 
 
 # -- command line ----------------------------------------------------------------------------------
-#: largest scale factor accepted (``--scale``, ``--up-to``): beyond it a typing error is likelier
-MAX_SCALE = 1000.0
+#: largest scale factor accepted (``--scale``, ``--scales``, ``--up-to``): :data:`pipeline.args.SCALE_RANGE`
+MAX_SCALE = SCALE_RANGE[1]
 
 
 def add_options(parser) -> None:
@@ -216,7 +216,7 @@ def _number(text, what, lo, hi) -> float:
 def options_from_args(args) -> dict:
     """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.Options`."""
     gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
-    up_to = _number(args.up_to, "--up-to", 1.0 + 1e-9, MAX_SCALE)
+    up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
     return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to}
 
 
@@ -227,7 +227,7 @@ def tasks_from_args(args, paths, columns, options):
     if not args.pair and args.pairs == "none" and scale == 1.0 and scales is None:
         return None
     say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
-    return make_tasks(paths, [tuple(p) for p in args.pair], args.pairs, columns, options, n, scale,
+    return make_tasks(paths, pair_files(args.pair), args.pairs, columns, options, n, scale,
                       scales, say=say)
 
 
@@ -241,7 +241,7 @@ def settings_from_args(args):
         raise SiteError(f"--directions must be 0 to {MAX_DIRECTIONS}, got {n}")
     if args.scale is not None and args.scales is not None:
         raise SiteError("give --scale or --scales, not both")
-    scale = 1.0 if args.scale is None else _number(args.scale, "--scale", 1e-3, MAX_SCALE)
+    scale = 1.0 if args.scale is None else parse_scale(args.scale, "--scale")
     scales = None if args.scales is None else read_scales(args.scales)
     return n, scale, scales
 
@@ -306,25 +306,27 @@ def read_scales(path) -> dict:
     name_key = keys.get("record") or keys.get("file")
     if name_key is None or "scale" not in keys:
         raise SiteError(f"--scales {path}: needs a 'record' (or 'file') column and a 'scale' column")
-    out = {}
+    out, lines = {}, {}
     for i, row in enumerate(rows, start=2):
         name = (row.get(name_key) or "").strip()
-        try:
-            k = float(row.get(keys["scale"]) or "")
-        except ValueError:
-            k = math.nan
-        if not name or not (math.isfinite(k) and k > 0):
-            raise SiteError(f"--scales {path}, line {i}: expected a record name and a positive scale")
-        out[name] = k
+        if not name:
+            raise SiteError(f"--scales {path}, line {i}: expected a record name and a scale")
+        k = parse_scale(row.get(keys["scale"]) or "", f"--scales {path}, line {i}: the scale")
+        if name in out:  # which one was meant is not known: never resolved silently
+            raise SiteError(f"--scales {path}, lines {lines[name]} and {i}: two rows for {name}")
+        out[name], lines[name] = k, i
     return out
 
 
 def _scale_for(scales, default, names) -> float:
     if scales is None:
         return default
-    for n in names:
-        if n in scales:
-            return scales[n]
+    found = {n: scales[n] for n in dict.fromkeys(names) if n in scales}
+    if len(set(found.values())) > 1:  # rows naming one record differently (path, file, id)
+        raise SiteError(f"--scales gives {names[0]} several scales: "
+                        + ", ".join(f"{k:g} (as {n})" for n, k in found.items()))
+    if found:
+        return next(iter(found.values()))
     raise SiteError(f"--scales gives no scale for {names[0]} (looked up as {', '.join(dict.fromkeys(names))})")
 
 

@@ -342,8 +342,11 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     energy = _dot(x, x)
     if weighting not in ("background", "plain"):
         raise FitError(f"weighting must be 'background' or 'plain', got {weighting!r}")
+    # the weighted least squares estimate the background once per record, from the best plain fit
+    # of every shape: a shape's fit does not depend on which others were asked for
+    fitted = shapes if weighting == "plain" else tuple(dict.fromkeys((*shapes, *DEFAULT_SHAPES)))
     fits = {}
-    for shape in shapes:
+    for shape in fitted:
         score = -np.inf
         for start in _coarse(matcher, shape, tps, t[-1]):
             trial = _refine(x, t, dt, shape, *start, baseline)
@@ -353,8 +356,9 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     # the share of energy explained, in the metric of the least squares used
     scores, weighted_scores = _plain_scores(x, fits, energy), None
     if weighting == "background":
-        fits, weighted_scores = _weighted(x, t, dt, fits, scores, energy, baseline)
+        fits, weighted_scores = _weighted(x, t, dt, fits, scores, energy, baseline, shapes)
         scores = scores if weighted_scores is None else weighted_scores
+    fits = {shape: fits[shape] for shape in shapes}
     candidates = []
     for shape, (_, (ap, tp, t0, idx), p) in fits.items():
         score = scores[shape]
@@ -376,10 +380,14 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
                     significant_duration(record.acc, dt), "plain" if weighted_scores is None else "background")
 
 
-def _weighted(x, t, dt, fits, plain_scores, energy, baseline):
-    """The weighted least squares of every shape from its plain fit (``fits``: shape ->
-    ``(match, trial, samples)``), and their scores: the share of the record's energy each
-    explains in the weighted metric; the plain fits and None where the weighting is not used.
+def _weighted(x, t, dt, fits, plain_scores, energy, baseline, wanted=None):
+    """The weighted least squares of the ``wanted`` shapes (default: all) from their plain fits
+    (``fits``: shape -> ``(match, trial, samples)``, every shape of :data:`DEFAULT_SHAPES` at
+    least), and their scores: the share of the record's energy each explains in the weighted
+    metric; the plain fits and None where the weighting is not used.
+
+    Whether it is used, and the background's spectrum, come from every shape of ``fits`` (the
+    best plain fit among them): a shape's weighted fit is the same whichever are ``wanted``.
 
     It is not used where the record has no background to weight by (the plain fit explains it
     to round-off), nor where it would overturn the plain ranking although the plain winner's own
@@ -388,24 +396,34 @@ def _weighted(x, t, dt, fits, plain_scores, energy, baseline):
     corners, misplaced for the weights (on the README's records, a short one-sine in 0.1-25 Hz
     background at 15 %, whose plain Tp was 12 % off).
     """
-    best = max(fits, key=plain_scores.get)
+    wanted = tuple(fits) if wanted is None else tuple(wanted)
+    order = sorted(fits, key=_canonical)  # ties go the same way whichever shapes were asked
+    best = max(order, key=plain_scores.get)
     resid = x - fits[best][2]
     if _dot(resid, resid) <= 1e-24 * energy:
         return fits, None
     background, best_fit, accepted = _estimate_background(x, t, dt, best, fits[best], energy, baseline)
     if background is None:
         return fits, None
-    weighted = {}
-    for shape, (match, trial, _) in fits.items():
+
+    def refit(shape):
+        match, trial, _ = fits[shape]
         if shape == best:
-            weighted[shape] = (match, *best_fit)
-            continue
+            return (match, *best_fit)
         trial = _refine_weighted(x, t, dt, shape, match, trial, background, baseline)
-        weighted[shape] = (match, trial, _score(x, t, dt, shape, trial, energy)[1])
+        return (match, trial, _score(x, t, dt, shape, trial, energy)[1])
+
+    # the ranking test below needs every shape; otherwise only those asked for
+    weighted = {shape: refit(shape) for shape in (order if not accepted else wanted)}
     scores = background.explained(x, {shape: p for shape, (_, _, p) in weighted.items()})
-    if not accepted and max(scores, key=scores.get) != best:
+    if not accepted and max((s for s in order), key=scores.get) != best:
         return fits, None
     return weighted, scores
+
+
+def _canonical(shape: str) -> int:
+    """Place of ``shape`` in :data:`DEFAULT_SHAPES` (shapes outside it after)."""
+    return DEFAULT_SHAPES.index(shape) if shape in DEFAULT_SHAPES else len(DEFAULT_SHAPES)
 
 
 def _plain_scores(x, fits, energy) -> dict:

@@ -111,13 +111,35 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
         raise RecordError(str(exc).replace(path, shown)) from None  # messages print and write safely
 
 
+def _check_entry(path) -> None:
+    """A :class:`RecordError` saying why ``path`` is no file that can be read, if it is not: missing,
+    a symbolic link to nothing or in a loop, in a folder without search permission, a folder."""
+    import errno
+    import stat
+
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        if exc.errno == errno.ENOENT and os.path.islink(path):
+            raise RecordError(f"{path}: a symbolic link to a file that does not exist "
+                              f"({printable(os.readlink(path))})") from None
+        if exc.errno == errno.ENOENT:
+            raise RecordError(f"{path}: no such file") from None
+        if exc.errno == errno.ELOOP:
+            raise RecordError(f"{path}: a loop of symbolic links") from None
+        raise RecordError(f"{path}: cannot be read: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(st.st_mode):
+        try:
+            os.listdir(path)
+        except OSError as exc:
+            raise RecordError(f"{path}: a folder whose files cannot be listed: {exc.strerror or exc}") from None
+        raise RecordError(f"{path}: is a directory, not a record file")
+
+
 def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
     """:func:`read_record` on a ``str`` path: dispatch to the format, then the common checks."""
     p = pathlib.Path(path)
-    if not p.exists():
-        raise RecordError(f"{path}: no such file")
-    if p.is_dir():
-        raise RecordError(f"{path}: is a directory, not a record file")
+    _check_entry(path)
     if p.stat().st_size == 0:
         raise RecordError(f"{path}: the file is empty")
     fmt = formats.detect(path) if format is None else (formats.by_name(format) or
@@ -207,6 +229,28 @@ def _time_step(path, reading, dt):
                       f"(--dt on the command line)")
 
 
+#: a record whose samples sit this fraction of their motion away from zero (median against the
+#: largest departure from it) is reported: ground acceleration swings about zero (a fling's
+#: permanent velocity moves the median of a real record by well under 1 % of its peak), so such an
+#: offset is a baseline or a sensor's static reading (1 g: gravity on a vertical sensor), which
+#: every design would otherwise take for ground motion
+OFFSET_WARN_FRACTION = 0.1
+
+
+def _check_offset(path, acc, meta) -> None:
+    """Warn of a large constant offset (:data:`OFFSET_WARN_FRACTION`); refuse a record that is one
+    constant throughout (no motion at all: nothing to design for)."""
+    offset = float(np.median(acc))
+    motion = float(np.max(np.abs(acc - offset)))
+    if motion == 0.0:
+        raise RecordError(f"{path}: every sample is {offset / G:.4g} g: a constant, no ground motion")
+    if abs(offset) > OFFSET_WARN_FRACTION * motion:
+        meta["warnings"].append(
+            f"the samples sit {offset / G:+.3g} g from zero (median), {abs(offset) / motion:.0%} of their "
+            "motion: a constant offset (baseline, gravity) is designed for as ground motion; "
+            "remove it if it is not")
+
+
 def _validate(path, acc, raw, units, units_source, meta):
     bad = ~np.isfinite(acc)
     if bad.any():
@@ -228,3 +272,4 @@ def _validate(path, acc, raw, units, units_source, meta):
                           f"for an accelerogram (outside {PLAUSIBLE_MIN_G:g} to {PLAUSIBLE_MAX_G:g} g); {fix}")
     if peak_g > WARN_PEAK_G:
         meta["warnings"].append(f"peak acceleration {peak_g:.3g} g is above {WARN_PEAK_G:g} g: check the units")
+    _check_offset(path, acc, meta)

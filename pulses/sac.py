@@ -22,6 +22,10 @@ IDEP_QUANTITY = {8: "acceleration", 7: "velocity", 6: "displacement", 5: "unknow
 #: the SAC standard's units for each quantity code
 IDEP_STANDARD_UNITS = {8: "nm/s2", 7: "nm/s", 6: "nm"}
 IACC = 8
+#: SAC ``iftype`` (the kind of file) enumeration values: only a time series is a record
+IFTYPE_KIND = {1: "time series", 2: "spectrum (real and imaginary)", 3: "spectrum (amplitude and phase)",
+               4: "general x-y data", 51: "general x-y-z data"}
+ITIME = 1
 #: value SAC uses for an undefined integer header
 SAC_UNDEFINED = -12345
 
@@ -77,7 +81,8 @@ def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
     Raises
     ------
     RecordError
-        For a velocity or displacement record (``idep`` = ``ivel``, ``idisp``).
+        For a velocity or displacement record (``idep`` = ``ivel``, ``idisp``), or a file that
+        is not a time series (``iftype`` other than ``itime``: a spectrum, x-y data).
     """
     sac = tr.stats.sac
     meta = obspyformat.trace_metadata(tr)
@@ -91,6 +96,11 @@ def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
     if quantity in ("velocity", "displacement"):
         raise RecordError(f"{path}: SAC idep says this is a {quantity} record; records must be ground "
                           f"acceleration (idep = iacc)")
+    iftype = sac.get("iftype")
+    if iftype is not None and int(iftype) not in (ITIME, SAC_UNDEFINED):  # a spectrum is no record
+        kind = IFTYPE_KIND.get(int(iftype), f"code {int(iftype)}")
+        raise RecordError(f"{path}: SAC iftype says this file is not a time series but {kind}; "
+                          "records must be time series (iftype = itime)")
     reading = formats.Reading(np.asarray(tr.data, dtype=float),
                               shortest_float32(sac.get("delta", tr.stats.delta)), meta,
                               units_rule=formats.UNITS_STANDARD)

@@ -38,6 +38,7 @@ import numpy as np
 import pywt
 from scipy import fft as sfft
 
+from .bytecache import byte_lru
 from .errors import RecordError
 from .record import Record
 
@@ -70,6 +71,12 @@ PI_COEFFICIENTS = (-7.817, -0.5679, -0.1516, -3.0253, -1.7396, -2.7156)
 LATE_PULSE_PERCENT, LATE_RECORD_PERCENT = 5.0, 17.0
 #: m/s to cm/s: the indicator's constants are in cm/s
 CM_PER_M = 100.0
+#: bytes the caches of filters may hold (each): every filter of a 200 Hz record fits many times
+#: over (51 coarse filters of at most 15,000 samples: 6 MB), while a 10 kHz record's, whose
+#: longest filter has 750,000 samples, are recomputed rather than held by the gigabyte
+FILTER_CACHE_BYTES = 64 * 2**20
+#: bytes the cache of the coarse filters' spectra may hold: a 200 Hz record of 40 s needs 10 MB
+SPECTRUM_CACHE_BYTES = 128 * 2**20
 
 
 # -- the db4 continuous transform ------------------------------------------------------------
@@ -92,7 +99,7 @@ def resampled_integral(scale: float) -> np.ndarray:
     return int_psi[j][::-1]
 
 
-@lru_cache(maxsize=256)  # the coarse scales; the refined ones are kept by _point_filter
+@byte_lru(FILTER_CACHE_BYTES)  # the coarse scales; the refined ones are kept by _point_filter
 def difference_filter(scale: float) -> np.ndarray:
     """Filter ``g`` with ``conv(x, g) = diff(conv(x, f))``, ``f`` the :func:`resampled_integral`
     (``g = [f0, f1 - f0, ..., -f_last]``); read-only."""
@@ -132,13 +139,12 @@ def db4_cwt_direct(x, scales) -> np.ndarray:
     return out
 
 
-@lru_cache(maxsize=16)
-def _filter_spectra(scales: tuple, size: int) -> np.ndarray:
-    spectra = np.empty((len(scales), size // 2 + 1), dtype=complex)
-    for i, a in enumerate(scales):
-        spectra[i] = sfft.rfft(difference_filter(a), size) * (-math.sqrt(a))
-    spectra.flags.writeable = False
-    return spectra
+@byte_lru(SPECTRUM_CACHE_BYTES)
+def _filter_spectrum(scale: float, size: int) -> np.ndarray:
+    """``-sqrt(scale)`` times the FFT of size ``size`` of :func:`difference_filter`; read-only."""
+    spectrum = sfft.rfft(difference_filter(scale), size) * (-math.sqrt(scale))
+    spectrum.flags.writeable = False
+    return spectrum
 
 
 def db4_cwt(x, scales) -> np.ndarray:
@@ -175,11 +181,10 @@ def _cwt_rows(x: np.ndarray, scales: tuple):
     n = x.shape[-1]
     for size, members in _size_groups(scales, n):
         spectrum = sfft.rfft(x, size, axis=-1)
-        spectra = _filter_spectra(tuple(scales[i] for i in members), size)
         product = np.empty_like(spectrum)
-        for j, i in enumerate(members):
+        for i in members:
             k = _offset(scales[i])
-            np.multiply(spectrum, spectra[j], out=product)
+            np.multiply(spectrum, _filter_spectrum(scales[i], size), out=product)
             yield i, sfft.irfft(product, size, axis=-1)[..., k:k + n]
 
 
@@ -209,7 +214,7 @@ def _dot(a: np.ndarray, b: np.ndarray) -> float:
     return float(sum(np.dot(a[i:i + DOT_PIECE], b[i:i + DOT_PIECE]) for i in range(0, a.size, DOT_PIECE)))
 
 
-@lru_cache(maxsize=4096)
+@byte_lru(FILTER_CACHE_BYTES)
 def _point_filter(scale: float) -> tuple[int, np.ndarray, float]:
     """What the transform at one sample needs at ``scale``: (the :func:`_offset`, the
     :func:`difference_filter` reversed (read-only), ``-sqrt(scale)``)."""
@@ -315,7 +320,7 @@ def _pulse_wavelet():
     return psi, x
 
 
-@lru_cache(maxsize=64)
+@byte_lru(FILTER_CACHE_BYTES)
 def _unit_wavelet(scale: float) -> tuple[int, np.ndarray]:
     """The db4 wavelet at ``scale`` on samples, centred on sample 0, linearly interpolated from
     the ``wavefun('db4', 4)`` grid (zero outside its support) as ``analyze_record.m`` draws it:
@@ -566,16 +571,49 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
                 pulse=pulse / CM_PER_M, velocity=signal / CM_PER_M)
 
 
-def _strongest(power: np.ndarray, peak: np.ndarray) -> tuple[int, int]:
-    """(row, column) of the largest value of ``power`` (non-negative), given ``peak``, its
-    largest value in each column: the column from ``peak``, then the row in that column; on a
-    tie between columns, the first in row-major order, as :func:`numpy.argmax`."""
-    cols = np.flatnonzero(peak == peak.max())
-    if cols.size == 1:
-        col = int(cols[0])
-        return int(np.argmax(power[:, col])), col
-    row, col = np.unravel_index(int(np.argmax(power)), power.shape)
-    return int(row), int(col)
+class _StrongestMap:
+    """The (scale, time) map of ``C1^2 + C2^2`` as the candidates need it, in memory proportional
+    to the record's length (not times the 51 scales): for each time, the largest value over the
+    scales (``peak``), the first scale where it is reached (``row``) and the coefficients there;
+    and the coefficients at the first scale, which a cleared time returns to.
+
+    :meth:`add` takes the rows in any order; :meth:`strongest` and :meth:`clear` then give what
+    the whole map would (:func:`numpy.argmax`'s first index on ties), value for value."""
+
+    def __init__(self, n: int, n_rows: int, pair: bool):
+        self.peak = np.zeros(n)
+        self.row = np.full(n, n_rows, dtype=np.intp)  # none yet: every row comes first
+        shape = (2, n) if pair else (1, n)
+        self.coef = np.zeros(shape)
+        self.coef0 = np.zeros(shape)
+
+    def add(self, i: int, row: np.ndarray) -> None:
+        """Row ``i`` of the transform (shape (n,), or (2, n) for a pair)."""
+        row = row.reshape(self.coef.shape)
+        power = row[0] * row[0]
+        if row.shape[0] == 2:
+            power += row[1] * row[1]
+        better = power > self.peak
+        better |= (power == self.peak) & (self.row > i)
+        np.copyto(self.peak, power, where=better)
+        self.row[better] = i
+        np.copyto(self.coef, row, where=better)
+        if i == 0:
+            self.coef0[...] = row
+
+    def strongest(self) -> tuple[int, int, float, float]:
+        """(row, column, C1, C2) of the largest value; on a tie between columns, the first in
+        row-major order."""
+        cols = np.flatnonzero(self.peak == self.peak.max())
+        col = int(cols[0]) if cols.size == 1 else int(cols[np.lexsort((cols, self.row[cols]))[0]])
+        c = self.coef[:, col]
+        return int(self.row[col]), col, float(c[0]), float(c[1]) if c.size == 2 else 0.0
+
+    def clear(self, cleared: slice) -> None:
+        """Set the map to zero at times ``cleared``: their largest value is then 0, first at row 0."""
+        self.peak[cleared] = 0.0
+        self.row[cleared] = 0
+        self.coef[:, cleared] = self.coef0[:, cleared]
 
 
 def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_energy) -> PulseClassification:
@@ -617,24 +655,15 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     if scales[0] < 1:
         raise RecordError(f"{record.name}: time step {dt:g} s is too long for pulses of "
                           f"{TP_MIN:g} s (at most {TP_MIN * FC:g} s)")
-    # the (scale, time) map of C1^2 + C2^2, each row made while its transform is in the cache
+    # the (scale, time) map of C1^2 + C2^2, kept as the candidates need it (_StrongestMap)
     x = v1 if v2 is None else np.stack([v1, v2])
-    coefs = np.empty(x.shape[:-1] + (scales.size, x.shape[-1]))
-    power = np.empty((scales.size, x.shape[-1]))
-    peak = np.zeros(x.shape[-1])  # largest power at each time (over scales)
+    strongest = _StrongestMap(x.shape[-1], scales.size, v2 is not None)
     for i, row in _cwt_rows(x, tuple(float(a) for a in scales)):
-        coefs[..., i, :] = row
-        if v2 is None:
-            np.multiply(row, row, out=power[i])
-        else:
-            np.multiply(row[0], row[0], out=power[i])
-            power[i] += row[1] * row[1]
-        np.maximum(peak, power[i], out=peak)
-    c1, c2 = (coefs, None) if v2 is None else (coefs[0], coefs[1])
+        strongest.add(i, row)
+    del x
     candidates = []
     for _ in range(N_CANDIDATES):
-        row, col = _strongest(power, peak)
-        a, b = c1[row, col], (c2[row, col] if c2 is not None else 0.0)
+        row, col, a, b = strongest.strongest()
         theta = math.atan(b / a) if a != 0.0 else (math.pi / 2 if b != 0.0 else 0.0)
         signal = v1 * math.cos(theta) + v2 * math.sin(theta) if v2 is not None else v1
         d = _analyze(signal, dt, int(col), int(row), scales, energy)
@@ -644,9 +673,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
             arrival=record.t_start + d["arrival_index"] * dt, orientation=math.degrees(theta),
             time=record.t_start + int(col) * dt, velocity=d["velocity"], pulse=d["pulse"]))
         reach = WINDOW * scales[row]  # clear samples strictly within `reach` of the maximum
-        cleared = slice(max(0, math.floor(col - reach) + 1), max(0, math.ceil(col + reach)))
-        power[:, cleared] = 0.0
-        peak[cleared] = 0.0
+        strongest.clear(slice(max(0, math.floor(col - reach) + 1), max(0, math.ceil(col + reach))))
     pulse_like = [i for i, c in enumerate(candidates) if c.is_pulse]
     chosen = pulse_like[0] if pulse_like else int(np.argmax([c.indicator for c in candidates]))
     c = candidates[chosen]
