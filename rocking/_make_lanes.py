@@ -1,12 +1,13 @@
-"""Write :mod:`rocking._taylor_lanes`: fixed-order Taylor steps of many runs at once (run this file
-to regenerate).
+"""Write ``rocking/_taylor_lanes.pxi``: fixed-order Taylor steps of many runs at once, in Cython
+(run this file to regenerate; the package's build compiles it into ``rocking/_core.pyx``).
 
-The step is the one of :mod:`rocking._taylor_fixed` (forcing linear over the step), written as a
+The step is the one of ``rocking/_taylor_fixed.pxi`` (forcing linear over the step), written as a
 loop over *lanes*, independent runs that share the record and its time grid (a batch of blocks
 or of scalings).  One run's step is a chain of dependent operations, so a processor core spends
 most of its time waiting; the loop over lanes has no dependence between iterations, which the
 compiler turns into SIMD instructions, and the core does several runs in the time of one.
-``tests/test_lanes.py`` checks that the committed module matches this generator.
+A lane's arithmetic is written once, as Python text (:func:`reference_source`), and compiled as
+written.  ``tests/test_lanes.py`` checks that the committed file matches this generator.
 """
 from __future__ import annotations
 

@@ -1,9 +1,14 @@
-"""Write :mod:`rocking._taylor_fixed`: Taylor steps of fixed order, unrolled (run this file to regenerate).
+"""Write ``rocking/_taylor_fixed.pxi``: Taylor steps of fixed order, unrolled, in Cython (run this
+file to regenerate; the package's build compiles it into ``rocking/_core.pyx``).
 
-The recurrences are those of :func:`rocking.engine.taylor_series` for forcing linear over the
-step (records, the rectangular pulse, free rocking); unrolled with the order fixed they keep every
-coefficient in registers and run about three times faster than the general loop.
-``tests/test_solver.py`` checks that the committed module matches this generator.
+The recurrences are those of the engine's general Taylor loop (``taylor_series`` in
+``rocking/_core.pyx``) for forcing linear over the step (records, the rectangular pulse, free
+rocking) and for smooth pulses (forcing given by its series); unrolled with the order fixed they
+keep every coefficient in registers and run about three times faster than the general loop.
+Each step is written once, as Python text (:func:`reference_source`); the Cython is that text
+with its locals declared C doubles, so the compiled step does the same operations in the same
+order.  ``tests/test_solver.py`` checks that the committed file matches this generator and that
+the compiled steps give the Python text's results bit for bit.
 """
 from __future__ import annotations
 
@@ -119,8 +124,8 @@ def _fixed_function(n: int) -> str:
     terms (in the order they become ready) before adding them to the large ones, as accurate as
     summing from the smallest term.  ``D_k = k c_k`` is not formed: ``omega h`` sums ``k c_k`` by
     multiply-adds and the flags compare ``k |c_k|``.  The ready times of the model (one unit per
-    add or multiply) order the sums; the compiler may fuse a multiply into the add that follows
-    (``fastmath='contract'``), never reorder."""
+    add or multiply) order the sums; the compiler keeps that order and fuses nothing
+    (``-ffp-contract=off``, setup.py)."""
     sc = _Sched()
     L = [f"\n\ndef _taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):",
          "    S_0 = s0",
