@@ -25,6 +25,25 @@ cdef extern from *:
     """
     double PI "ROCKING_PI"
 
+# ``k ? a : b`` and Python's ``max(a, b)`` without a branch: the bits of ``a`` or ``b`` chosen by
+# a mask (the same value as the conditional; a branch, and a conditional the compiler turns into
+# one, keep the lanes' loop from being vectorised)
+cdef extern from *:
+    """
+    #include <stdint.h>
+    #include <string.h>
+    static inline double rocking_select(int k, double a, double b) {
+        uint64_t m = (uint64_t)0 - (uint64_t)(k != 0), x, y;
+        memcpy(&x, &a, 8); memcpy(&y, &b, 8);
+        x = (x & m) | (y & ~m);
+        memcpy(&a, &x, 8);
+        return a;
+    }
+    static inline double rocking_fmax(double a, double b) { return rocking_select(b > a, b, a); }
+    """
+    double select "rocking_select"(int k, double a, double b) noexcept nogil
+    double fmax_ "rocking_fmax"(double a, double b) noexcept nogil
+
 cdef double HALF_PI = 0.5 * PI
 cdef double TWO_PI = 2.0 * PI
 cdef double SQRT3 = sqrt(3.0)

@@ -51,17 +51,18 @@ cdef (long, long) lanes_4(long n, double uj, double duj, Chunk* L, double h, dou
         a_3 = abs(D_3)
         a_2 = abs(D_2)
         a_1 = abs(D_1)
-        hi = max(a_4, a_3)
-        lo = max(a_2, a_1)
+        hi = fmax_(a_4, a_3)
+        lo = fmax_(a_2, a_1)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
@@ -112,17 +113,18 @@ cdef (long, long) lanes_6(long n, double uj, double duj, Chunk* L, double h, dou
         a_5 = abs(D_5)
         a_4 = abs(D_4)
         a_3 = abs(D_3)
-        hi = max(a_6, a_5)
-        lo = max(a_4, a_3)
+        hi = fmax_(a_6, a_5)
+        lo = fmax_(a_4, a_3)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
@@ -181,17 +183,18 @@ cdef (long, long) lanes_8(long n, double uj, double duj, Chunk* L, double h, dou
         a_7 = abs(D_7)
         a_6 = abs(D_6)
         a_5 = abs(D_5)
-        hi = max(a_8, a_7)
-        lo = max(a_6, a_5)
+        hi = fmax_(a_8, a_7)
+        lo = fmax_(a_6, a_5)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
@@ -259,17 +262,18 @@ cdef (long, long) lanes_10(long n, double uj, double duj, Chunk* L, double h, do
         a_9 = abs(D_9)
         a_8 = abs(D_8)
         a_7 = abs(D_7)
-        hi = max(a_10, a_9)
-        lo = max(a_8, a_7)
+        hi = fmax_(a_10, a_9)
+        lo = fmax_(a_8, a_7)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
@@ -345,17 +349,18 @@ cdef (long, long) lanes_12(long n, double uj, double duj, Chunk* L, double h, do
         a_11 = abs(D_11)
         a_10 = abs(D_10)
         a_9 = abs(D_9)
-        hi = max(a_12, a_11)
-        lo = max(a_10, a_9)
+        hi = fmax_(a_12, a_11)
+        lo = fmax_(a_10, a_9)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
@@ -440,17 +445,18 @@ cdef (long, long) lanes_14(long n, double uj, double duj, Chunk* L, double h, do
         a_13 = abs(D_13)
         a_12 = abs(D_12)
         a_11 = abs(D_11)
-        hi = max(a_14, a_13)
-        lo = max(a_12, a_11)
+        hi = fmax_(a_14, a_13)
+        lo = fmax_(a_12, a_11)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
@@ -543,17 +549,18 @@ cdef (long, long) lanes_16(long n, double uj, double duj, Chunk* L, double h, do
         a_15 = abs(D_15)
         a_14 = abs(D_14)
         a_13 = abs(D_13)
-        hi = max(a_16, a_15)
-        lo = max(a_14, a_13)
+        hi = fmax_(a_16, a_15)
+        lo = fmax_(a_14, a_13)
         converged = hi <= tol
         quiet = (om * om2 > 0.0) & (L.f[R_SIDE][i] * th2 > 0.0) & (abs(th2) < 1.5707963267948966)
         keep = converged & quiet
-        # branch-free selects (they vectorise): the new state where kept
-        L.f[R_TH][i] = th2 if keep else th
-        L.f[R_OM][i] = om2 if keep else om
-        L.f[R_SPHI][i] = s1 if keep else S_0
-        L.f[R_CPHI][i] = c1 if keep else C_0
-        L.f[R_MX][i] = max(L.f[R_MX][i], abs(th2)) if keep else L.f[R_MX][i]
+        # branch-free selects (C conditional expressions, which vectorise): the new
+        # state where kept
+        L.f[R_TH][i] = select(keep, th2, th)
+        L.f[R_OM][i] = select(keep, om2, om)
+        L.f[R_SPHI][i] = select(keep, s1, S_0)
+        L.f[R_CPHI][i] = select(keep, c1, C_0)
+        L.f[R_MX][i] = select(keep, fmax_(L.f[R_MX][i], abs(th2)), L.f[R_MX][i])
         b = (1 - keep) * (2 - converged)  # 0 kept, 1 something happens, 2 order too low
         L.bad[i] = b
         n_bad += b > 0
