@@ -25,25 +25,6 @@ cdef extern from *:
     """
     double PI "ROCKING_PI"
 
-# ``k ? a : b`` and Python's ``max(a, b)`` without a branch: the bits of ``a`` or ``b`` chosen by
-# a mask (the same value as the conditional; a branch, and a conditional the compiler turns into
-# one, keep the lanes' loop from being vectorised)
-cdef extern from *:
-    """
-    #include <stdint.h>
-    #include <string.h>
-    static inline double rocking_select(int k, double a, double b) {
-        uint64_t m = (uint64_t)0 - (uint64_t)(k != 0), x, y;
-        memcpy(&x, &a, 8); memcpy(&y, &b, 8);
-        x = (x & m) | (y & ~m);
-        memcpy(&a, &x, 8);
-        return a;
-    }
-    static inline double rocking_fmax(double a, double b) { return rocking_select(b > a, b, a); }
-    """
-    double select "rocking_select"(int k, double a, double b) noexcept nogil
-    double fmax_ "rocking_fmax"(double a, double b) noexcept nogil
-
 cdef double HALF_PI = 0.5 * PI
 cdef double TWO_PI = 2.0 * PI
 cdef double SQRT3 = sqrt(3.0)
@@ -76,8 +57,6 @@ cdef enum:
     #: steps in a row for which a lower order would have done before an unrolled step of forcing
     #: linear over the step (records) takes the next order down
     LOW_RUN_FIXED = 8
-    #: runs stepped together at most (rocking.lanes.LANES)
-    LANES = 32
     #: intervals in a row in which a lower order sufficed for every rocking lane before it is
     #: lowered (rocking.lanes.LOW_RUN)
     LOW_RUN = 64
@@ -1217,40 +1196,33 @@ def run(int kind, double amp, double tp, double t0, const double[::1] uval, doub
 
 
 # --------------------------------------------------------------------------- batch engine
-# rows of a chunk's float state (one column per lane), and of its integer state
-cdef enum:
-    R_A = 0
-    R_Q = 1
-    R_SA = 2
-    R_CA = 3
-    R_TAN = 4
-    R_P = 5
-    R_ALPHA = 6
-    R_ETA = 7
-    R_TH = 8
-    R_OM = 9
-    R_SIDE = 10
-    R_SPHI = 11
-    R_CPHI = 12
-    R_REST = 13
-    R_MX = 14
-    NF = 15
-cdef enum:
-    I_STATUS = 0
-    I_NIMP = 1
-    I_UP = 2
-    I_RUN = 3
-    I_WAKE = 4
-    NI = 5
+# the lanes' steps (generated C, rocking/_make_lanes.py), and the rows of a chunk's float state
+# (one column per lane) and of its integer state
+cdef extern from "_taylor_lanes.h":
+    enum:
+        R_A, R_Q, R_SA, R_CA, R_TAN, R_P, R_ALPHA, R_ETA, R_TH, R_OM, R_SIDE, R_SPHI, R_CPHI
+        R_REST, R_MX, NF
+        I_STATUS, I_NIMP, I_UP, I_RUN, I_WAKE, NI
+        LANES  # runs stepped together at most (rocking.lanes.LANES)
+    int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
+                               int64_t* bad, double h, double eps, int64_t* n_low) noexcept nogil
 
 ctypedef struct Chunk:
     # the state of up to LANES runs stepped together: NF rows of floats, NI rows of integers,
     # and why each lane was left by the last step (lanes_N)
     double f[NF][LANES]
     long i[NI][LANES]
-    long bad[LANES]
+    int64_t bad[LANES]
 
-include "_taylor_lanes.pxi"
+
+cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, Chunk* L, double h,
+                                    double eps) noexcept nogil:
+    """The lanes' step of order ``order`` (the highest for larger) on lanes ``0 .. n-1`` of
+    ``L``: ``(n_bad, n_low)``, the lanes left and the kept lanes a lower order would have done."""
+    cdef int64_t n_low = 0
+    cdef int64_t n_bad = rocking_lanes_step(order, n, uj, duj, &L.f[0][0], &L.bad[0], h, eps,
+                                            &n_low)
+    return n_bad, n_low
 
 
 cdef inline void _swap(Chunk* L, long i, long k) noexcept nogil:

@@ -4,7 +4,7 @@ A design search or a spectrum runs one record against hundreds of blocks (or sca
 Taylor step (``rocking/_taylor_fixed.pxi``) is a chain of dependent operations, so the core mostly
 waits on it; the runs of a batch are independent, so :func:`run_lanes` takes them
 :data:`LANES` at a time and advances all the rocking ones over each sample interval with one loop
-over lanes (``rocking/_taylor_lanes.pxi``, the same arithmetic lane by lane, which the compiler
+over lanes (``rocking/_taylor_lanes.h``, generated C: the same arithmetic lane by lane, which the compiler
 turns into SIMD instructions).  Only the common case is done there: a block rocking through a whole
 interval with no turning point, impact or overturning, and with the series converged at the
 chunk's order.  Everything else in an interval (uplift, impacts, Zeno sequences, peaks, a higher
