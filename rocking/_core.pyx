@@ -9,7 +9,7 @@ here runs without the GIL on C doubles and pointers (no Python object, no alloca
 scratch space is on the C stack), so that Python threads run batches in parallel.
 
 The unrolled Taylor steps are generated: ``_taylor_fixed.pxi`` by ``rocking/_make_taylor.py``,
-``_taylor_lanes.pxi`` by ``rocking/_make_lanes.py`` (included below).
+``_taylor_lanes.h`` (C) by ``rocking/_make_lanes.py`` (included below).
 """
 from libc.stdint cimport int64_t
 from libc.math cimport (acos, copysign, cos, exp, fabs, isnan, sin, sinh, sqrt, tan, INFINITY,
