@@ -2,16 +2,16 @@
 
 A design search or a spectrum runs one record against hundreds of blocks (or scalings).  One run's
 Taylor step (``rocking/_taylor_fixed.pxi``) is a chain of dependent operations, so the core mostly
-waits on it; the runs of a batch are independent, so :func:`run_lanes` takes them
-:data:`LANES` at a time and advances all the rocking ones over each sample interval with one loop
-over lanes (``rocking/_taylor_lanes.h``, generated C: the same arithmetic lane by lane, which the compiler
-turns into SIMD instructions).  Only the common case is done there: a block rocking through a whole
-interval with no turning point, impact or overturning, and with the series converged at the
-chunk's order.  Everything else in an interval (uplift, impacts, Zeno sequences, peaks, a higher
-order, overturning) is handed for that one interval and that one lane to the engine's own
-``run_core`` (``rocking/_core.pyx``), so the model, its events and its accuracy are exactly
-those of :func:`rocking.engine.run`.  The steps agree with a single run's to rounding (same formula, same
-operations, at the same or a higher order).
+waits on it; the runs of a batch are independent, so :func:`run_lanes` takes them :data:`LANES`
+at a time and advances all the rocking ones over each sample interval with one loop over lanes
+(``rocking/_taylor_lanes.h``, generated C: the same arithmetic lane by lane, which the compiler
+turns into SIMD instructions).  Only the common case is done there: a block rocking through a
+whole interval with no turning point, impact or overturning, and with the series converged at
+the chunk's order.  Everything else in an interval (uplift, impacts, Zeno sequences, peaks, a
+higher order, overturning) is handed for that one interval and that one lane to the engine's
+own ``run_core`` (``rocking/_core.pyx``), so the model, its events and its accuracy are exactly
+those of :func:`rocking.engine.run`.  The steps agree with a single run's to rounding (same
+formula, same operations, at the same or a higher order).
 
 For records (forcing linear between samples) on a uniform grid with one Taylor step per sample
 (``p dt`` within :data:`rocking.solver.PH_MAX`); :func:`rocking.simulate_many` uses it for those

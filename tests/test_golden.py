@@ -42,7 +42,8 @@ def current():
 
 
 def _close(a, b, *, rel=0.0, abs_=0.0):
-    return a == b or (a is not None and b is not None and math.isclose(a, b, rel_tol=rel, abs_tol=abs_))
+    return a == b or (a is not None and b is not None
+                      and math.isclose(a, b, rel_tol=rel, abs_tol=abs_))
 
 
 def _single(want, got, key):
