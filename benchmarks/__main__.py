@@ -96,7 +96,7 @@ def main(argv=None) -> int:
 
     matplotlib.use("Agg")
     log(f"benchmarks{' (quick)' if quick else ''}: sections {', '.join(todo)}; warming up the compiled code")
-    import rocking  # noqa: F401  (load the numba caches before timing)
+    import rocking  # noqa: F401  (import before timing)
 
     mach = machine()
     load0 = loadavg()

@@ -93,7 +93,7 @@ def fmt_e(err: float) -> str:
 
 
 def machine() -> dict:
-    import numba
+    import Cython
     import scipy
 
     cpu = "unknown"
@@ -117,7 +117,7 @@ def machine() -> dict:
     except OSError:
         pass
     return {"cpu": cpu, "nproc": os.cpu_count(), "python": platform.python_version(),
-            "numba": numba.__version__, "numpy": np.__version__, "scipy": scipy.__version__,
+            "cython": Cython.__version__, "numpy": np.__version__, "scipy": scipy.__version__,
             "platform": platform.platform(), "commit": commit,
             "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
 

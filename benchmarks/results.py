@@ -311,7 +311,7 @@ def cost_section(d, out_dir):
     md.append("\n### `pipeline simulate` cold start (issue 2: under 2 s)\n")
     if cold:
         md.append(f"`pipeline simulate --block 7.5x1.8 --pulse sine --ap 0.71g --tp 0.8` in a fresh process "
-                  f"(`python -m pipeline`, numba caches on disk): median **{cold['t']:.2f} s** (best {cold['tmin']:.2f} s) "
+                  f"(`python -m pipeline`): median **{cold['t']:.2f} s** (best {cold['tmin']:.2f} s) "
                   f"of {d['n_cold']}; of which `import rocking, pulses` alone takes {cold['imp']:.2f} s and a bare "
                   f"Python start {cold['py']:.2f} s. Its answer: `{cold['out']}`.\n")
     else:
@@ -372,7 +372,7 @@ def design_section(res, out_dir):
                   f"{fmt_t(t)} ({fmt_t(t.best)}) | < 20 ms |")
         t1 = res.get(f"min_slenderness {shape} 1 thread")
         if t1 is not None:
-            md.append(f"| the same with numba limited to one thread: median (best) | {fmt_t(t1)} ({fmt_t(t1.best)}) | |")
+            md.append(f"| the same limited to one thread: median (best) | {fmt_t(t1)} ({fmt_t(t1.best)}) | |")
     for key, value in res.items():
         if key.startswith("spectrum"):
             md.append(f"| overturning {key} (one run) | {value:.2f} s | < 5 s |")
@@ -452,7 +452,7 @@ def write_report(out_dir, measured, mach, load0, cal0, quick, only, total=None, 
             "in this one run on this machine. Regenerate it with the same command.", "",
             "## Machine", "",
             f"- CPU: {mach['cpu']}, {mach['nproc']} cores visible (`nproc`); {mach['platform']}",
-            f"- Python {mach['python']}, numba {mach['numba']}, numpy {mach['numpy']}, scipy {mach['scipy']}",
+            f"- Python {mach['python']}, Cython {mach.get('cython', '?')}, numpy {mach['numpy']}, scipy {mach['scipy']}",
             f"- commit {mach['commit']}, run started {mach['date']}",
             f"- load average (1/5/15 min) at the start: {load0}" + (f", at the end: {load1}" if load1 else ""),
             "- The machine is shared with other test runs, so single timings are noisy: times are medians of "

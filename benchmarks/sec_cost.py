@@ -65,19 +65,19 @@ def measure(quick):
               for _ in range(3 if not quick else 1)]
         spec[shape] = tstat(ts)
         log(f"  {shape}: {spec[shape]:.2f} s")
-    import numba
+    from rocking import lanes
 
-    threads = numba.get_num_threads()
+    threads = lanes.get_threads()
     spec1 = {}
     try:
-        numba.set_num_threads(1)
+        lanes.set_threads(1)
         for shape in ("sine", "ricker-sym"):
             ts = [timed(lambda: rocking.overturning_spectrum(alpha, shape, wp, ratio))[1]
                   for _ in range(3 if not quick else 1)]
             spec1[shape] = tstat(ts)
             log(f"  {shape}, one thread: {spec1[shape]:.2f} s")
     finally:
-        numba.set_num_threads(threads)
+        lanes.set_threads(threads)
 
     log("cost: `pipeline simulate` cold start")
     cold = None

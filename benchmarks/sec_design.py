@@ -24,17 +24,17 @@ def measure(quick):
         pulse = make_pulse(shape, 0.71 * G, 0.8)
         res[f"min_slenderness {shape}"] = per_call(lambda: rocking.min_slenderness(pulse, 1.381), 0.5, 3)
         log(f"  min_slenderness {shape}: {fmt_t(res[f'min_slenderness {shape}'])}")
-    import numba
+    from rocking import lanes
 
-    threads = numba.get_num_threads()
+    threads = lanes.get_threads()
     try:
-        numba.set_num_threads(1)
+        lanes.set_threads(1)
         for shape in ("sine", "ricker-sym"):
             pulse = make_pulse(shape, 0.71 * G, 0.8)
             res[f"min_slenderness {shape} 1 thread"] = per_call(lambda: rocking.min_slenderness(pulse, 1.381), 0.5, 3)
             log(f"  min_slenderness {shape}, one thread: {fmt_t(res[f'min_slenderness {shape} 1 thread'])}")
     finally:
-        numba.set_num_threads(threads)
+        lanes.set_threads(threads)
     alpha = math.radians(14.0)
     wp, ratio = np.linspace(0.5, 12, 200), np.linspace(1, 6, 200)
     for shape in (("sine",) if quick else ("sine", "ricker-sym")):

@@ -20,9 +20,7 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
                              "gives identical files")
     parser.add_argument("--jobs", "-j", metavar="N", default=None,
                         help="number of worker processes (default 1, or one per CPU with --dask "
-                             "local; 0 = one per CPU); the output does not depend on it. Without "
-                             "it, a first run after an install compiles the solver with one "
-                             "process per CPU; --jobs 1 compiles it in this one process")
+                             "local; 0 = one per CPU); the output does not depend on it")
     parser.add_argument("--dask", metavar="SCHEDULER",
                         help="distribute records over a dask.distributed cluster: a scheduler "
                              "address (tcp://host:8786) or 'local' for a local cluster of --jobs "

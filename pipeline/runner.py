@@ -82,41 +82,21 @@ def make_tasks(paths, columns, options: Options) -> list[Task]:
 
 
 # -- executors -------------------------------------------------------------------------------------
-def _serial(tasks, helpers: int = 0):
-    """Records one after the other in this process.  ``helpers``: processes that share the
-    solver's compilation with this one when its cache is cold (:func:`warm_up`); 0: the solver
-    compiles in this process, on its first call."""
-    if helpers and tasks:
-        warm_up(helpers=helpers, check=interrupts.check)
+def _serial(tasks):
+    """Records one after the other in this process."""
     for task in tasks:
         interrupts.check()
         yield work(task)
 
 
-def warm_up(shared=None, helpers: int = 0, check=None) -> None:
-    """Compile (or load) the solver before the first record: ``rocking.warm_up``, which shares
-    the compilation between the processes given the same ``shared`` folder (and ``helpers``
-    started for it).  It never fails the run: what it could not compile is compiled by the
-    record that needs it, as without it."""
-    try:
-        import rocking
-
-        rocking.warm_up(shared=shared, helpers=helpers, check=check)
-    except Exception:  # pragma: no cover - the records report any real problem
-        pass
-
-
 def init_worker() -> None:
-    """Set up a worker process: one compiled-solver thread (the processes share the CPUs; the
-    solver's batches then run on one thread, with the same runs and the same results)."""
+    """Set up a worker process: one solver thread (the processes share the CPUs; the solver's
+    batches then run on one thread, with the same runs and the same results)."""
     global _in_worker
     _in_worker = True
-    try:
-        import numba
+    from rocking import lanes
 
-        numba.set_num_threads(1)
-    except Exception:  # pragma: no cover - numba missing or threading layer not started
-        pass
+    lanes.set_threads(1)
 
 
 def _size(task) -> int:
@@ -126,12 +106,11 @@ def _size(task) -> int:
         return 0
 
 
-def _init_pool_worker(kill_at: str | None = None, shared: str | None = None) -> None:
+def _init_pool_worker(kill_at: str | None = None) -> None:
     """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
     the workers itself (a worker interrupted on its own would only print a traceback).
     ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
-    the workers may have been started before it was set).  ``shared``: the folder in which the
-    workers share the solver's compilation (:func:`warm_up`) before their first record."""
+    the workers may have been started before it was set)."""
     import signal
 
     if kill_at is None:
@@ -141,8 +120,6 @@ def _init_pool_worker(kill_at: str | None = None, shared: str | None = None) -> 
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     init_worker()
-    if shared is not None:
-        warm_up(shared)
 
 
 #: test-only: a record id at which a worker process (never the main one) kills itself with SIGKILL,
@@ -179,9 +156,9 @@ def _pool(tasks, jobs):
     from concurrent.futures.process import BrokenProcessPool
 
     plots = any(t.options.plots for t in tasks)
-    # Not plain fork: the parent may already run OpenMP threads (numba's parallel solver), and
+    # Not plain fork: the parent may already run threads (the solver's batch threads), and
     # forking such a process is unsafe.  The fork server starts clean, imports the package once
-    # and forks the workers from there (cheap, and compilation caches are loaded only once).
+    # and forks the workers from there (cheap).
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     if ctx.get_start_method() == "forkserver":
@@ -207,15 +184,9 @@ def _pool(tasks, jobs):
     window = 2 * jobs
     pool = None
     finished = False
-    # the workers compile the solver together before their first record, each function in one
-    # of them (when the cache is warm they only load it, as their first record would)
-    import tempfile
-
-    shared = tempfile.mkdtemp(prefix="pipeline-warm-up-")
-
     def new_pool():
         return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
-                                   initargs=(os.environ.get(TEST_KILL_ENV), shared))
+                                   initargs=(os.environ.get(TEST_KILL_ENV),))
 
     try:
         while queue or suspects:
@@ -273,9 +244,6 @@ def _pool(tasks, jobs):
                 pool.shutdown(wait=True)
             else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
                 _stop(pool, others)
-        import shutil
-
-        shutil.rmtree(shared, ignore_errors=True)
 
 
 def _child_processes() -> set:
@@ -401,23 +369,12 @@ def _dask(tasks, address, jobs):
 def execute(tasks, jobs: int | None = 1, dask: str | None = None):
     """Results of :func:`process_record` for every task, in completion order.
 
-    ``jobs`` None (not given): the records in this process, and when the solver's cache is cold
-    its compilation shared with helper processes, one per further CPU (:func:`warm_up`); 1: all
-    in this process."""
+    ``jobs`` None (not given) or 1: the records in this process."""
     if dask:
         return _dask(tasks, dask, jobs)
-    if jobs is None:
-        return _serial(tasks, helpers=max(0, _cpus() - 1))
-    if jobs <= 1 or len(tasks) <= 1:
-        return _serial(tasks, helpers=max(0, jobs - 1))
+    if jobs is None or jobs <= 1 or len(tasks) <= 1:
+        return _serial(tasks)
     return _pool(tasks, min(jobs, len(tasks)))
-
-
-def _cpus() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):  # not Linux
-        return os.cpu_count() or 1
 
 
 def _import_plots():

@@ -24,6 +24,3 @@ __all__ += ["equivalent_size", "eta_frame", "frame_p"]
 from .fragility import CriticalScale, Fragility, critical_scale, fragility
 
 __all__ += ["CriticalScale", "Fragility", "critical_scale", "fragility"]
-from .warmup import WarmUp, warm_up
-
-__all__ += ["WarmUp", "warm_up"]

@@ -514,9 +514,9 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     method : {"taylor", "rk8", "rk4"}
         Stepping formula of the fast engine (see :func:`simulate`).
     threads : int, optional
-        Threads sharing the batch (default: ``numba.get_num_threads()`` for batches of 256 runs
-        or more, else 1; worker processes that already share the cores call
-        ``numba.set_num_threads(1)`` or pass 1).
+        Threads sharing the batch (default: ``rocking.lanes.get_threads()``, one per CPU, for
+        batches of 256 runs or more, else 1; worker processes that already share the cores call
+        ``rocking.lanes.set_threads(1)`` or pass 1).
     lanes : bool
         True: runs under a record go through the batch engine's lanes where they apply; False:
         every run one by one (the same answers; to compare their speed).

@@ -11,7 +11,7 @@ import inspect
 
 from benchmarks import common, results
 
-MACHINE = dict(cpu="Test CPU", nproc=2, platform="Linux-test", python="3.x", numba="0.x", numpy="2.x",
+MACHINE = dict(cpu="Test CPU", nproc=2, platform="Linux-test", python="3.x", cython="3.x", numpy="2.x",
                scipy="1.x", commit="abc1234", date="2026-01-01 00:00 UTC")
 
 

@@ -35,7 +35,7 @@ def test_generated_lanes_module_is_current():
     from rocking import _make_lanes
 
     assert _make_lanes.TARGET.read_text(encoding="utf-8") == _make_lanes.source(), (
-        "rocking/_taylor_lanes.py is stale: run python rocking/_make_lanes.py")
+        "rocking/_taylor_lanes.h is stale: run python rocking/_make_lanes.py")
 
 
 def test_batch_of_widths_matches_single_runs(record):

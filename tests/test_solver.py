@@ -4,6 +4,7 @@ exact symmetries of the equation (polarity, similarity of SPEC section 4)."""
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 import pytest
@@ -376,7 +377,7 @@ def test_generated_taylor_module_is_current():
     from rocking import _make_taylor
 
     assert _make_taylor.TARGET.read_text(encoding="utf-8") == _make_taylor.source(), (
-        "rocking/_taylor_fixed.py is stale: run python rocking/_make_taylor.py")
+        "rocking/_taylor_fixed.pxi is stale: run python rocking/_make_taylor.py")
 
 
 def _one_step_dop853(block, s, u0, u1, h, theta, omega):
@@ -395,7 +396,8 @@ def _one_step_dop853(block, s, u0, u1, h, theta, omega):
 @pytest.mark.parametrize("h", [0.005, 0.02, 0.1])
 def test_taylor_steps_match_an_independent_integrator(h):
     from rocking import engine
-    from rocking._taylor_fixed import ORDERS, taylor_fixed
+    from rocking._core import ORDERS
+    from rocking._core import py_taylor_fixed as taylor_fixed
 
     rng = np.random.default_rng(1)
     size = engine.NMAX + 3
@@ -452,7 +454,8 @@ def test_forcing_series_of_smooth_pulses_matches_the_pulse(shape):
 @pytest.mark.parametrize("shape", ["sine", "ricker-sym", "ricker-anti"])
 def test_unrolled_smooth_pulse_steps_match_the_general_series(shape):
     from rocking import engine
-    from rocking._taylor_fixed import SMOOTH_ORDERS, taylor_smooth
+    from rocking._core import SMOOTH_ORDERS
+    from rocking._core import py_taylor_smooth as taylor_smooth
 
     size = engine.NMAX + 3
     cf, S, C, U = np.zeros(size), np.zeros(size), np.zeros(size), np.zeros(2 * size)
@@ -543,14 +546,22 @@ def test_dop853_tableau_meets_the_order_conditions():
 
 
 def test_compiled_steps_compute_their_python_source():
-    """The unrolled steps are compiled from their Python source by rocking._straight (LLVM
-    instructions emitted statement by statement).  Without fused multiply-adds (the smooth-pulse
-    steps, the lanes) the compiled step must give the plain Python evaluation's bits exactly; the
-    record steps may fuse a multiply into the add that follows (fastmath 'contract'), which
-    changes each operation by at most half an ulp: 1e-15 relative over a step's sums."""
-    from rocking import _taylor_fixed as tf
-    from rocking import _taylor_lanes as tl
+    """The unrolled steps are compiled from the same text as their Python source
+    (rocking._make_taylor, rocking._make_lanes).  Built without fused multiply-adds
+    (``-ffp-contract=off``, setup.py), every compiled step must give the plain Python evaluation's
+    bits exactly; the record steps are compared at 1e-15 relative, the bound that held when the
+    record steps could fuse a multiply into the add that follows (half an ulp per operation)."""
+    from rocking import _core, _make_lanes, _make_taylor
 
+    tf, tl = types.SimpleNamespace(), types.SimpleNamespace()
+    exec(_make_taylor.reference_source(), vars(tf))
+    exec(_make_lanes.reference_source(), vars(tl))
+    tf.taylor_smooth_24 = lambda *a: _core.py_taylor_smooth(24, *a)
+    tf.taylor_16 = lambda *a: _core.py_taylor_fixed(16, *a[:-1])
+    # (the compiled lanes take the rows in the order amp, q, theta, omega, side, s_phi, c_phi,
+    # peak: the order the test's state is written in)
+    tl.lanes_16 = lambda n, uj, duj, state, rows, h, eps, bad: _core.py_lanes_step(
+        16, n, uj, duj, state, h, eps, bad)
     rng = np.random.default_rng(5)
     kept = 0
     for _ in range(50):

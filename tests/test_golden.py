@@ -1,0 +1,116 @@
+"""The compiled core against the answers of the numba engine it replaced (issue 25).
+
+``tests/golden/golden.json`` holds the answers of the engine of commit 4fcd268 (numba) on the
+reference pulses, the hard cases (verge of overturning, Zeno sequences, safe islands, extreme
+slenderness, a 300 s record), batches, real records and the demo, recorded by
+``tests/golden/make_golden.py``; this test runs the same script on the installed package.
+
+Tolerances.  The two engines do the same operations in the same order except that numba fused
+some multiplies and adds in the record steps (half an ulp each), and the compilers' libm may
+differ in the last bit: single steps agree to ~1e-16.  Rocking under a record amplifies such
+differences along the motion (measured: 8e-10 rad after 9 s of a record scaled to overturning,
+2e-14 on the peaks), so histories and times are compared at 1e-8 (rad, s), peaks at 1e-9
+relative, and every verdict (overturning, uplift, model, which rule decided) must be the same.
+Impact counts must be equal, except in the 300 s record's batch, where the count of the tiny hops
+of a block coming to rest is itself chaotic (measured: 884 against 857 for one width, with the
+same peak to the last bit): 5 %.  Critical amplitudes, slenderness transitions and islands are
+bisected on the same verdicts: 1e-9 relative.  Verified widths and critical scales of real
+records: the issue's 0.5 % (measured: identical), with the same number of transitions.  The
+demo's summary: 2e-5 relative (6 significant digits printed).
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import pathlib
+
+import pytest
+
+from .conftest import SHARED_RECORDS
+
+HERE = pathlib.Path(__file__).resolve().parent / "golden"
+GOLDEN = json.loads((HERE / "golden.json").read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def current():
+    spec = importlib.util.spec_from_file_location("make_golden", HERE / "make_golden.py")
+    make_golden = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make_golden)
+    return make_golden.collect(real=SHARED_RECORDS.is_dir())
+
+
+def _close(a, b, *, rel=0.0, abs_=0.0):
+    return a == b or (a is not None and b is not None
+                      and math.isclose(a, b, rel_tol=rel, abs_tol=abs_))
+
+
+def _single(want, got, key):
+    for name in ("overturned", "uplifted", "model", "verdict_by"):
+        assert got[name] == want[name], (key, name)
+    assert _close(want["max_rotation"], got["max_rotation"], rel=1e-9), key
+    slack = 0.05 if key.startswith("long") else 0.0
+    assert abs(got["n_impacts"] - want["n_impacts"]) <= slack * want["n_impacts"], key
+    assert _close(want["t_overturn"], got["t_overturn"], abs_=1e-8), key
+    for name in ("t", "theta", "impacts"):
+        assert len(got[name]) == len(want[name]), (key, name)
+        for a, b in zip(want[name], got[name]):
+            assert _close(a, b, abs_=1e-8), (key, name, a, b)
+
+
+def _batch(want, got, key):
+    assert got["overturned"] == want["overturned"], key
+    assert got["uplifted"] == want["uplifted"], key
+    for a, b in zip(want["max_rotation"], got["max_rotation"]):
+        assert _close(a, b, rel=1e-9), key
+    slack = 0.05 if key.startswith("batch/long") else 0.0
+    for a, b in zip(want["n_impacts"], got["n_impacts"]):
+        assert abs(a - b) <= slack * a, key
+
+
+def _values(want, got, key, rel):
+    if isinstance(want, dict):
+        assert set(got) == set(want), key
+        for k in want:
+            _values(want[k], got[k], key, rel)
+    elif isinstance(want, list):
+        assert len(got) == len(want), key
+        for a, b in zip(want, got):
+            _values(a, b, key, rel)
+    else:
+        assert _close(want, got, rel=rel), (key, want, got)
+
+
+CASES = sorted(k for k in GOLDEN if k != "demo/summary")
+
+
+@pytest.mark.parametrize("key", CASES)
+def test_same_answers_as_the_numba_engine(current, key):
+    want = GOLDEN[key]
+    if key.startswith("real/") and key not in current:
+        pytest.skip(f"real records not available: {SHARED_RECORDS} is absent")
+    got = current[key]
+    if isinstance(want, dict) and "max_rotation" in want:
+        (_batch if isinstance(want["max_rotation"], list) else _single)(want, got, key)
+    elif key.startswith("real/") and key.endswith(("/width", "/critical_scale")):
+        # the answers users see: the issue's 0.5 %, the same transitions found
+        _values(want, got, key, rel=5e-3)
+    else:
+        _values(want, got, key, rel=1e-9)
+
+
+def test_demo_summary_same_as_the_numba_engine(current):
+    want, got = GOLDEN["demo/summary"], current["demo/summary"]
+    assert [r["record"] for r in got] == [r["record"] for r in want]
+    for a, b in zip(want, got):
+        assert set(a) == set(b)
+        for col in a:
+            if col in ("file", "file2"):
+                continue  # where the package's data sits
+            try:
+                x, y = float(a[col]), float(b[col])
+            except ValueError:
+                assert a[col] == b[col], (a["record"], col)
+                continue
+            assert _close(x, y, rel=2e-5), (a["record"], col, a[col], b[col])
