@@ -104,7 +104,8 @@ def test_demo_summary_same_as_the_numba_engine(current):
     want, got = GOLDEN["demo/summary"], current["demo/summary"]
     assert [r["record"] for r in got] == [r["record"] for r in want]
     for a, b in zip(want, got):
-        assert set(a) == set(b)
+        # every column the numba engine reported is still reported (later columns may be added)
+        assert set(a) <= set(b)
         for col in a:
             if col in ("file", "file2"):
                 continue  # where the package's data sits
