@@ -290,10 +290,12 @@ def source() -> str:
     out += [_cython(_fixed_function(n), FIXED_SIGNATURE.format(n=n)) for n in ORDERS]
     out += [RUN_STRUCT] + [RUN_TEMPLATE.format(n=n) for n in ORDERS]
     out += [_cython(_smooth_function(n), SMOOTH_SIGNATURE.format(n=n)) for n in SMOOTH_ORDERS]
-    d = ["\n\ncdef inline (double, double, double, double, int) taylor_fixed(\n"
+    d = ["\n\ncdef (double, double, double, double, int) taylor_fixed(\n"
          "        long order, double u0, double u1, double q, double theta, double wh, double s0,"
          " double c0,\n        double eps, double* cf) noexcept nogil:",
-         '    """The step of ORDERS order ``order`` (the highest for larger), its polynomial stored."""']
+         '    """The step of ORDERS order ``order`` (the highest for larger), its polynomial'
+         ' stored (a\n    function of its own, not inlined: one copy of each step for all its'
+         ' callers)."""']
     for n in ORDERS[:-1]:
         d.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, True)")
     d.append(f"    return taylor_{ORDERS[-1]}(u0, u1, q, theta, wh, s0, c0, eps, cf, True)")
@@ -308,7 +310,7 @@ def source() -> str:
         call = f"fixed_run_{n}({args}, {lower}, low_run, eps, cf, out)"
         d.append(f"    if order <= {n}:\n        return {call}" if i < len(ORDERS) - 1
                  else f"    return {call}")
-    d.append("\n\ncdef inline (double, double, double, double, int) taylor_smooth(\n"
+    d.append("\n\ncdef (double, double, double, double, int) taylor_smooth(\n"
              "        long order, const double* U, double q, double theta, double wh, double s0,"
              " double c0, double eps,\n        double* cf) noexcept nogil:")
     d.append('    """The step of SMOOTH_ORDERS order ``order`` (the highest for larger)."""')

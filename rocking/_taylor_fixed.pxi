@@ -2225,10 +2225,11 @@ cdef inline (double, double, double, double, int) taylor_smooth_24(
     return (c_24 + c_23 + c_22 + c_21 + c_20 + c_19 + c_18 + c_17 + c_16 + c_15 + c_14 + c_13 + c_12 + c_11 + c_10 + c_9 + c_8 + c_7 + c_6 + c_5 + c_4 + c_3 + c_2 + wh + theta, D_24 + D_23 + D_22 + D_21 + D_20 + D_19 + D_18 + D_17 + D_16 + D_15 + D_14 + D_13 + D_12 + D_11 + D_10 + D_9 + D_8 + D_7 + D_6 + D_5 + D_4 + D_3 + D_2 + D_1, S_22 + S_21 + S_20 + S_19 + S_18 + S_17 + S_16 + S_15 + S_14 + S_13 + S_12 + S_11 + S_10 + S_9 + S_8 + S_7 + S_6 + S_5 + S_4 + S_3 + S_2 + S_1 + S_0, C_22 + C_21 + C_20 + C_19 + C_18 + C_17 + C_16 + C_15 + C_14 + C_13 + C_12 + C_11 + C_10 + C_9 + C_8 + C_7 + C_6 + C_5 + C_4 + C_3 + C_2 + C_1 + C_0, flag)
 
 
-cdef inline (double, double, double, double, int) taylor_fixed(
+cdef (double, double, double, double, int) taylor_fixed(
         long order, double u0, double u1, double q, double theta, double wh, double s0, double c0,
         double eps, double* cf) noexcept nogil:
-    """The step of ORDERS order ``order`` (the highest for larger), its polynomial stored."""
+    """The step of ORDERS order ``order`` (the highest for larger), its polynomial stored (a
+    function of its own, not inlined: one copy of each step for all its callers)."""
     if order <= 4:
         return taylor_4(u0, u1, q, theta, wh, s0, c0, eps, cf, True)
     if order <= 6:
@@ -2263,7 +2264,7 @@ cdef inline int fixed_run(long order, const double* uval, double amp, long j, lo
     return fixed_run_16(uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low, True, low_run, eps, cf, out)
 
 
-cdef inline (double, double, double, double, int) taylor_smooth(
+cdef (double, double, double, double, int) taylor_smooth(
         long order, const double* U, double q, double theta, double wh, double s0, double c0, double eps,
         double* cf) noexcept nogil:
     """The step of SMOOTH_ORDERS order ``order`` (the highest for larger)."""
