@@ -1,34 +1,44 @@
-"""Pulse shapes, accelerogram reading and pulse fitting (no dependency on ``rocking``)."""
-from .errors import RecordError
-from .record import G, Record
-from .scenario import VP_TO_AP, design_pulse, pulse_period
-from .io import read_record
-from .sac import write_sac
-from .fit import Candidate, FitError, PulseFit, fit_pulse
-from .shapes import (
-    BETA,
-    SHAPES,
-    AntisymmetricRicker,
-    OneSine,
-    Pulse,
-    Rectangular,
-    SymmetricRicker,
-    make_pulse,
-    shape_class,
-)
+"""Pulse shapes, accelerogram reading and pulse fitting (no dependency on ``rocking``).
 
-__all__ = [
-    "G", "Record", "BETA", "SHAPES", "Pulse", "Rectangular", "OneSine", "SymmetricRicker",
-    "AntisymmetricRicker", "make_pulse", "shape_class",
-    "RecordError", "read_record", "write_sac", "fit_pulse", "FitError", "PulseFit", "Candidate",
-    "design_pulse", "pulse_period", "VP_TO_AP",
-]
+Names are loaded from their modules on first use (PEP 562), so that ``import pulses`` costs
+almost nothing and a program pays for scipy, PyWavelets or obspy only when it reads records,
+fits pulses or classifies them.
+"""
+import importlib
 
-from .velocity import PulseCandidate, PulseClassification, classify_pulse
-from .pairs import Pairing, check_pair, component, pair_files, read_pair, rotate_pair
-from . import peer
-from .peer import PeerDownload
-from .triplets import check_triplet
+#: public name -> the module of this package that defines it
+_WHERE = {
+    "RecordError": "errors",
+    "G": "record", "Record": "record",
+    "VP_TO_AP": "scenario", "design_pulse": "scenario", "pulse_period": "scenario",
+    "read_record": "io",
+    "write_sac": "sac",
+    "Candidate": "fit", "FitError": "fit", "PulseFit": "fit", "fit_pulse": "fit",
+    "BETA": "shapes", "SHAPES": "shapes", "AntisymmetricRicker": "shapes", "OneSine": "shapes",
+    "Pulse": "shapes", "Rectangular": "shapes", "SymmetricRicker": "shapes", "make_pulse": "shapes",
+    "shape_class": "shapes",
+    "PulseCandidate": "velocity", "PulseClassification": "velocity", "classify_pulse": "velocity",
+    "Pairing": "pairs", "check_pair": "pairs", "component": "pairs", "pair_files": "pairs",
+    "read_pair": "pairs", "rotate_pair": "pairs",
+    "PeerDownload": "peer",
+    "check_triplet": "triplets",
+}
+#: submodules that are part of the public namespace
+_MODULES = ("peer",)
 
-__all__ += ["classify_pulse", "PulseClassification", "PulseCandidate", "read_pair", "check_pair",
-            "component", "rotate_pair", "pair_files", "Pairing", "peer", "PeerDownload", "check_triplet"]
+__all__ = sorted(_WHERE) + list(_MODULES)
+
+
+def __getattr__(name):
+    if name in _MODULES:
+        return importlib.import_module(f".{name}", __name__)
+    where = _WHERE.get(name)
+    if where is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{where}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

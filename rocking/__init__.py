@@ -1,26 +1,52 @@
-"""Housner's rocking block: solvers (exact-where-possible, fast, reference) and design."""
-from .block import ALPHA_PLASTIC, Block, eta_housner
-from .design import (
-    CriticalAmplitudes, MinSlenderness, RequiredWidth, critical_amplitudes, envelope_rule, eq20,
-    eq31, min_slenderness, min_slenderness_batch, required_width,
-)
-from .spectrum import OverturningSpectrum, overturning_spectrum, plot_chart, slenderness_chart
+"""Housner's rocking block: solvers (exact-where-possible, fast, reference) and design.
 
-__all__ = ["ALPHA_PLASTIC", "Block", "eta_housner"]
-__all__ += [
-    "eq31", "eq20", "envelope_rule", "min_slenderness", "min_slenderness_batch", "MinSlenderness",
-    "critical_amplitudes", "CriticalAmplitudes", "required_width", "RequiredWidth",
-    "overturning_spectrum", "OverturningSpectrum", "slenderness_chart", "plot_chart",
-]
-from .solver import BatchResult, RockingResult, linear_error_estimate, simulate, simulate_many
+Names are loaded from their modules on first use (PEP 562): ``import rocking`` costs almost
+nothing, and the compiled core, scipy and the design modules load when first asked for.
+"""
+import importlib
+import sys
+import types
 
-__all__ += ["BatchResult", "RockingResult", "linear_error_estimate", "simulate", "simulate_many"]
-from .reference_vertical import VerticalRockingResult, simulate_vertical_reference
+#: public name -> the module of this package that defines it
+_WHERE = {
+    "ALPHA_PLASTIC": "block", "Block": "block", "eta_housner": "block",
+    "CriticalAmplitudes": "design", "MinSlenderness": "design", "RequiredWidth": "design",
+    "critical_amplitudes": "design", "envelope_rule": "design", "eq20": "design", "eq31": "design",
+    "min_slenderness": "design", "min_slenderness_batch": "design", "required_width": "design",
+    "OverturningSpectrum": "spectrum", "overturning_spectrum": "spectrum", "plot_chart": "spectrum",
+    "slenderness_chart": "spectrum",
+    "BatchResult": "solver", "RockingResult": "solver", "linear_error_estimate": "solver",
+    "simulate": "solver", "simulate_many": "solver",
+    "VerticalRockingResult": "reference_vertical",
+    "simulate_vertical_reference": "reference_vertical",
+    "equivalent_size": "frame", "eta_frame": "frame", "frame_p": "frame",
+    "CriticalScale": "fragility", "Fragility": "fragility", "critical_scale": "fragility",
+    "fragility": "fragility",
+}
 
-__all__ += ["VerticalRockingResult", "simulate_vertical_reference"]
-from .frame import equivalent_size, eta_frame, frame_p
+__all__ = sorted(_WHERE)
 
-__all__ += ["equivalent_size", "eta_frame", "frame_p"]
-from .fragility import CriticalScale, Fragility, critical_scale, fragility
 
-__all__ += ["CriticalScale", "Fragility", "critical_scale", "fragility"]
+def __getattr__(name):
+    where = _WHERE.get(name)
+    if where is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{where}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+class _Package(types.ModuleType):
+    def __setattr__(self, name, value):
+        # importing a submodule binds it to the package; where a public function has its module's
+        # name (``fragility``), ``rocking.fragility`` stays the function, as the package documents
+        if isinstance(value, types.ModuleType) and _WHERE.get(name) == name:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
