@@ -40,6 +40,11 @@ DESIGN_COLUMNS = Columns(
     ("verified_adequate", "-", "The column as it stands is at least the verified width (it survives "
                                "with no safe island); blank for `--height`."),
     ("max_theta_ratio", "-", "Largest max|theta|/alpha of the column as it stands over the directions."),
+    ("widest_failing_width_m", "m", "Widest width found to overturn above the verified width by the check "
+                                    "after the search (over the directions; docs/slivers.md); blank where "
+                                    "none was found, which does not prove there is none."),
+    ("survives_vertical", "-", "The column as it stands does not overturn with the record's vertical "
+                               "component too (in any direction of a pair); blank without a vertical."),
 )
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
 
@@ -67,6 +72,21 @@ def _num(value):
     return v if math.isfinite(v) else None
 
 
+def _widest(values, above=None):
+    """The largest of ``values`` if it is above ``above`` (a failing width of one direction below the
+    pair's verified width is no failure of the design), else None."""
+    values = [v for v in map(_num, values) if v is not None]
+    if not values or (above is not None and max(values) <= above):
+        return None
+    return max(values)
+
+
+def _whole(value):
+    """``15`` for the number 15.0 read back from a report (an RSN, a year), else the text."""
+    v = _num(value)
+    return str(int(v)) if v is not None and v == int(v) else str(value)
+
+
 def design_rows(rows, failed=None) -> list[dict]:
     """The rows of ``design.csv`` from the rows of ``summary.csv`` (dicts of typed values) and
     ``failed`` (``{pair: directions that failed}``)."""
@@ -91,6 +111,10 @@ def design_rows(rows, failed=None) -> list[dict]:
                          _bool_all([None if r.get("overturns") is None else not r["overturns"] for r in group])),
             "verified_adequate": _bool_all([r.get("verified_adequate") for r in group]) if block else None,
             "max_theta_ratio": max(ratios) if (block and ratios) else None,
+            "widest_failing_width_m": _widest([r.get("widest_failing_width_m") for r in group],
+                                              above=_num(gov.get("verified_width_m"))),
+            "survives_vertical": (None if not block else _bool_all(
+                [None if r.get("vertical_overturns") is None else not r["vertical_overturns"] for r in group])),
         }))
     return out
 
@@ -130,7 +154,10 @@ def survives_text(row) -> str:
     return "yes" if row.get("verified_adequate") else "yes, safe island"
 
 
-HEADERS = ("record", "column", "pulse-like", "governing pulse", "Eq.31 width", "verified width", "survives")
+HEADERS = ("record", "column", "pulse-like", "governing pulse", "Eq.31 width", "verified width",
+           "fails above", "survives")
+#: the heading of the column added where a run used vertical components
+VERTICAL_HEADER = "with vertical"
 
 
 def table_cells(row) -> tuple[str, ...]:
@@ -142,24 +169,65 @@ def table_cells(row) -> tuple[str, ...]:
     return (name, display(row.get("column") or "-"), _yes(row.get("pulse_like")), pulse_text(row),
             _m(row.get("eq31_width_m")) + (" m" if _num(row.get("eq31_width_m")) is not None else ""),
             _m(row.get("verified_width_m")) + (" m" if _num(row.get("verified_width_m")) is not None else ""),
+            _m(row.get("widest_failing_width_m")) + (" m" if _num(row.get("widest_failing_width_m")) is not None else ""),
             survives_text(row))
 
 
-def table_text(rows, failures=()) -> str:
+def _vertical_text(row) -> str:
+    return _yes(row.get("survives_vertical"), no="NO")
+
+
+def metadata_text(row) -> str | None:
+    """``RSN77 San Fernando 1971, Pacoima Dam: M6.61 Reverse, Rrup 1.8 km, Vs30 2016 m/s; Tp 1.64 s
+    (PEER), 1.64 s (here)`` for a row of a PEER download (``summary.csv``'s ``peer_*``); None otherwise."""
+    if not row.get("peer_rsn"):
+        return None
+    year = _whole(row["peer_year"]) if row.get("peer_year") is not None else ""
+    parts = [f"RSN{_whole(row['peer_rsn'])} {row.get('peer_event') or ''} {year}".rstrip()]
+    if row.get("peer_station"):
+        parts[0] += f", {row['peer_station']}"
+    site = []
+    if _num(row.get("peer_magnitude")) is not None:
+        site.append(f"M{_num(row['peer_magnitude']):.2f}" + (f" {row['peer_mechanism']}" if row.get("peer_mechanism") else ""))
+    for key, label, unit in (("peer_rrup_km", "Rrup", "km"), ("peer_vs30_m_s", "Vs30", "m/s")):
+        if _num(row.get(key)) is not None:
+            site.append(f"{label} {_num(row[key]):g} {unit}")
+    tp = _num(row.get("peer_tp_s"))
+    ours = _num(row.get("velocity_tp_s"))
+    if tp is not None or ours is not None:
+        site.append("velocity pulse Tp " + ("-" if tp is None else f"{tp:.2f} s") + " (PEER), "
+                    + ("-" if ours is None else f"{ours:.2f} s") + " (here)")
+    return display(parts[0] + (": " + ", ".join(site) if site else ""))
+
+
+def table_text(rows, failures=(), summary=()) -> str:
     """The compact table printed at the end of ``pipeline run``: every design row, then every failed
-    record (``failures``: rows of ``failures.csv``) with its reason."""
+    record (``failures``: rows of ``failures.csv``) with its reason, then the search report's
+    metadata of each record of a PEER download (``summary``: rows of ``summary.csv``)."""
+    headers = HEADERS
     body = [table_cells(r) for r in rows]
-    widths = [max([len(h)] + [len(c[i]) for c in body]) for i, h in enumerate(HEADERS)]
-    right = {4, 5}  # widths, aligned on the decimal point
+    if any(r.get("survives_vertical") is not None for r in rows):
+        headers = HEADERS + (VERTICAL_HEADER,)
+        body = [c + (_vertical_text(r),) for c, r in zip(body, rows)]
+    widths = [max([len(h)] + [len(c[i]) for c in body]) for i, h in enumerate(headers)]
+    right = {4, 5, 6}  # widths, aligned on the decimal point
 
     def line(cells):
         return "  ".join(c.rjust(w) if i in right else c.ljust(w)
                          for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
 
-    lines = [line(HEADERS), line(["-" * w for w in widths])]
+    lines = [line(headers), line(["-" * w for w in widths])]
     lines += [line(c) for c in body]
     for f in failures:
         lines.append(f"{display(f['record'])}  failed ({f['stage']}): {' '.join(display(f['reason']).split())}")
+    seen = {}
+    for r in summary:
+        text = metadata_text(r)
+        if text:
+            seen.setdefault(r.get("pair") or r.get("record"), text)
+    if seen:
+        lines.append("")
+        lines += [f"{display(name)}: {text}" for name, text in seen.items()]
     return "\n".join(lines) + "\n"
 
 

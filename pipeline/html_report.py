@@ -17,7 +17,7 @@ import pathlib
 import urllib.parse
 
 from . import report
-from .design_table import pulse_text, survives_text
+from .design_table import metadata_text, pulse_text, survives_text
 
 #: the file in ``--out``
 REPORT_HTML = "report.html"
@@ -120,9 +120,11 @@ def _anchor(record_id) -> str:
 
 def _batch_table(design, anchors) -> list[str]:
     directions = any(r["direction_deg"] is not None for r in design)  # pairs in the run
+    vertical = any(r.get("survives_vertical") is not None for r in design)  # verticals in the run
     heads = ["record", "column"] + (["direction (deg)"] if directions else []) + [
         "pulse-like", "velocity Tp (s)", "governing pulse", "ap (g)", "Tp (s)", "Eq. 31 width (m)",
-        "verified width (m)", "width (m)", "survives", "max theta/alpha"]
+        "verified width (m)", "widest failing width (m)", "width (m)", "survives"] + (
+        ["with vertical"] if vertical else []) + ["max theta/alpha"]
     out = ['<div class="wide"><table class="sortable" id="batch"><thead><tr>'
            + "".join(f"<th>{_e(h)}</th>" for h in heads) + "</tr></thead><tbody>"]
     for r in design:
@@ -143,8 +145,10 @@ def _batch_table(design, anchors) -> list[str]:
             + _cell(r["governing_tp_s"], _fixed(r["governing_tp_s"], 3), numeric=True)
             + _cell(r["eq31_width_m"], _fixed(r["eq31_width_m"]), numeric=True)
             + _cell(r["verified_width_m"], _fixed(r["verified_width_m"]), numeric=True)
+            + _cell(r.get("widest_failing_width_m"), _fixed(r.get("widest_failing_width_m")), numeric=True)
             + _cell(r["width_m"], _fixed(r["width_m"]), numeric=True)
             + _cell(surv if r["survives"] is not None else None, surv)
+            + (_cell(r.get("survives_vertical"), _yes(r.get("survives_vertical"))) if vertical else "")
             + _cell(r["max_theta_ratio"], _fixed(r["max_theta_ratio"]), numeric=True)
             + "</tr>")
     out.append("</tbody></table></div>")
@@ -156,6 +160,8 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
     out = [f'<section class="rec" id="{anchor}"><h3>{_e(rid)}</h3>']
     if first:
         facts = [("file", first.get("file"))]
+        if metadata_text(first):
+            facts.append(("PEER search report", metadata_text(first)))
         if first.get("file2"):
             facts.append(("second component", first.get("file2")))
         if first.get("direction_deg") is not None:
@@ -181,6 +187,11 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
                      f"verified width {_fixed(r.get('verified_width_m')) or '-'} m"]
+            if r.get("check_runs"):
+                share = _num(r.get("failing_share"))
+                parts.append(f"check above it: {r.get('check_runs')} widths, "
+                             + (f"{100 * share:.2g} % overturn, the widest at "
+                                f"{_fixed(r.get('widest_failing_width_m'))} m" if share else "none overturns"))
             if r.get("column_kind") == "block":
                 surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
                                       "verified_adequate": r.get("verified_adequate")})
@@ -188,6 +199,11 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                            "yes, safe island": "survives on a safe island (narrower than the verified width)"}
                 parts.append(f"as it stands: {verdict.get(surv, surv)}, max theta/alpha "
                              f"{_fixed(r.get('max_theta_ratio')) or '-'}")
+                if r.get("vertical_overturns") is not None:
+                    parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): "
+                                 + ("overturns" if r["vertical_overturns"] else "survives")
+                                 + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}"
+                                 + (" (the block lifts off the ground)" if r.get("vertical_lifts_off") else ""))
             out.append(f"<li>{_e('; '.join(parts))}</li>")
         out.append("</ul>")
     if failure:

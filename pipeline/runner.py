@@ -611,10 +611,15 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
+        if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
+            groups = {site.pair_of(t) for t in tasks}
+            msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
+                   f"records or pairs processed in every direction ({summary.n_ok} of "
+                   f"{summary.n_records} tasks)")
         msg += f" ({n_reused} reused from an earlier run, {len(todo)} computed)"
         if n_failed:
             msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
-        print(design_table.table_text(design, failures), end="")
+        print(design_table.table_text(design, failures, rows), end="")
         print(f"{msg}; reports in {report.display(out)}")
     return summary
 

@@ -220,12 +220,14 @@ def test_vertical_polarity_is_never_guessed(tmp_path, name, component, expected)
 
 # -- pipeline run on the shared download -------------------------------------------------------------
 @pytest.mark.parametrize("as_zip", [False, True], ids=["folder", "zip"])
-def test_pipeline_run_on_the_shared_download(download, download_zip, tmp_path, as_zip):
+def test_pipeline_run_on_the_shared_download(download, download_zip, tmp_path, as_zip, capsys):
     """The floor: one pair row per complete record, the metadata columns equal to the report's,
     the missing records in failures.csv with the files they lack, exit status 1."""
     source = download_zip if as_zip else download
     out = tmp_path / "out"
-    assert main(["run", str(source), *RUN_ARGS, "--out", str(out)]) == 1
+    loud = [a for a in RUN_ARGS if a != "--quiet"]  # the table is printed unless --quiet
+    assert main(["run", str(source), *loud, "--out", str(out)]) == 1
+    printed = capsys.readouterr().out
     pairs = list(csv.DictReader(open(out / "pairs.csv")))
     assert sorted(int(r["peer_rsn"]) for r in pairs) == sorted(COMPLETE)
     ref = reference_table(download).set_index("Record Sequence Number")
@@ -248,6 +250,14 @@ def test_pipeline_run_on_the_shared_download(download, download_zip, tmp_path, a
     rsn77 = [r for r in pairs if r["peer_rsn"] == "77"][0]
     assert float(rsn77["peer_tp_s"]) == 1.638
     assert abs(float(rsn77["velocity_tp_s"]) - 1.638) < 0.05
+    # the printed summary and report.html say which earthquake, where, and PEER's Tp beside ours
+    # (the report's values: RSN 77 is San Fernando 1971, M 6.61, Rrup 1.81 km, Tp 1.638 s)
+    line77 = [ln for ln in printed.splitlines() if ln.startswith("RSN77_") and ": RSN77 " in ln]
+    assert len(line77) == 1, printed
+    assert "San Fernando 1971" in line77[0] and "M6.61" in line77[0] and "Rrup 1.81 km" in line77[0]
+    assert "Tp 1.64 s (PEER)" in line77[0]
+    page = (out / "report.html").read_text()
+    assert "RSN77 San Fernando 1971" in page and "Tp 1.64 s (PEER)" in page
     # every row of summary.csv carries the metadata too
     summary = list(csv.DictReader(open(out / "summary.csv")))
     assert {r["peer_rsn"] for r in summary} == {str(k) for k in COMPLETE}
