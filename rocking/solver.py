@@ -204,10 +204,14 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         Fast engine only: largest ``p_eff * h`` of a step (default :data:`PH_MAX`, or
         :data:`PH_MAX_RK4` for ``method="rk4"``); smaller means more sub-steps per sample.
     vertical : pulses.Record, optional
-        Upward ground acceleration (m/s^2) on the excitation's time axis (docs/theory.md section
-        10).  The compiled engine does not take it yet: the response is the reference model's
-        (:func:`rocking.simulate_vertical_reference`, ``model="reference-vertical"``, slow), with
-        ``lifts_off`` where ``g + av < 0``.
+        Upward ground acceleration (m/s^2) on the excitation's time axis (a PEER ``DWN`` file
+        negated first), docs/theory.md section 10.  The compiled engine takes it (model
+        ``"fast-vertical"``, Taylor steps; the result is a
+        :class:`rocking.reference_vertical.VerticalRockingResult` with ``lifts_off`` and
+        ``t_lift_off``: where ``g + av < 0`` the block leaves the ground and the run stops
+        there); ``model="reference"`` answers with the independent reference integrator
+        (:func:`rocking.simulate_vertical_reference`, ``"reference-vertical"``, slow).  Records
+        only, the block starting at rest; not with ``model="linear"``.
 
     Returns
     -------
@@ -219,7 +223,14 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
                                     "and the block at rest")
         from .reference_vertical import simulate_vertical_reference
 
-        return simulate_vertical_reference(block, excitation, vertical, duration=duration, zeno_tol=zeno_tol)
+        if model == "reference":
+            return simulate_vertical_reference(block, excitation, vertical, duration=duration,
+                                               zeno_tol=zeno_tol)
+        if model not in ("auto", "fast") or method != "taylor":
+            raise RockingInputError("simulate: with a vertical record the model is 'fast' (Taylor "
+                                    "steps) or 'reference'")
+        return _simulate_vertical(block, excitation, vertical, duration, history, zeno_tol,
+                                  ph_max if ph_max is not None else PH_MAX)
     if not isinstance(block, Block):
         raise TypeError("block must be a rocking.Block")
     for name, value in (("theta0", theta0), ("omega0", omega0)):
@@ -299,12 +310,13 @@ def _never_uplifts(block, excitation, duration, history):
 
 
 def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_tol,
-              stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX):
+              stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX, vertical=None):
     if grid.lazy is not None:
         h = grid.lazy[3]
     else:
         h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
-    n_sub = _n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else ph_max)
+    g_max = 1.0 if vertical is None else vertical[2]  # largest effective gravity over g
+    n_sub = _n_sub(h, block.p * math.sqrt(g_max + grid.u_peak), 0.05 if linear else ph_max)
     if linear and grid.kind in (engine.NODAL, engine.RECT, engine.FREE):
         n_sub = 1  # exact for forcing linear on each interval
     if grid.lazy is not None or (grid.kind == engine.FREE and grid.n_int > PART_INTERVALS):
@@ -318,11 +330,12 @@ def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_t
             engine.Settings(linear, method, zeno_tol, stop_at_rest, history),
             (hist_t, hist_th, hist_om))
     start = engine.Start(0, theta0, omega0, -math.inf)
-    out = engine.run(*args, impacts, start)
+    vert = None if vertical is None else vertical[:2]
+    out = engine.run(*args, impacts, start, vert)
     status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
-        out = engine.run(*args, impacts, start)
+        out = engine.run(*args, impacts, start, vert)
         status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if history:
         hist_t, hist_th, hist_om = hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist]
@@ -462,6 +475,44 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
             t, th, om = (np.concatenate([a, b[1:]]) for a, b in ((t, t2), (th, th2), (om, om2)))
     return _result(block, over, max_abs, impacts, n_imp, t, th, om, name, verdict_by, uplifted,
                    t_over)
+
+
+def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_max):
+    """The compiled engine under horizontal ``record`` and upward ``vertical`` (docs/theory.md
+    section 10): model ``"fast-vertical"``."""
+    from .reference_vertical import VerticalRockingResult, check_axes
+
+    if not isinstance(block, Block):
+        raise TypeError("block must be a rocking.Block")
+    if not isinstance(vertical, Record):
+        raise RockingInputError("simulate: vertical must be a pulses.Record, got "
+                                f"{type(vertical).__name__}")
+    if duration is not None and not (math.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be positive and finite, got {duration!r}")
+    vertical = check_axes(record, vertical)
+    grid = _grid(record, block.p, False, duration, ph_max)
+    vval = vertical.acc
+    g_min = 1.0 + float(np.min(vval[:grid.n_int + 1])) / G
+    g_max = max(1.0, 1.0 + float(np.max(vval[:grid.n_int + 1])) / G)
+    res = _run_grid(grid, block, 0.0, 0.0, False, history, zeno_tol, method=engine.TAYLOR,
+                    ph_max=ph_max, vertical=(vval, 1.0 / G, g_max))
+    status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
+    t_over, t_lift, lifts = math.nan, math.nan, status == engine.LIFTOFF
+    if status == engine.OVERTURNED:
+        over, verdict_by, t_over = True, "integration", t_end
+    elif lifts:
+        # the block leaves the ground: the model ends there (overturned: not before it)
+        over, verdict_by, t_lift = False, "lifts off", t_end
+    elif status == engine.REST:
+        over, verdict_by = False, "integration"
+    else:  # after the records the vertical is zero: the energy rule as without it
+        over, peak = engine.energy_verdict(theta, omega, block.p, block.alpha, block.eta, False)
+        verdict_by = "energy rule"
+        max_abs = math.pi / 2 if over else max(max_abs, peak)
+    out = _result(block, over, max_abs, impacts, n_imp, t, th, om, "fast-vertical", verdict_by,
+                  uplifted, t_over)
+    return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__},
+                                 lifts_off=lifts, t_lift_off=t_lift, min_effective_gravity=g_min)
 
 
 # --------------------------------------------------------------------------- batch
