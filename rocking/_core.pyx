@@ -1695,6 +1695,31 @@ def abs_max(const double[::1] a):
     return max(max(m0, m1), max(m2, m3))
 
 
+def vertical_bounds(const double[::1] uval, const double[::1] vval, double amp, double vamp,
+                    double tan_a, long n):
+    """One pass over the first ``n`` nodes of a record and its vertical (docs/theory.md section
+    10): ``(quiet, g_min, g_max, zero)``: whether ``|amp u| <= (1 + vamp v) tan_a`` at every node
+    (then, both being linear between nodes, the block never uplifts and never lifts off), the
+    smallest and largest effective gravity ``1 + vamp v``, and whether the vertical is zero."""
+    cdef double g_min = INFINITY, g_max = -INFINITY, g
+    cdef bint quiet = True, zero = True
+    cdef Py_ssize_t i
+    if n > uval.shape[0] or n > vval.shape[0] or n < 1:
+        raise ValueError("fewer node values than asked for")
+    with nogil:
+        for i in range(n):
+            g = 1.0 + vamp * vval[i]
+            if vval[i] != 0.0:
+                zero = False
+            if g < g_min:
+                g_min = g
+            if g > g_max:
+                g_max = g
+            if fabs(amp * uval[i]) > g * tan_a:
+                quiet = False
+    return bool(quiet), g_min, g_max, bool(zero)
+
+
 def py_forcing_series(int kind, double amp, double tp, double t0, const double[::1] uval, long j,
                       double ta, double tb, double t, double h, double[::1] U, long n_terms):
     cdef Forcing F

@@ -230,7 +230,7 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
             raise RockingInputError("simulate: with a vertical record the model is 'fast' (Taylor "
                                     "steps) or 'reference'")
         return _simulate_vertical(block, excitation, vertical, duration, history, zeno_tol,
-                                  ph_max if ph_max is not None else PH_MAX)
+                                  ph_max, model, tol)
     if not isinstance(block, Block):
         raise TypeError("block must be a rocking.Block")
     for name, value in (("theta0", theta0), ("omega0", omega0)):
@@ -477,9 +477,10 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
                    t_over)
 
 
-def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_max):
+def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_max, model, tol):
     """The compiled engine under horizontal ``record`` and upward ``vertical`` (docs/theory.md
-    section 10): model ``"fast-vertical"``."""
+    section 10): model ``"fast-vertical"``.  A vertical that is zero over the run is no vertical:
+    the horizontal-only model answers (its result bit for bit, its ``model`` named)."""
     from .reference_vertical import VerticalRockingResult, check_axes
 
     if not isinstance(block, Block):
@@ -490,10 +491,20 @@ def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be positive and finite, got {duration!r}")
     vertical = check_axes(record, vertical)
-    grid = _grid(record, block.p, False, duration, ph_max)
-    vval = vertical.acc
-    g_min = 1.0 + float(np.min(vval[:grid.n_int + 1])) / G
-    g_max = max(1.0, 1.0 + float(np.max(vval[:grid.n_int + 1])) / G)
+    grid = _grid(record, block.p, False, duration, PH_MAX if ph_max is None else ph_max)
+    vval = engine.as_input(vertical.acc)
+    quiet, g_min, g_max, zero = engine.vertical_bounds(record.acc, vval, 1.0 / G, 1.0 / G,
+                                                       block.tan_alpha, grid.n_int + 1)
+    if zero:
+        out = simulate(block, record, duration=duration, model=model, tol=tol, history=history,
+                       zeno_tol=zeno_tol, ph_max=ph_max)
+        return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__})
+    if quiet:  # |ag| <= (g + av) tan(alpha) at every sample: no uplift, no lift-off
+        out = _never_uplifts(block, record, duration, history)
+        return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__},
+                                     min_effective_gravity=g_min)
+    ph_max = PH_MAX if ph_max is None else ph_max
+    g_max = max(1.0, g_max)
     res = _run_grid(grid, block, 0.0, 0.0, False, history, zeno_tol, method=engine.TAYLOR,
                     ph_max=ph_max, vertical=(vval, 1.0 / G, g_max))
     status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
