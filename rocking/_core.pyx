@@ -1597,21 +1597,27 @@ cdef void _one_by_one(long i0, long i1, int kind, const double* amp, double tp, 
                       double h, long n_int, const int64_t* n_sub, const double* p,
                       const double* alpha, const double* eta, bint linear, double zeno_tol,
                       int method, unsigned char* overturned, double* max_abs,
-                      int64_t* n_impacts, unsigned char* uplifted) noexcept nogil:
-    """Runs ``i0 .. i1-1`` from rest one by one with :func:`run_core`, then the energy rule."""
+                      int64_t* n_impacts, unsigned char* uplifted, const double* vval,
+                      double* t_lift) noexcept nogil:
+    """Runs ``i0 .. i1-1`` from rest one by one with :func:`run_core`, then the energy rule.
+    ``vval`` (or NULL): the vertical ground motion's node values, scaled as the record
+    (``1 + amp * vval``); ``t_lift`` (with it): the lift-off time of each run (nan if none)."""
     cdef Forcing F
     cdef Outcome o
     cdef long i
     cdef bint over
     cdef double mx, peak
     F.kind, F.tp, F.t0, F.uval = kind, tp, t0, uval
-    F.vval, F.vamp = NULL, 0.0
+    F.vval, F.vamp = vval, 0.0
     for i in range(i0, i1):
         F.amp = amp[i]
+        F.vamp = amp[i]
         o = run_core(&F, t_start, h, n_sub[i], nodes, uniform, p[i], alpha[i], eta[i], linear,
                      method, zeno_tol, False, False, 0, 0.0, 0.0, -INFINITY, n_int, NULL, NULL,
                      NULL, NULL, 0)
         mx = o.max_abs
+        if t_lift != NULL:
+            t_lift[i] = o.t if o.status == LIFTOFF else NAN
         if o.status == OVERTURNED:
             over = True
         elif o.status == ROCKING:
@@ -1631,12 +1637,17 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
            const int64_t[::1] n_sub, const double[::1] p, const double[::1] alpha,
            const double[::1] eta, bint linear, double zeno_tol, int method,
            unsigned char[::1] overturned, double[::1] max_abs, int64_t[::1] n_impacts,
-           unsigned char[::1] uplifted, int64_t[::1] stats):
+           unsigned char[::1] uplifted, int64_t[::1] stats, const double[::1] vval=None,
+           double[::1] t_lift=None):
     """Runs ``i0 .. i1-1`` of a batch from rest, then the energy rule; results written at their
     indices (``overturned`` and ``uplifted`` as bytes 0 or 1).  ``lanes``: stepped together (at
     most :data:`LANES` runs; a record on a uniform grid, one Taylor step per sample), else one by
     one with :func:`run_core`.  Runs without the GIL: :func:`rocking.lanes.run_batch` spreads
-    calls over threads."""
+    calls over threads.  ``vval``: the vertical ground motion's node values (one by one only,
+    records on a uniform grid, Taylor steps; scaled as the record), with ``t_lift`` the lift-off
+    time of each run (nan if none)."""
+    cdef const double* vval_p = NULL
+    cdef double* t_lift_p = NULL
     cdef const double* uval_p = _ptr(uval)
     cdef const double* nodes_p = _ptr(nodes)
     cdef bint uniform = nodes.shape[0] == 0
@@ -1650,6 +1661,15 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
         raise ValueError("the node values are fewer than the intervals run")
     if not uniform and nodes.shape[0] < n_int + 1:
         raise ValueError("the node times are fewer than the intervals run")
+    if vval is not None:
+        if lanes or kind != NODAL or not uniform or linear or method != TAYLOR:
+            raise ValueError("vertical ground motion: records on a uniform grid, one by one, "
+                             "Taylor steps of the nonlinear equation only")
+        if vval.shape[0] < n_int + 1 or t_lift is None or t_lift.shape[0] < p.shape[0]:
+            raise ValueError("the vertical node values are fewer than the intervals run, or no "
+                             "room for the lift-off times")
+        vval_p = &vval[0]
+        t_lift_p = &t_lift[0]
     if i1 <= i0:
         return
     with nogil:
@@ -1659,7 +1679,8 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
         else:
             _one_by_one(i0, i1, kind, &amp[0], tp, t0, uval_p, nodes_p, uniform, t_start, h,
                         n_int, &n_sub[0], &p[0], &alpha[0], &eta[0], linear, zeno_tol, method,
-                        &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0])
+                        &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0], vval_p,
+                         t_lift_p)
 
 
 # --------------------------------------------------------------------------- from Python

@@ -15,6 +15,7 @@ integration (unless a longer ``duration`` is asked for, to draw the free rocking
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -27,7 +28,7 @@ from .block import Block
 from ._common import (ZENO_TOL, BatchResult, RockingResult, _free_rocking_horizon,
                       _pulse_extrema, _result)
 from .errors import RockingInputError
-from .lanes import run_lanes, run_many
+from .lanes import run_batch, run_lanes, run_many
 
 #: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
 #: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  The Taylor
@@ -560,7 +561,8 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lane
 
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor",
-                  threads: int | None = None, lanes: bool = True) -> BatchResult:
+                  threads: int | None = None, lanes: bool = True,
+                  vertical: Record | None = None) -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
 
     Parameters
@@ -582,6 +584,11 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     lanes : bool
         True: runs under a record go through the batch engine's lanes where they apply; False:
         every run one by one (the same answers; to compare their speed).
+    vertical : pulses.Record, optional
+        Upward ground acceleration (m/s^2) on the record's time axis, scaled with it
+        (docs/theory.md section 10): the runs go one by one through the compiled engine (model
+        ``"fast-vertical"``; Taylor steps) and the result has ``lifts_off`` and ``t_lift_off``.
+        A zero vertical is no vertical (the horizontal-only batch, bit for bit).
 
     Returns
     -------
@@ -591,6 +598,24 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     """
     if model not in ("fast", "linear"):
         raise ValueError("simulate_many supports model='fast' or 'linear'")
+    vval = None
+    if vertical is not None:
+        from .reference_vertical import check_axes
+
+        if not isinstance(excitation, Record) or not isinstance(vertical, Record):
+            raise RockingInputError("simulate_many: a vertical record goes with a horizontal "
+                                    "pulses.Record")
+        if model != "fast" or method != "taylor":
+            raise RockingInputError("simulate_many: with a vertical record the model is 'fast' "
+                                    "with Taylor steps")
+        vval = engine.as_input(check_axes(excitation, vertical).acc)
+        _, g_min, g_max, zero = engine.vertical_bounds(excitation.acc, vval, 1.0 / G, 1.0 / G,
+                                                       0.0, excitation.npts)
+        if zero:
+            out = simulate_many(blocks, excitation, scales, grid=grid, model=model,
+                                method=method, threads=threads, lanes=lanes)
+            none = np.zeros(out.overturned.shape, dtype=bool)
+            return dataclasses.replace(out, lifts_off=none, t_lift_off=np.full(none.shape, np.nan))
     linear = model == "linear"
     blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
     p = np.array([b.p for b in blocks], dtype=float)
@@ -617,10 +642,22 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
             f"than a batch holds ({PART_INTERVALS}); run its blocks one by one with simulate")
     amp = g.amp * scales
     h = g.h if g.nodes.size == 0 else float(np.max(np.diff(g.nodes)))
-    p_eff = p * np.sqrt(1.0 + g.u_peak * np.abs(scales))
+    g_hi = 1.0
+    if vval is not None:  # the largest effective gravity of each run (the vertical scaled too)
+        g_hi = np.maximum(1.0, np.maximum(1.0 + scales * (g_max - 1.0), 1.0 + scales * (g_min - 1.0)))
+    p_eff = p * np.sqrt(g_hi + g.u_peak * np.abs(scales))
     n_sub = _n_sub(h, p_eff, 0.05 if linear else ph_max)
     if linear and g.kind in (engine.NODAL, engine.RECT):
         n_sub[:] = 1
+    if vval is not None:
+        over, max_abs, n_imp, up, t_lift = run_batch(
+            False, g.kind, amp, g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h, g.n_int, n_sub, p,
+            alpha, eta, False, ZENO_TOL, stepper, threads, vval=vval)
+        lifts = ~np.isnan(t_lift)
+        return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
+                           max_abs.reshape(shape), (max_abs / alpha).reshape(shape),
+                           n_imp.reshape(shape), up.reshape(shape), "fast-vertical",
+                           lifts.reshape(shape), t_lift.reshape(shape))
     over, max_abs, n_imp, up = _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads,
                                           lanes)
     ratio = max_abs / alpha

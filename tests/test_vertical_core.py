@@ -203,3 +203,42 @@ def test_real_three_component_records_agree_with_the_reference(name, files, widt
         assert abs(res.max_rotation - ref.max_rotation) <= TOL_ALPHA * block.alpha, w
         verdicts.add(res.overturned)
     assert verdicts == {True, False}  # each record's widths straddle overturning
+
+
+def test_batch_with_a_vertical_is_the_single_runs():
+    """simulate_many(..., vertical=) runs each block by the same engine as simulate: unscaled the
+    same numbers bit for bit; scaled, the single run takes the scaled records (m/s^2 multiplied
+    first, then over g, where the batch multiplies by scale/g): rounding differences only, which
+    chaotic rocking may grow but far below the floor of 1e-6 of alpha."""
+    rec = record(seed=4, ap_g=0.45)
+    up = pulses.Record(0.5 * G * np.sin(2 * math.pi * 1.7 * rec.time + 0.3), rec.dt)
+    blocks = [rocking.Block.from_dimensions(3.0, w) for w in np.linspace(0.45, 1.4, 8)]
+    scales = [1.0, 0.8, 1.25]
+    batch = rocking.simulate_many(blocks, rec, scales, grid=True, vertical=up)
+    assert batch.model == "fast-vertical" and batch.lifts_off.shape == (8, 3)
+    assert batch.overturned.any() and not batch.overturned.all()
+    for i, block in enumerate(blocks):
+        for k, s in enumerate(scales):
+            one = rocking.simulate(block, rec.scaled(s), vertical=up.scaled(s), history=False)
+            assert (one.overturned, one.lifts_off) == (batch.overturned[i, k], batch.lifts_off[i, k])
+            if s == 1.0:
+                assert one.max_rotation == batch.max_rotation[i, k]
+            assert abs(one.max_rotation - batch.max_rotation[i, k]) <= TOL_ALPHA * block.alpha
+    # 1.25 x 0.5 g: no lift-off; a vertical of 2.5 g lifts every block off, at the same time
+    lifted = rocking.simulate_many(blocks, rec, 5.0, vertical=up)
+    one = rocking.simulate(blocks[0], rec.scaled(5.0), vertical=up.scaled(5.0))
+    assert lifted.lifts_off.all() and one.lifts_off
+    assert np.all(np.abs(lifted.t_lift_off - one.t_lift_off) <= 1e-12)
+
+
+def test_batch_with_a_zero_vertical_is_the_horizontal_batch():
+    rec = record()
+    blocks = [rocking.Block.from_dimensions(3.0, w) for w in np.linspace(0.45, 1.4, 8)]
+    hor = rocking.simulate_many(blocks, rec)
+    ver = rocking.simulate_many(blocks, rec, vertical=pulses.Record(np.zeros(rec.npts), rec.dt))
+    np.testing.assert_array_equal(ver.max_rotation, hor.max_rotation)
+    np.testing.assert_array_equal(ver.overturned, hor.overturned)
+    assert not ver.lifts_off.any()
+    with pytest.raises(rocking.errors.RockingInputError):
+        rocking.simulate_many(blocks, rec, vertical=pulses.Record(np.ones(rec.npts), rec.dt),
+                              model="linear")
