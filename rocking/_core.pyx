@@ -1719,26 +1719,25 @@ def abs_max(const double[::1] a):
 def vertical_bounds(const double[::1] uval, const double[::1] vval, double amp, double vamp,
                     double tan_a, long n):
     """One pass over the first ``n`` nodes of a record and its vertical (docs/theory.md section
-    10): ``(quiet, g_min, g_max, zero)``: whether ``|amp u| <= (1 + vamp v) tan_a`` at every node
-    (then, both being linear between nodes, the block never uplifts and never lifts off), the
-    smallest and largest effective gravity ``1 + vamp v``, and whether the vertical is zero."""
-    cdef double g_min = INFINITY, g_max = -INFINITY, g
-    cdef bint quiet = True, zero = True
+    10): ``(quiet, g_min, g_max, zero, u_max)``: whether ``|amp u| <= (1 + vamp v) tan_a`` at
+    every node (then, both being linear between nodes, the block never uplifts and never lifts
+    off), the smallest and largest effective gravity ``1 + vamp v``, whether the vertical is zero,
+    and ``max |u|`` (the record's peak, unscaled)."""
+    cdef double v_min = INFINITY, v_max = -INFINITY, excess = -INFINITY, u_max = 0.0, v, u, e
     cdef Py_ssize_t i
     if n > uval.shape[0] or n > vval.shape[0] or n < 1:
         raise ValueError("fewer node values than asked for")
     with nogil:
-        for i in range(n):
-            g = 1.0 + vamp * vval[i]
-            if vval[i] != 0.0:
-                zero = False
-            if g < g_min:
-                g_min = g
-            if g > g_max:
-                g_max = g
-            if fabs(amp * uval[i]) > g * tan_a:
-                quiet = False
-    return bool(quiet), g_min, g_max, bool(zero)
+        for i in range(n):  # branch-free running extrema
+            v = vval[i]
+            u = fabs(uval[i])
+            v_min = v if v < v_min else v_min
+            v_max = v if v > v_max else v_max
+            u_max = u if u > u_max else u_max
+            e = fabs(amp) * u - (1.0 + vamp * v) * tan_a
+            excess = e if e > excess else excess
+    return (bool(excess <= 0.0), 1.0 + vamp * (v_min if vamp >= 0 else v_max),
+            1.0 + vamp * (v_max if vamp >= 0 else v_min), v_min == 0.0 and v_max == 0.0, u_max)
 
 
 def py_forcing_series(int kind, double amp, double tp, double t0, const double[::1] uval, long j,

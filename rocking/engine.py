@@ -153,10 +153,10 @@ def run(forcing, uval, grid, nodes, n_int, block, settings, history, impacts, st
 
 
 def vertical_bounds(uval, vval, amp, vamp, tan_alpha, n):
-    """``(quiet, g_min, g_max, zero)`` of the first ``n`` nodes of a record (``amp * uval`` =
-    ``ug''/g``) and its vertical (``1 + vamp * vval`` = ``1 + av/g``), in one compiled pass:
+    """``(quiet, g_min, g_max, zero, u_max)`` of the first ``n`` nodes of a record (``amp * uval``
+    = ``ug''/g``) and its vertical (``1 + vamp * vval`` = ``1 + av/g``), in one compiled pass:
     no node past the uplift threshold ``(1 + av/g) tan(alpha)`` (nor, then, any lift-off), the
-    smallest and largest effective gravity, and whether the vertical is zero."""
+    smallest and largest effective gravity, whether the vertical is zero, and ``max|uval|``."""
     return _core.vertical_bounds(as_input(uval), as_input(vval), float(amp), float(vamp),
                                  float(tan_alpha), int(n))
 

@@ -29,6 +29,7 @@ from ._common import (ZENO_TOL, BatchResult, RockingResult, _free_rocking_horizo
                       _pulse_extrema, _result)
 from .errors import RockingInputError
 from .lanes import run_batch, run_lanes, run_many
+from .reference_vertical import VerticalRockingResult, check_axes, simulate_vertical_reference
 
 #: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
 #: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  The Taylor
@@ -222,8 +223,6 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         if not isinstance(excitation, Record) or theta0 != 0.0 or omega0 != 0.0:
             raise RockingInputError("simulate: a vertical record goes with a horizontal pulses.Record "
                                     "and the block at rest")
-        from .reference_vertical import simulate_vertical_reference
-
         if model == "reference":
             return simulate_vertical_reference(block, excitation, vertical, duration=duration,
                                                zeno_tol=zeno_tol)
@@ -482,8 +481,6 @@ def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_
     """The compiled engine under horizontal ``record`` and upward ``vertical`` (docs/theory.md
     section 10): model ``"fast-vertical"``.  A vertical that is zero over the run is no vertical:
     the horizontal-only model answers (its result bit for bit, its ``model`` named)."""
-    from .reference_vertical import VerticalRockingResult, check_axes
-
     if not isinstance(block, Block):
         raise TypeError("block must be a rocking.Block")
     if not isinstance(vertical, Record):
@@ -492,19 +489,24 @@ def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be positive and finite, got {duration!r}")
     vertical = check_axes(record, vertical)
-    grid = _grid(record, block.p, False, duration, PH_MAX if ph_max is None else ph_max)
+    n = record.npts if duration is None else min(record.npts,
+                                                 max(1, math.ceil(duration / record.dt - 1e-9)) + 1)
     vval = engine.as_input(vertical.acc)
-    quiet, g_min, g_max, zero = engine.vertical_bounds(record.acc, vval, 1.0 / G, 1.0 / G,
-                                                       block.tan_alpha, grid.n_int + 1)
+    quiet, g_min, g_max, zero, u_max = engine.vertical_bounds(record.acc, vval, 1.0 / G, 1.0 / G,
+                                                              block.tan_alpha, n)
     if zero:
         out = simulate(block, record, duration=duration, model=model, tol=tol, history=history,
                        zeno_tol=zeno_tol, ph_max=ph_max)
         return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__})
     if quiet:  # |ag| <= (g + av) tan(alpha) at every sample: no uplift, no lift-off
-        out = _never_uplifts(block, record, duration, history)
-        return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__},
+        start, end = record.support
+        t = np.array([start, end if duration is None else start + duration]) if history else \
+            np.zeros(0)
+        return VerticalRockingResult(False, False, 0.0, 0.0, np.zeros(0), 0, t, np.zeros_like(t),
+                                     np.zeros_like(t), "rest", "no uplift", False, block=block,
                                      min_effective_gravity=g_min)
     ph_max = PH_MAX if ph_max is None else ph_max
+    grid = _grid(record, block.p, False, duration, ph_max, u_max)
     g_max = max(1.0, g_max)
     res = _run_grid(grid, block, 0.0, 0.0, False, history, zeno_tol, method=engine.TAYLOR,
                     ph_max=ph_max, vertical=(vval, 1.0 / G, g_max))
@@ -521,10 +523,12 @@ def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_
         over, peak = engine.energy_verdict(theta, omega, block.p, block.alpha, block.eta, False)
         verdict_by = "energy rule"
         max_abs = math.pi / 2 if over else max(max_abs, peak)
-    out = _result(block, over, max_abs, impacts, n_imp, t, th, om, "fast-vertical", verdict_by,
-                  uplifted, t_over)
-    return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__},
-                                 lifts_off=lifts, t_lift_off=t_lift, min_effective_gravity=g_min)
+    max_abs = float(max_abs)
+    return VerticalRockingResult(bool(over), bool(max_abs > block.alpha), max_abs,
+                                 max_abs / block.alpha, impacts, int(n_imp), t, th, om,
+                                 "fast-vertical", verdict_by, bool(uplifted), float(t_over),
+                                 block=block, lifts_off=lifts, t_lift_off=t_lift,
+                                 min_effective_gravity=g_min)
 
 
 # --------------------------------------------------------------------------- batch
@@ -600,8 +604,6 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         raise ValueError("simulate_many supports model='fast' or 'linear'")
     vval = None
     if vertical is not None:
-        from .reference_vertical import check_axes
-
         if not isinstance(excitation, Record) or not isinstance(vertical, Record):
             raise RockingInputError("simulate_many: a vertical record goes with a horizontal "
                                     "pulses.Record")
@@ -609,8 +611,8 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
             raise RockingInputError("simulate_many: with a vertical record the model is 'fast' "
                                     "with Taylor steps")
         vval = engine.as_input(check_axes(excitation, vertical).acc)
-        _, g_min, g_max, zero = engine.vertical_bounds(excitation.acc, vval, 1.0 / G, 1.0 / G,
-                                                       0.0, excitation.npts)
+        _, g_min, g_max, zero, _ = engine.vertical_bounds(excitation.acc, vval, 1.0 / G, 1.0 / G,
+                                                          0.0, excitation.npts)
         if zero:
             out = simulate_many(blocks, excitation, scales, grid=grid, model=model,
                                 method=method, threads=threads, lanes=lanes)
