@@ -39,7 +39,7 @@ RECORDS = [("RSN77 San Fernando, Pacoima Dam (DWN)", "RSN77_SFERN_PUL164.AT2",
             "RSN77_SFERN_PUL254.AT2", "RSN77_SFERN_PULDWN.AT2"),
            ("RSN15 Kern County, Taft (UP)", "RSN15_KERN_TAF021.AT2", "RSN15_KERN_TAF111.AT2",
             "RSN15_KERN_TAF-UP.AT2"),
-           ("RSN41 Lytle Creek, Wrightwood (DWN)", "RSN41_LYTLECR_ORR021.AT2",
+           ("RSN41 Lytle Creek, Castaic (DWN)", "RSN41_LYTLECR_ORR021.AT2",
             "RSN41_LYTLECR_ORR291.AT2", "RSN41_LYTLECR_ORRDWN.AT2")]
 
 
