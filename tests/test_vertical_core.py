@@ -242,3 +242,18 @@ def test_batch_with_a_zero_vertical_is_the_horizontal_batch():
     with pytest.raises(rocking.errors.RockingInputError):
         rocking.simulate_many(blocks, rec, vertical=pulses.Record(np.ones(rec.npts), rec.dt),
                               model="linear")
+
+
+def test_coarse_sampling_takes_sub_steps_and_agrees_with_the_reference():
+    """p h above the solver's step bound (a small block, a record sampled at 20 Hz): each sample
+    interval is split into sub-steps (the general loop), with uplift, impacts and a vertical
+    above 1 g that never reaches free flight (min 1 + av/g = 0.1)."""
+    block = rocking.Block.from_dimensions(0.6, 0.2)
+    rec = record(seed=5, ap_g=0.3, tp=0.3, dt=0.05, duration=5.0)
+    up = pulses.Record(0.9 * G * np.sin(2 * math.pi * 0.9 * rec.time), rec.dt)
+    assert block.p * np.sqrt(1.9 + 0.32) * rec.dt > rocking.solver.PH_MAX  # sub-steps
+    res = rocking.simulate(block, rec, vertical=up)
+    ref = simulate_vertical_reference(block, rec, up)
+    assert res.uplifted and res.n_impacts > 0 and not res.lifts_off
+    assert res.overturned == ref.overturned
+    assert abs(res.max_rotation - ref.max_rotation) <= TOL_ALPHA * block.alpha
