@@ -12,7 +12,9 @@ The vertical changes the motion (more or fewer impacts, earlier or no overturnin
 of these two times mixes the cost of the vertical code path with that of a different motion; the
 second table isolates the code path: a constant vertical of 0.3 g against the similar block
 (``p sqrt(1.3)`` under ``ag / 1.3``, docs/theory.md section 10), the same motion computed both
-ways.  Times are CPU seconds (``time.process_time``) per call, the median of ``--repeat`` calls
+ways.  The third table times batches (``rocking.simulate_many``) of 256 widths with and without
+the vertical (the vertical batch runs one by one; the horizontal one in lanes).  Times are CPU
+seconds (``time.process_time``) per call, the median of ``--repeat`` calls
 after one untimed call, best of three rounds taken alternately so that both see the same load of
 the shared machine.  Printed: markdown tables with the ratios, and (unless ``--no-reference``)
 the agreement of the peak rotation with the independent reference integrator
@@ -122,6 +124,17 @@ def main(argv=None):
             print(f"| {name} | {hb[0]} x {hb[1]} m | {history} | {1e3 * th:.3f} ms | "
                   f"{1e3 * tv:.3f} ms | {tv / th:.2f} |", flush=True)
     print(f"\nratio, the same motion: median {statistics.median(same):.2f}, largest {max(same):.2f}")
+    print("\nBatches: 256 widths of 3 m tall columns (0.3 to 3 m, geometric), one thread\n")
+    print("| record | horizontal only (lanes) | horizontal only (one by one) | with vertical | ratio |")
+    print("|---|---|---|---|---|")
+    for name, h1, h2, v in RECORDS:
+        hor, up = read(h1, h2, v)
+        widths = [rocking.Block.from_dimensions(3.0, float(w)) for w in np.geomspace(0.3, 3.0, 256)]
+        t_l, t_v = pair(lambda: rocking.simulate_many(widths, hor, threads=1),
+                        lambda: rocking.simulate_many(widths, hor, vertical=up, threads=1), 3)
+        t_o = timed(lambda: rocking.simulate_many(widths, hor, threads=1, lanes=False), 3)
+        print(f"| {name} | {1e3 * t_l:.1f} ms | {1e3 * t_o:.1f} ms | {1e3 * t_v:.1f} ms | "
+              f"{t_v / t_l:.2f} |", flush=True)
 
 
 def pair(f_h, f_v, repeat):
