@@ -213,7 +213,9 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         ``t_lift_off``: where ``g + av < 0`` the block leaves the ground and the run stops
         there); ``model="reference"`` answers with the independent reference integrator
         (:func:`rocking.simulate_vertical_reference`, ``"reference-vertical"``, slow).  Records
-        only, the block starting at rest; not with ``model="linear"``.
+        only, the block starting at rest; not with ``model="linear"``.  The history ends with
+        the record (a longer ``duration`` is not filled with free rocking; the verdict after the
+        record is the energy rule's, as without a vertical).
 
     Returns
     -------
