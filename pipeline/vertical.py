@@ -5,9 +5,9 @@ A task has a vertical when its record is a PEER record whose search report lists
 vertical of the same station.  With ``--vertical auto`` (the default) the three components are read
 on one time axis (:func:`pulses.check_triplet`: cut to the shortest, the vertical made upward by
 its stated polarity), and for every column as it stands the response with the vertical is computed
-beside the horizontal-only one (:data:`VERTICAL_COLUMNS`).  The compiled engine does not take a
-vertical yet: that response is the reference model's (:func:`rocking.simulate_vertical_reference`,
-slow), so the verified width and the design rules stay those of the horizontal motion alone.  A
+beside the horizontal-only one (:data:`VERTICAL_COLUMNS`), by the compiled engine
+(``rocking.simulate(..., vertical=)``, model ``fast-vertical``); the verified width and the design
+rules stay those of the horizontal motion alone.  A
 vertical whose polarity is not stated is not used, and the row's ``warnings`` says why.
 """
 from __future__ import annotations
@@ -34,8 +34,9 @@ VERTICAL_COLUMNS = Columns(
                                 "which the rocking model does not describe; the response with the "
                                 "vertical stops there and its verdict is not a verdict."),
     ("vertical_t_lift_off_s", "s", "First time of g + av < 0 (blank when it never happens)."),
-    ("vertical_model", "-", "Model that answered with the vertical: `reference-vertical` (scipy DOP853 "
-                            "with located events, `rocking.simulate_vertical_reference`)."),
+    ("vertical_model", "-", "Model that answered with the vertical: `fast-vertical` (the compiled "
+                            "engine, `rocking.simulate(..., vertical=)`; `rest` if the column never "
+                            "uplifts)."),
 )
 
 
@@ -148,7 +149,7 @@ def fields(block, record, up, shown_file) -> dict:
               "vertical_overturns": None, "vertical_max_theta_ratio": None, "vertical_lifts_off": None,
               "vertical_t_lift_off_s": None, "vertical_model": None}
     if block is not None:
-        res = rocking.simulate_vertical_reference(block, record, up)
+        res = rocking.simulate(block, record, vertical=up, history=False)
         values.update(vertical_overturns=bool(res.overturned), vertical_max_theta_ratio=float(res.max_rotation_ratio),
                       vertical_lifts_off=bool(res.lifts_off),
                       vertical_t_lift_off_s=None if not res.lifts_off else float(res.t_lift_off),

@@ -87,6 +87,10 @@ class BatchResult:
     n_impacts: np.ndarray
     uplifted: np.ndarray
     model: str
+    #: with a vertical record (docs/theory.md section 10): whether each run left the ground
+    #: (``g + av < 0``; its verdict is then not a verdict) and when (nan where not); else None
+    lifts_off: np.ndarray | None = None
+    t_lift_off: np.ndarray | None = None
 
 
 def _pulse_extrema(pulse: Pulse) -> list[float]:

@@ -47,6 +47,7 @@ cdef enum:
     REST = 0
     ROCKING = 1
     OVERTURNED = 2
+    LIFTOFF = 3  # g + av < 0: the block leaves the ground (the model stops there)
 
 cdef enum:
     #: highest order of a Taylor step (rocking.engine.NMAX)
@@ -95,6 +96,10 @@ ctypedef struct Forcing:
     int kind
     double amp, tp, t0
     const double* uval
+    # vertical ground motion (docs/theory.md section 10, records only): 1 + av/g is
+    # 1 + vamp * vval[j] at the nodes, linear between them; vval NULL: none (gravity 1)
+    const double* vval
+    double vamp
 
 ctypedef struct Dyn:
     # the equation as the steppers take it: p (rad/s), sin and cos of alpha (alpha and 1 in the
@@ -242,6 +247,22 @@ cdef inline (double, double) linear_forcing(const Forcing* F, long j, double ta,
     return 0.0, 0.0
 
 
+cdef inline (double, double) linear_gravity(const Forcing* F, long j, double ta, double tb,
+                                            double t, double h) noexcept nogil:
+    """``(g0, g1)`` with the effective gravity over g ``1 + av/g = g0 + g1 x`` over the step
+    (``x = (t' - t) / h``; records are linear between samples)."""
+    cdef double slope = F.vamp * (F.vval[j + 1] - F.vval[j]) / (tb - ta)
+    return 1.0 + (F.vamp * F.vval[j] + slope * (t - ta)), slope * h
+
+
+cdef inline double gravity(const Forcing* F, long j, double ta, double tb, double t) noexcept nogil:
+    """Effective gravity over g, ``1 + av/g``, at ``t`` inside interval ``j`` (1 without a
+    vertical)."""
+    if F.vval == NULL:
+        return 1.0
+    return 1.0 + F.vamp * (F.vval[j] + (F.vval[j + 1] - F.vval[j]) * ((t - ta) / (tb - ta)))
+
+
 cdef (int, bint) forcing_series(const Forcing* F, long j, double ta, double tb, double t,
                                 double h, double* U, long n_terms) noexcept nogil:
     """Taylor coefficients of ``u(t + x h)`` in powers of ``x`` (``u = ug''/g``), into ``U``.
@@ -309,7 +330,8 @@ cdef (int, bint) forcing_series(const Forcing* F, long j, double ta, double tb, 
 cdef (int, double, double) taylor_series(const double* U, int nu, bint complete, double h,
                                          double theta, double omega, double s, double p2,
                                          double sa, double ca, double* cf, double* S, double* C,
-                                         bint sc_known, double s0, double c0) noexcept nogil:
+                                         bint sc_known, double s0, double c0, bint vert,
+                                         double g0, double g1) noexcept nogil:
     """Taylor coefficients of ``theta(t + x h)`` in powers of ``x``, into ``cf``.
 
     Returns ``(n, s1, c1)``: the order ``n`` of the polynomial, and ``sin(phi)``, ``cos(phi)`` at
@@ -322,7 +344,9 @@ cdef (int, double, double) taylor_series(const double* U, int nu, bint complete,
     (``S_k = (1/k) sum_j j phi_j C_{k-j}``), so each order costs one short convolution and no
     function evaluation.  The series is cut when two consecutive terms of ``theta`` and of
     ``h omega`` fall below :data:`TAYLOR_EPS` times the leading terms.  ``U`` holds ``2 M``
-    floats: the forcing's series, then the series of ``h theta'`` (scratch).
+    floats: the forcing's series, then the series of ``h theta'`` (scratch).  ``vert``: vertical
+    ground motion, the sine series multiplied by the effective gravity ``g0 + g1 x``
+    (docs/theory.md section 10).
     """
     cdef double q, tol, sk, ck, f, s1, c1
     cdef int n, k, i
@@ -335,7 +359,10 @@ cdef (int, double, double) taylor_series(const double* U, int nu, bint complete,
     q = p2 * h * h
     cf[0] = theta
     cf[1] = omega * h
-    cf[2] = -0.5 * q * (S[0] + U[0] * C[0])
+    if vert:
+        cf[2] = -0.5 * q * (g0 * S[0] + U[0] * C[0])
+    else:
+        cf[2] = -0.5 * q * (S[0] + U[0] * C[0])
     tol = TAYLOR_EPS * (fabs(theta) + fabs(cf[1]) + fabs(cf[2]))
     n = 2
     D[1] = cf[1]
@@ -353,6 +380,8 @@ cdef (int, double, double) taylor_series(const double* U, int nu, bint complete,
         S[k] = sk
         C[k] = ck
         f = sk
+        if vert:
+            f = g0 * sk + g1 * S[k - 1]
         for i in range(min(nu, k + 1)):
             f += U[i] * C[k - i]
         cf[k + 2] = -q * f * INV2[k]
@@ -511,15 +540,18 @@ cdef (double, double, int, double, double) _advance(
     forcing series of smooth pulses is computed a few terms beyond it, and in full if needed)."""
     cdef int nu, n
     cdef bint complete
-    cdef double s1, c1, th, om
+    cdef double s1, c1, th, om, g0 = 1.0, g1 = 0.0
+    cdef bint vert = F.vval != NULL
     if D.method == TAYLOR and not D.linear:
+        if vert:
+            g0, g1 = linear_gravity(F, j, ta, tb, t, h)
         nu, complete = forcing_series(F, j, ta, tb, t, h, U, n_hint + 4)
         n, s1, c1 = taylor_series(U, nu, complete, h, theta, omega, s, D.p * D.p, D.sa, D.ca, cf,
-                                  S, C, sc_known, s0, c0)
+                                  S, C, sc_known, s0, c0, vert, g0, g1)
         if n < 0:
             nu, complete = forcing_series(F, j, ta, tb, t, h, U, NMAX + 1)
             n, s1, c1 = taylor_series(U, nu, complete, h, theta, omega, s, D.p * D.p, D.sa, D.ca,
-                                      cf, S, C, sc_known, s0, c0)
+                                      cf, S, C, sc_known, s0, c0, vert, g0, g1)
         th, om = taylor_eval(cf, n, 1.0, h)
         return th, om, n, s1, c1
     th, om = step(F, j, ta, tb, t, h, theta, omega, s, D, kt, kw)
@@ -690,14 +722,15 @@ cdef void _cruise(const Forcing* F, double t_start, double h_uniform, const doub
     cdef long n_hist = c.n_hist
     cdef double h = h_uniform, q = p2 * h_uniform * h_uniform
     cdef double inv_h = 1.0 / h_uniform if uniform else 0.0
-    cdef double wh, ta, tb, h_new, u0, u1
+    cdef double wh, ta, tb, h_new, u0, u1, g0, g1
     cdef int stop, flag
     cdef FixedRun res
     # the loop carries omega h (one step's length to the next on a uniform grid: no rounding
     # from omega to omega h and back at every step, and two multiplications less on the chain
     # of dependent operations from one step to the next)
     wh = omega * h
-    if uniform and F.kind == NODAL and not record and j < n_int and t == t_start + j * h_uniform:
+    if (uniform and F.kind == NODAL and F.vval == NULL and not record and j < n_int
+            and t == t_start + j * h_uniform):
         # records without history (the common case): the same loop, stripped to what changes
         # from one interval to the next
         if not sc_known:
@@ -746,8 +779,18 @@ cdef void _cruise(const Forcing* F, double t_start, double h_uniform, const doub
                 u1 = F.amp * (F.uval[j + 1] - F.uval[j])
             else:
                 u0, u1 = linear_forcing(F, j, ta, tb, t, h)
-            th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, wh, s_phi,
-                                                          c_phi, TAYLOR_EPS, cf)
+            if F.vval != NULL:
+                # vertical ground motion: the effective gravity g0 + g1 x over the interval; an
+                # interval where it turns negative (lift-off) is left to run_core
+                g0 = 1.0 + F.vamp * F.vval[j]
+                g1 = F.vamp * (F.vval[j + 1] - F.vval[j])
+                if g0 < 0.0 or g0 + g1 < 0.0:
+                    break
+                th2, wh2, s_next, c_next, flag = taylor_fixed_v(order, u0, u1, g0, g1, q, theta,
+                                                                wh, s_phi, c_phi, TAYLOR_EPS, cf)
+            else:
+                th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, wh, s_phi,
+                                                              c_phi, TAYLOR_EPS, cf)
             if flag == 0:
                 break  # the series needs more terms: run_core() raises the order (rare)
             n_used = order
@@ -779,6 +822,34 @@ cdef void _cruise(const Forcing* F, double t_start, double h_uniform, const doub
                                                              n_used)
 
 
+cdef (double, double) _uplift_vertical(const Forcing* F, long j, double ta, double tb, double t,
+                                       double t2, double tan_a) noexcept nogil:
+    """:func:`_uplift` under vertical ground motion too (a record): the block uplifts when
+    ``|u| > (1 + av/g) tan(alpha)`` (docs/theory.md section 10), towards ``-sgn(u)``.  Both
+    ``u`` and ``1 + av/g`` are linear over the interval, so each side's threshold
+    ``+-u - (1 + av/g) tan(alpha)`` is linear: its first positive value is found in closed form."""
+    cdef double ua = forcing(F, j, ta, tb, t), ub = forcing(F, j, ta, tb, t2)
+    cdef double ga = gravity(F, j, ta, tb, t), gb = gravity(F, j, ta, tb, t2)
+    cdef double best = INFINITY, side = 0.0, sign, fa, fb, cand
+    cdef int k
+    for k in range(2):
+        sign = 1.0 if k == 0 else -1.0  # the sign of u at uplift
+        fa = sign * ua - ga * tan_a
+        fb = sign * ub - gb * tan_a
+        if fa > 0.0:
+            cand = t
+        elif fb > 0.0:
+            cand = min(max(t + (t2 - t) * (fa / (fa - fb)), t), t2)
+        else:
+            continue
+        if cand < best:
+            best = cand
+            side = -sign
+    if side == 0.0:
+        return t2, 0.0
+    return best, side
+
+
 cdef (double, double) _uplift(const Forcing* F, long j, double ta, double tb, double t, double t2,
                               double tan_a, double rest_until) noexcept nogil:
     """A block at rest from ``t``: ``(t_up, s)``, when and to which side it uplifts inside
@@ -789,6 +860,8 @@ cdef (double, double) _uplift(const Forcing* F, long j, double ta, double tb, do
         return t2, 0.0
     if rest_until > t:
         t = rest_until
+    if F.vval != NULL:
+        return _uplift_vertical(F, j, ta, tb, t, t2, tan_a)
     t_up = _uplift_time(F, j, ta, tb, t, t2, tan_a)
     if isnan(t_up):
         return t2, 0.0
@@ -809,10 +882,15 @@ cdef bint _unrolled(bint fixed, long* order_io, long* n_low_io, long lowest, lon
     ``out``: theta, omega, sin, cos at the end of the step and the order it took (its
     polynomial is in ``cf``)."""
     cdef long order = order_io[0], n_low = n_low_io[0], n_used
-    cdef double wh = omega * h, u0, u1, th2, wh2, s_next, c_next
+    cdef double wh = omega * h, u0, u1, th2, wh2, s_next, c_next, g0, g1
     cdef int flag
     while True:
-        if fixed:
+        if fixed and F.vval != NULL:
+            u0, u1 = linear_forcing(F, j, ta, tb, t, h)
+            g0, g1 = linear_gravity(F, j, ta, tb, t, h)
+            th2, wh2, s_next, c_next, flag = taylor_fixed_v(order, u0, u1, g0, g1, q, theta, wh,
+                                                            s_phi, c_phi, TAYLOR_EPS, cf)
+        elif fixed:
             u0, u1 = linear_forcing(F, j, ta, tb, t, h)
             th2, wh2, s_next, c_next, flag = taylor_fixed(order, u0, u1, q, theta, wh, s_phi,
                                                           c_phi, TAYLOR_EPS, cf)
@@ -847,10 +925,14 @@ cdef double _zeno_rest(const Forcing* F, long j, double ta, double tb, double t,
     """After an impact with ``|omega|`` below the Zeno threshold (block on side ``s`` now): the
     remaining geometric series of hops summed in closed form.  Returns the time until which the
     block is at rest."""
-    cdef double u_now = forcing(F, j, ta, tb, t), a_new, a_old, p = D.p
+    cdef double u_now = forcing(F, j, ta, tb, t), a_new, a_old, p = D.p, g
     if D.linear:  # (sa is alpha itself in the linearised model)
         a_new = p * p * (D.sa + s * u_now)
         a_old = p * p * (D.sa - s * u_now)
+    elif F.vval != NULL:  # the effective gravity (docs/theory.md section 10)
+        g = gravity(F, j, ta, tb, t)
+        a_new = p * p * (g * D.sa + s * u_now * D.ca)
+        a_old = p * p * (g * D.sa - s * u_now * D.ca)
     else:
         a_new = p * p * (D.sa + s * u_now * D.ca)
         a_old = p * p * (D.sa - s * u_now * D.ca)
@@ -919,7 +1001,7 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
     cdef Dyn D
     cdef Cruise cr
     cdef double stepped[5]
-    cdef double c0, c1, c2, c3, lo, hi, th_e, x, th_x, om_x, xn, t_imp
+    cdef double c0, c1, c2, c3, lo, hi, th_e, x, th_x, om_x, xn, t_imp, t_lift, g_a, g_b
     cdef Outcome out
     cdef int n_adv
     # forcing linear over each step: unrolled Taylor steps of a fixed order, adapted as we go
@@ -970,8 +1052,19 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
         if s == 0.0 and F.kind == NODAL and uniform and not stop_at_rest and rest_until <= t:
             # at rest under a record: on to the first interval whose ends exceed the uplift
             # threshold (the forcing is linear between them), the history meanwhile zero
-            while (j < n_int and fabs(F.amp * F.uval[j]) <= tan_a
+            while (j < n_int and F.vval == NULL and fabs(F.amp * F.uval[j]) <= tan_a
                    and fabs(F.amp * F.uval[j + 1]) <= tan_a):
+                j += 1
+                if record:
+                    hist_t[n_hist] = t_start + j * h_uniform
+                    hist_theta[n_hist] = 0.0
+                    hist_omega[n_hist] = 0.0
+                    n_hist += 1
+            # under vertical motion too: |u| <= (1 + av/g) tan(alpha) at both ends (both linear
+            # in between; a negative effective gravity, lift-off, fails it)
+            while (j < n_int and F.vval != NULL
+                   and fabs(F.amp * F.uval[j]) <= (1.0 + F.vamp * F.vval[j]) * tan_a
+                   and fabs(F.amp * F.uval[j + 1]) <= (1.0 + F.vamp * F.vval[j + 1]) * tan_a):
                 j += 1
                 if record:
                     hist_t[n_hist] = t_start + j * h_uniform
@@ -1000,8 +1093,20 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
             ta = nodes[j]
             tb = nodes[j + 1]
         hsub = (tb - ta) / n_sub
+        t_lift = INFINITY
+        if F.vval != NULL:
+            # lift-off: the effective gravity 1 + av/g (linear over the interval) turns negative
+            # inside it; the run stops there (docs/theory.md section 10)
+            g_a = 1.0 + F.vamp * F.vval[j]
+            g_b = 1.0 + F.vamp * F.vval[j + 1]
+            if g_a < 0.0:
+                t_lift = ta
+            elif g_b < 0.0:
+                t_lift = min(max(ta + (tb - ta) * (g_a / (g_a - g_b)), ta), tb)
         for k in range(n_sub):
             t2 = tb if k == n_sub - 1 else ta + (k + 1) * hsub
+            if t2 > t_lift:
+                t2 = t_lift
             events = 0
             while t < t2:
                 events += 1
@@ -1138,12 +1243,15 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
                 c_phi = c_next
             if status == OVERTURNED or (stop_at_rest and status == REST):
                 break
+        if t_lift < INFINITY and status != OVERTURNED:
+            status = LIFTOFF
+            t = t_lift
         if record:
             hist_t[n_hist] = t
             hist_theta[n_hist] = theta
             hist_omega[n_hist] = omega
             n_hist += 1
-        if status == OVERTURNED or (stop_at_rest and status == REST):
+        if status == OVERTURNED or status == LIFTOFF or (stop_at_rest and status == REST):
             break
         j += 1
     if status == REST:
@@ -1166,10 +1274,12 @@ def run(int kind, double amp, double tp, double t0, const double[::1] uval, doub
         double h, long n_sub, const double[::1] nodes, double p, double alpha, double eta,
         bint linear, int method, double zeno_tol, bint stop_at_rest, bint record, long j0,
         double theta0, double omega0, double rest_until, long n_end, double[::1] hist_t,
-        double[::1] hist_theta, double[::1] hist_omega, double[::1] impacts):
+        double[::1] hist_theta, double[::1] hist_omega, double[::1] impacts,
+        const double[::1] vval=None, double vamp=0.0):
     """The engine called from Python (:func:`rocking.engine.run` checks the arguments), without
     the GIL.  Returns ``(status, theta, omega, t_end, max_abs_theta, n_impacts, n_hist,
-    uplifted, rest_until)``."""
+    uplifted, rest_until)``.  ``vval``: the vertical ground motion's node values (``1 + av/g =
+    1 + vamp * vval``), a record's on a uniform grid stepped by Taylor steps only."""
     cdef Forcing F
     cdef Outcome o
     cdef const double* nodes_p = _ptr(nodes)
@@ -1180,6 +1290,14 @@ def run(int kind, double amp, double tp, double t0, const double[::1] uval, doub
     cdef bint uniform = nodes.shape[0] == 0
     cdef long n_imp_max = impacts.shape[0]
     F.kind, F.amp, F.tp, F.t0, F.uval = kind, amp, tp, t0, _ptr(uval)
+    F.vval, F.vamp = NULL, 0.0
+    if vval is not None:
+        if not (kind == NODAL and nodes.shape[0] == 0 and method == TAYLOR and not linear):
+            raise ValueError("vertical ground motion: records on a uniform grid, Taylor steps of "
+                             "the nonlinear equation only")
+        if vval.shape[0] < n_end + 1 or vval.shape[0] < 1:
+            raise ValueError("the vertical node values are fewer than the intervals run")
+        F.vval, F.vamp = &vval[0], vamp
     if record and not (hist_t.shape[0] >= n_end - j0 + 1 and hist_theta.shape[0] >= n_end - j0 + 1
                        and hist_omega.shape[0] >= n_end - j0 + 1):
         raise ValueError("the history arrays are shorter than the intervals run")
@@ -1298,6 +1416,7 @@ cdef bint _turn(long order, double a, const double* uval, long j, double ta, dou
     if lo >= 0.0:
         return False
     F.kind, F.amp, F.tp, F.t0, F.uval = NODAL, a, 1.0, 0.0, uval
+    F.vval, F.vamp = NULL, 0.0
     D.p, D.sa, D.ca, D.linear, D.method = p, sa, ca, False, TAYLOR
     peak = _step_peak(&F, j, ta, ta + h, ta, h, theta, omega, th2, om2, side, &D, kt, kw, h, cf,
                       <int>order, 0.0)
@@ -1354,6 +1473,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
         L.i[I_WAKE][i] = 0
         L.bad[i] = 0
     F.kind, F.tp, F.t0, F.uval = NODAL, 1.0, 0.0, uval
+    F.vval, F.vamp = NULL, 0.0
     for j in range(n_int):
         if n_live == 0:
             break
@@ -1477,20 +1597,27 @@ cdef void _one_by_one(long i0, long i1, int kind, const double* amp, double tp, 
                       double h, long n_int, const int64_t* n_sub, const double* p,
                       const double* alpha, const double* eta, bint linear, double zeno_tol,
                       int method, unsigned char* overturned, double* max_abs,
-                      int64_t* n_impacts, unsigned char* uplifted) noexcept nogil:
-    """Runs ``i0 .. i1-1`` from rest one by one with :func:`run_core`, then the energy rule."""
+                      int64_t* n_impacts, unsigned char* uplifted, const double* vval,
+                      double* t_lift) noexcept nogil:
+    """Runs ``i0 .. i1-1`` from rest one by one with :func:`run_core`, then the energy rule.
+    ``vval`` (or NULL): the vertical ground motion's node values, scaled as the record
+    (``1 + amp * vval``); ``t_lift`` (with it): the lift-off time of each run (nan if none)."""
     cdef Forcing F
     cdef Outcome o
     cdef long i
     cdef bint over
     cdef double mx, peak
     F.kind, F.tp, F.t0, F.uval = kind, tp, t0, uval
+    F.vval, F.vamp = vval, 0.0
     for i in range(i0, i1):
         F.amp = amp[i]
+        F.vamp = amp[i]
         o = run_core(&F, t_start, h, n_sub[i], nodes, uniform, p[i], alpha[i], eta[i], linear,
                      method, zeno_tol, False, False, 0, 0.0, 0.0, -INFINITY, n_int, NULL, NULL,
                      NULL, NULL, 0)
         mx = o.max_abs
+        if t_lift != NULL:
+            t_lift[i] = o.t if o.status == LIFTOFF else NAN
         if o.status == OVERTURNED:
             over = True
         elif o.status == ROCKING:
@@ -1510,12 +1637,17 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
            const int64_t[::1] n_sub, const double[::1] p, const double[::1] alpha,
            const double[::1] eta, bint linear, double zeno_tol, int method,
            unsigned char[::1] overturned, double[::1] max_abs, int64_t[::1] n_impacts,
-           unsigned char[::1] uplifted, int64_t[::1] stats):
+           unsigned char[::1] uplifted, int64_t[::1] stats, const double[::1] vval=None,
+           double[::1] t_lift=None):
     """Runs ``i0 .. i1-1`` of a batch from rest, then the energy rule; results written at their
     indices (``overturned`` and ``uplifted`` as bytes 0 or 1).  ``lanes``: stepped together (at
     most :data:`LANES` runs; a record on a uniform grid, one Taylor step per sample), else one by
     one with :func:`run_core`.  Runs without the GIL: :func:`rocking.lanes.run_batch` spreads
-    calls over threads."""
+    calls over threads.  ``vval``: the vertical ground motion's node values (one by one only,
+    records on a uniform grid, Taylor steps; scaled as the record), with ``t_lift`` the lift-off
+    time of each run (nan if none)."""
+    cdef const double* vval_p = NULL
+    cdef double* t_lift_p = NULL
     cdef const double* uval_p = _ptr(uval)
     cdef const double* nodes_p = _ptr(nodes)
     cdef bint uniform = nodes.shape[0] == 0
@@ -1529,6 +1661,15 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
         raise ValueError("the node values are fewer than the intervals run")
     if not uniform and nodes.shape[0] < n_int + 1:
         raise ValueError("the node times are fewer than the intervals run")
+    if vval is not None:
+        if lanes or kind != NODAL or not uniform or linear or method != TAYLOR:
+            raise ValueError("vertical ground motion: records on a uniform grid, one by one, "
+                             "Taylor steps of the nonlinear equation only")
+        if vval.shape[0] < n_int + 1 or t_lift is None or t_lift.shape[0] < p.shape[0]:
+            raise ValueError("the vertical node values are fewer than the intervals run, or no "
+                             "room for the lift-off times")
+        vval_p = &vval[0]
+        t_lift_p = &t_lift[0]
     if i1 <= i0:
         return
     with nogil:
@@ -1538,7 +1679,8 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
         else:
             _one_by_one(i0, i1, kind, &amp[0], tp, t0, uval_p, nodes_p, uniform, t_start, h,
                         n_int, &n_sub[0], &p[0], &alpha[0], &eta[0], linear, zeno_tol, method,
-                        &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0])
+                        &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0], vval_p,
+                         t_lift_p)
 
 
 # --------------------------------------------------------------------------- from Python
@@ -1574,6 +1716,30 @@ def abs_max(const double[::1] a):
     return max(max(m0, m1), max(m2, m3))
 
 
+def vertical_bounds(const double[::1] uval, const double[::1] vval, double amp, double vamp,
+                    double tan_a, long n):
+    """One pass over the first ``n`` nodes of a record and its vertical (docs/theory.md section
+    10): ``(quiet, g_min, g_max, zero, u_max)``: whether ``|amp u| <= (1 + vamp v) tan_a`` at
+    every node (then, both being linear between nodes, the block never uplifts and never lifts
+    off), the smallest and largest effective gravity ``1 + vamp v``, whether the vertical is zero,
+    and ``max |u|`` (the record's peak, unscaled)."""
+    cdef double v_min = INFINITY, v_max = -INFINITY, excess = -INFINITY, u_max = 0.0, v, u, e
+    cdef Py_ssize_t i
+    if n > uval.shape[0] or n > vval.shape[0] or n < 1:
+        raise ValueError("fewer node values than asked for")
+    with nogil:
+        for i in range(n):  # branch-free running extrema
+            v = vval[i]
+            u = fabs(uval[i])
+            v_min = v if v < v_min else v_min
+            v_max = v if v > v_max else v_max
+            u_max = u if u > u_max else u_max
+            e = fabs(amp) * u - (1.0 + vamp * v) * tan_a
+            excess = e if e > excess else excess
+    return (bool(excess <= 0.0), 1.0 + vamp * (v_min if vamp >= 0 else v_max),
+            1.0 + vamp * (v_max if vamp >= 0 else v_min), v_min == 0.0 and v_max == 0.0, u_max)
+
+
 def py_forcing_series(int kind, double amp, double tp, double t0, const double[::1] uval, long j,
                       double ta, double tb, double t, double h, double[::1] U, long n_terms):
     cdef Forcing F
@@ -1582,13 +1748,15 @@ def py_forcing_series(int kind, double amp, double tp, double t0, const double[:
     if U.shape[0] < 2 * M:
         raise ValueError(f"U needs {2 * M} floats")
     F.kind, F.amp, F.tp, F.t0, F.uval = kind, amp, tp, t0, _ptr(uval)
+    F.vval, F.vamp = NULL, 0.0
     nu, complete = forcing_series(&F, j, ta, tb, t, h, &U[0], n_terms)
     return nu, bool(complete)
 
 
 def py_taylor_series(const double[::1] U, int nu, bint complete, double h, double theta,
                      double omega, double s, double p2, double sa, double ca, double[::1] cf,
-                     double[::1] S, double[::1] C, bint sc_known, double s0, double c0):
+                     double[::1] S, double[::1] C, bint sc_known, double s0, double c0,
+                     bint vert=False, double g0=1.0, double g1=0.0):
     cdef double Uc[2 * M]
     cdef int n, k
     cdef double s1, c1
@@ -1597,7 +1765,7 @@ def py_taylor_series(const double[::1] U, int nu, bint complete, double h, doubl
     for k in range(2 * M):
         Uc[k] = U[k] if k < U.shape[0] and k < M else 0.0
     n, s1, c1 = taylor_series(Uc, nu, complete, h, theta, omega, s, p2, sa, ca, &cf[0], &S[0],
-                              &C[0], sc_known, s0, c0)
+                              &C[0], sc_known, s0, c0, vert, g0, g1)
     return n, s1, c1
 
 
@@ -1613,6 +1781,15 @@ def py_taylor_fixed(long order, double u0, double u1, double q, double theta, do
     if cf.shape[0] < min(max(order, ORDERS_FIRST), ORDERS_LAST) + 1:
         raise ValueError("cf is shorter than the step's polynomial")
     return taylor_fixed(order, u0, u1, q, theta, wh, s0, c0, eps, &cf[0])
+
+
+def py_taylor_fixed_v(long order, double u0, double u1, double g0, double g1, double q,
+                      double theta, double wh, double s0, double c0, double eps, double[::1] cf):
+    """The vertical step ``taylor_v_N`` of :data:`ORDERS` order ``order``; its polynomial in
+    ``cf``."""
+    if cf.shape[0] < min(max(order, ORDERS_FIRST), ORDERS_LAST) + 1:
+        raise ValueError("cf is shorter than the step's polynomial")
+    return taylor_fixed_v(order, u0, u1, g0, g1, q, theta, wh, s0, c0, eps, &cf[0])
 
 
 def py_taylor_smooth(long order, const double[::1] U, double q, double theta, double wh,

@@ -114,7 +114,7 @@ class _Sched:
         return f"    {name} = {value} * {factor}"
 
 
-def _fixed_function(n: int) -> str:
+def _fixed_function(n: int, vertical: bool = False) -> str:
     """The unrolled step of order ``n`` for forcing ``u0 + u1 x``, arranged for latency.
 
     The same recurrences as :func:`rocking.engine.taylor_series`, with the factors that do not
@@ -125,9 +125,15 @@ def _fixed_function(n: int) -> str:
     summing from the smallest term.  ``D_k = k c_k`` is not formed: ``omega h`` sums ``k c_k`` by
     multiply-adds and the flags compare ``k |c_k|``.  The ready times of the model (one unit per
     add or multiply) order the sums; the compiler keeps that order and fuses nothing
-    (``-ffp-contract=off``, setup.py)."""
+    (``-ffp-contract=off``, setup.py).
+
+    ``vertical``: the step ``_taylor_v_N`` under vertical ground motion too (docs/theory.md
+    section 10): the sine series is multiplied by the effective gravity ``g0 + g1 x``
+    (``1 + av/g``, linear over the step), ``c_{k+2} = G_k S_k + V_k S_{k-1} + A_k C_k +
+    B_k C_{k-1}`` with ``G_k = Q_k g0``, ``V_k = Q_k g1``."""
     sc = _Sched()
-    L = [f"\n\ndef _taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, store=True):",
+    head = (f"_taylor_v_{n}(u0, u1, g0, g1, q," if vertical else f"_taylor_{n}(u0, u1, q,")
+    L = [f"\n\ndef {head} theta, wh, s0, c0, eps, cf, store=True):",
          "    S_0 = s0",
          "    C_0 = c0"]
     for k in range(0, n - 1):  # c_{k+2} = Q_k S_k + A_k C_k + B_k C_{k-1}
@@ -136,15 +142,22 @@ def _fixed_function(n: int) -> str:
         L.append(f"    A_{k} = Q_{k} * u0")
         if k > 0:
             L.append(f"    B_{k} = Q_{k} * u1")
+        if vertical:
+            L.append(f"    G_{k} = Q_{k} * g0")
+            if k > 0:
+                L.append(f"    V_{k} = Q_{k} * g1")
+    qs = "G" if vertical else "Q"  # the factor on S_k
     for k in range(2, n - 1):
         L.append(f"    w_{k} = wh * {1.0 / k!r}")
     sc.ready.update({"S_0": 0, "C_0": 0, "wh": 0})
     for k in range(0, n - 1):
         sc.ready[f"A_{k}"] = 2 * _LAT
         sc.ready[f"B_{k}"] = 2 * _LAT
+        sc.ready[f"G_{k}"] = 2 * _LAT
+        sc.ready[f"V_{k}"] = 2 * _LAT
     for k in range(2, n - 1):
         sc.ready[f"w_{k}"] = _LAT
-    L.append(sc.sum("c_2", [(*sc.product("Q_0", "S_0"), 1), (*sc.product("A_0", "C_0"), 1)]))
+    L.append(sc.sum("c_2", [(*sc.product(f"{qs}_0", "S_0"), 1), (*sc.product("A_0", "C_0"), 1)]))
     for k in range(1, n - 1):
         for i in range(2, k):
             L.append(sc.scaled(f"P_{i}_{k}", f"c_{i}", repr(i / k)))
@@ -157,8 +170,10 @@ def _fixed_function(n: int) -> str:
             for i in range(2, k):  # D_i Y_{k-i} / k = (c_i i / k) Y_{k-i}
                 terms.append((*sc.product(f"P_{i}_{k}", f"{Y}_{k - i}"), sign))
             L.append(sc.sum(f"{X}_{k}", terms))
-        terms = [(*sc.product(f"Q_{k}", f"S_{k}"), 1), (*sc.product(f"A_{k}", f"C_{k}"), 1),
+        terms = [(*sc.product(f"{qs}_{k}", f"S_{k}"), 1), (*sc.product(f"A_{k}", f"C_{k}"), 1),
                  (*sc.product(f"B_{k}", f"C_{k - 1}"), 1)]
+        if vertical:
+            terms.append((*sc.product(f"V_{k}", f"S_{k - 1}"), 1))
         L.append(sc.sum(f"c_{k + 2}", terms))
     # end state: the terms after the leading one added in the order they become ready (the
     # largest first, but all far below the leading term), then the leading term, whose addition
@@ -211,6 +226,10 @@ def _cython(py: str, signature: str) -> str:
 FIXED_SIGNATURE = ("cdef inline (double, double, double, double, int) taylor_{n}(\n"
                    "        double u0, double u1, double q, double theta, double wh, double s0,"
                    " double c0, double eps,\n        double* cf, bint store) noexcept nogil:")
+FIXED_V_SIGNATURE = ("cdef inline (double, double, double, double, int) taylor_v_{n}(\n"
+                     "        double u0, double u1, double g0, double g1, double q, double theta,"
+                     " double wh, double s0,\n        double c0, double eps, double* cf,"
+                     " bint store) noexcept nogil:")
 SMOOTH_SIGNATURE = ("cdef inline (double, double, double, double, int) taylor_smooth_{n}(\n"
                     "        const double* U, double q, double theta, double wh, double s0,"
                     " double c0, double eps,\n        double* cf) noexcept nogil:")
@@ -281,6 +300,7 @@ def reference_source() -> str:
     """The steps as plain Python functions ``_taylor_N`` and ``_taylor_smooth_N``: the text that
     :func:`source` compiles (tests check the compiled steps against it, bit for bit)."""
     return ("".join(_fixed_function(n) for n in ORDERS)
+            + "".join(_fixed_function(n, True) for n in ORDERS)
             + "".join(_smooth_function(n) for n in SMOOTH_ORDERS))
 
 
@@ -288,6 +308,7 @@ def source() -> str:
     """Text of the generated Cython include file."""
     out = [HEADER, f"\nORDERS = {ORDERS!r}\nSMOOTH_ORDERS = {SMOOTH_ORDERS!r}\n"]
     out += [_cython(_fixed_function(n), FIXED_SIGNATURE.format(n=n)) for n in ORDERS]
+    out += [_cython(_fixed_function(n, True), FIXED_V_SIGNATURE.format(n=n)) for n in ORDERS]
     out += [RUN_STRUCT] + [RUN_TEMPLATE.format(n=n) for n in ORDERS]
     out += [_cython(_smooth_function(n), SMOOTH_SIGNATURE.format(n=n)) for n in SMOOTH_ORDERS]
     d = ["\n\ncdef (double, double, double, double, int) taylor_fixed(\n"
@@ -299,6 +320,15 @@ def source() -> str:
     for n in ORDERS[:-1]:
         d.append(f"    if order <= {n}:\n        return taylor_{n}(u0, u1, q, theta, wh, s0, c0, eps, cf, True)")
     d.append(f"    return taylor_{ORDERS[-1]}(u0, u1, q, theta, wh, s0, c0, eps, cf, True)")
+    d.append("\n\ncdef inline (double, double, double, double, int) taylor_fixed_v(\n"
+             "        long order, double u0, double u1, double g0, double g1, double q, double theta,"
+             " double wh,\n        double s0, double c0, double eps, double* cf) noexcept nogil:")
+    d.append('    """The vertical step (``taylor_v_N``) of ORDERS order ``order`` (the highest for'
+             ' larger),\n    its polynomial stored."""')
+    for n in ORDERS[:-1]:
+        d.append(f"    if order <= {n}:\n        return taylor_v_{n}(u0, u1, g0, g1, q, theta, wh,"
+                 " s0, c0, eps, cf, True)")
+    d.append(f"    return taylor_v_{ORDERS[-1]}(u0, u1, g0, g1, q, theta, wh, s0, c0, eps, cf, True)")
     args = "uval, amp, j, n_int, q, s, theta, wh, s_phi, c_phi, max_abs, n_low"
     d.append("\n\ncdef inline int fixed_run(long order, const double* uval, double amp, long j, long n_int,"
              " double q,\n        double s, double theta, double wh, double s_phi, double c_phi,"

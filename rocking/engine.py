@@ -64,8 +64,9 @@ NMAX = 40
 #: ``TAYLOR_EPS`` times the size of the step's leading terms
 TAYLOR_EPS = 1e-15
 
-# status codes returned by run()
-REST, ROCKING, OVERTURNED = 0, 1, 2
+# status codes returned by run(); LIFTOFF: the effective gravity g + av turned negative, the
+# block leaves the ground (vertical ground motion, docs/theory.md section 10) and the run stops
+REST, ROCKING, OVERTURNED, LIFTOFF = 0, 1, 2, 3
 
 #: the ground motion: ``kind`` (:data:`KINDS`), ``amp`` (``ap/g`` of a pulse, or the factor on
 #: the node values ``uval`` of ``ug''/g`` for ``NODAL``), ``tp``, ``t0`` (a pulse's period and
@@ -85,7 +86,8 @@ Settings = namedtuple("Settings", "linear method zeno_tol stop_at_rest record")
 Start = namedtuple("Start", "j0 theta omega rest_until")
 
 
-def run(forcing, uval, grid, nodes, n_int, block, settings, history, impacts, start=None):
+def run(forcing, uval, grid, nodes, n_int, block, settings, history, impacts, start=None,
+        vertical=None):
     """Integrate the rocking block over intervals ``start.j0 .. n_int - 1`` of the grid.
 
     Parameters
@@ -117,6 +119,11 @@ def run(forcing, uval, grid, nodes, n_int, block, settings, history, impacts, st
         ``(j0, theta, omega, rest_until)``: first interval (its start time), the state there
         (rad, rad/s), at rest until ``rest_until`` (after a Zeno sequence; ``-inf`` if not).
         Default: interval 0, at rest.
+    vertical : (vval, vamp), optional
+        Vertical ground motion (docs/theory.md section 10): the effective gravity over g is
+        ``1 + vamp * vval`` at the nodes, linear between them (records on a uniform grid, Taylor
+        steps of the nonlinear equation).  The run stops with :data:`LIFTOFF` at the first time
+        it turns negative.  None: horizontal motion only (the horizontal code path itself).
 
     Returns
     -------
@@ -128,12 +135,30 @@ def run(forcing, uval, grid, nodes, n_int, block, settings, history, impacts, st
     linear, method, zeno_tol, stop_at_rest, record = settings
     j0, theta0, omega0, rest_until = start or (0, 0.0, 0.0, -math.inf)
     hist_t, hist_theta, hist_omega = history
+    if vertical is not None:
+        vval, vamp = vertical
+        return _core.run(int(kind), float(amp), float(tp), float(t0), as_input(uval),
+                         float(t_start), float(h), int(n_sub), as_input(nodes), float(block[0]),
+                         float(block[1]), float(block[2]), bool(linear), int(method),
+                         float(zeno_tol), bool(stop_at_rest), bool(record), int(j0),
+                         float(theta0), float(omega0), float(rest_until), int(n_int),
+                         as_output(hist_t), as_output(hist_theta), as_output(hist_omega),
+                         as_output(impacts), as_input(vval), float(vamp))
     return _core.run(int(kind), float(amp), float(tp), float(t0), as_input(uval), float(t_start),
                      float(h), int(n_sub), as_input(nodes), float(block[0]), float(block[1]),
                      float(block[2]), bool(linear), int(method), float(zeno_tol),
                      bool(stop_at_rest), bool(record), int(j0), float(theta0), float(omega0),
                      float(rest_until), int(n_int), as_output(hist_t), as_output(hist_theta),
                      as_output(hist_omega), as_output(impacts))
+
+
+def vertical_bounds(uval, vval, amp, vamp, tan_alpha, n):
+    """``(quiet, g_min, g_max, zero, u_max)`` of the first ``n`` nodes of a record (``amp * uval``
+    = ``ug''/g``) and its vertical (``1 + vamp * vval`` = ``1 + av/g``), in one compiled pass:
+    no node past the uplift threshold ``(1 + av/g) tan(alpha)`` (nor, then, any lift-off), the
+    smallest and largest effective gravity, whether the vertical is zero, and ``max|uval|``."""
+    return _core.vertical_bounds(as_input(uval), as_input(vval), float(amp), float(vamp),
+                                 float(tan_alpha), int(n))
 
 
 def energy_verdict(theta, omega, p, alpha, eta, linear):

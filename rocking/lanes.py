@@ -74,7 +74,7 @@ def _pool(threads):
 
 
 def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p, alpha, eta,
-              linear, zeno_tol, method=TAYLOR, threads=None, stats=None):
+              linear, zeno_tol, method=TAYLOR, threads=None, stats=None, vval=None):
     """Runs from rest of blocks ``p``, ``alpha``, ``eta`` (arrays) scaled by ``amp`` (array), then
     the energy rule; no histories.  ``lanes``: stepped together (records on a uniform grid with one
     Taylor step per sample, ``n_sub == 1``), else one by one (any grid, model or method).
@@ -83,6 +83,10 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
     least :data:`PARALLEL_MIN_RUNS` runs, else 1; 1 runs it on the calling thread).  ``stats``
     (4 integers, lanes only) is incremented by the steps kept in lanes, the turning points taken
     in lanes, and the intervals handed to the engine for rocking lanes and for lanes at rest.
+
+    ``vval``: node values of the vertical ground motion, scaled as the record (``1 + amp * vval`` =
+    ``1 + av/g``; one by one only, docs/theory.md section 10); then a fifth array is returned, the
+    lift-off time of each run (nan where none).
 
     Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted``.
     """
@@ -106,9 +110,15 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
             float(h), int(n_int), np.ascontiguousarray(n_sub, dtype=np.int64), f64(p), f64(alpha),
             f64(eta), bool(linear), float(zeno_tol), int(method)) + results
 
+    extra = ()
+    if vval is not None:
+        t_lift = np.full(n, np.nan)
+        extra = (f64(vval), t_lift)
+        out = out + (t_lift,)
+
     def task(k):
         i0 = starts[k]
-        _core.kernel(bool(lanes), i0, min(n, i0 + size), *args, counts[k])
+        _core.kernel(bool(lanes), i0, min(n, i0 + size), *args, counts[k], *extra)
 
     if threads == 1 or len(starts) <= 1:
         for k in range(len(starts)):

@@ -15,6 +15,7 @@ integration (unless a longer ``duration`` is asked for, to draw the free rocking
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -27,7 +28,8 @@ from .block import Block
 from ._common import (ZENO_TOL, BatchResult, RockingResult, _free_rocking_horizon,
                       _pulse_extrema, _result)
 from .errors import RockingInputError
-from .lanes import run_lanes, run_many
+from .lanes import run_batch, run_lanes, run_many
+from .reference_vertical import VerticalRockingResult, check_axes, simulate_vertical_reference
 
 #: Accuracy knob of the fast engine: the largest ``p_eff * h`` of a step, with
 #: ``p_eff = p sqrt(1 + max|ug''|/g)`` (the fastest rate of the linearised dynamics).  The Taylor
@@ -204,10 +206,16 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         Fast engine only: largest ``p_eff * h`` of a step (default :data:`PH_MAX`, or
         :data:`PH_MAX_RK4` for ``method="rk4"``); smaller means more sub-steps per sample.
     vertical : pulses.Record, optional
-        Upward ground acceleration (m/s^2) on the excitation's time axis (docs/theory.md section
-        10).  The compiled engine does not take it yet: the response is the reference model's
-        (:func:`rocking.simulate_vertical_reference`, ``model="reference-vertical"``, slow), with
-        ``lifts_off`` where ``g + av < 0``.
+        Upward ground acceleration (m/s^2) on the excitation's time axis (a PEER ``DWN`` file
+        negated first), docs/theory.md section 10.  The compiled engine takes it (model
+        ``"fast-vertical"``, Taylor steps; the result is a
+        :class:`rocking.reference_vertical.VerticalRockingResult` with ``lifts_off`` and
+        ``t_lift_off``: where ``g + av < 0`` the block leaves the ground and the run stops
+        there); ``model="reference"`` answers with the independent reference integrator
+        (:func:`rocking.simulate_vertical_reference`, ``"reference-vertical"``, slow).  Records
+        only, the block starting at rest; not with ``model="linear"``.  The history ends with
+        the record (a longer ``duration`` is not filled with free rocking; the verdict after the
+        record is the energy rule's, as without a vertical).
 
     Returns
     -------
@@ -217,9 +225,14 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
         if not isinstance(excitation, Record) or theta0 != 0.0 or omega0 != 0.0:
             raise RockingInputError("simulate: a vertical record goes with a horizontal pulses.Record "
                                     "and the block at rest")
-        from .reference_vertical import simulate_vertical_reference
-
-        return simulate_vertical_reference(block, excitation, vertical, duration=duration, zeno_tol=zeno_tol)
+        if model == "reference":
+            return simulate_vertical_reference(block, excitation, vertical, duration=duration,
+                                               zeno_tol=zeno_tol)
+        if model not in ("auto", "fast") or method != "taylor":
+            raise RockingInputError("simulate: with a vertical record the model is 'fast' (Taylor "
+                                    "steps) or 'reference'")
+        return _simulate_vertical(block, excitation, vertical, duration, history, zeno_tol,
+                                  ph_max, model, tol)
     if not isinstance(block, Block):
         raise TypeError("block must be a rocking.Block")
     for name, value in (("theta0", theta0), ("omega0", omega0)):
@@ -299,12 +312,13 @@ def _never_uplifts(block, excitation, duration, history):
 
 
 def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_tol,
-              stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX):
+              stop_at_rest=False, method=engine.TAYLOR, ph_max=PH_MAX, vertical=None):
     if grid.lazy is not None:
         h = grid.lazy[3]
     else:
         h = grid.h if grid.nodes.size == 0 else float(np.max(np.diff(grid.nodes)))
-    n_sub = _n_sub(h, block.p * math.sqrt(1.0 + grid.u_peak), 0.05 if linear else ph_max)
+    g_max = 1.0 if vertical is None else vertical[2]  # largest effective gravity over g
+    n_sub = _n_sub(h, block.p * math.sqrt(g_max + grid.u_peak), 0.05 if linear else ph_max)
     if linear and grid.kind in (engine.NODAL, engine.RECT, engine.FREE):
         n_sub = 1  # exact for forcing linear on each interval
     if grid.lazy is not None or (grid.kind == engine.FREE and grid.n_int > PART_INTERVALS):
@@ -318,11 +332,12 @@ def _run_grid(grid: _Grid, block: Block, theta0, omega0, linear, history, zeno_t
             engine.Settings(linear, method, zeno_tol, stop_at_rest, history),
             (hist_t, hist_th, hist_om))
     start = engine.Start(0, theta0, omega0, -math.inf)
-    out = engine.run(*args, impacts, start)
+    vert = None if vertical is None else vertical[:2]
+    out = engine.run(*args, impacts, start, vert)
     status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if n_imp > impacts.size:  # rerun with room for every impact time (rare: long Zeno trains)
         impacts = np.empty(n_imp)
-        out = engine.run(*args, impacts, start)
+        out = engine.run(*args, impacts, start, vert)
         status, theta, omega, t_end, max_abs, n_imp, n_hist, uplifted, _ = out
     if history:
         hist_t, hist_th, hist_om = hist_t[:n_hist], hist_th[:n_hist], hist_om[:n_hist]
@@ -464,6 +479,60 @@ def _simulate_compiled(block, excitation, theta0, omega0, duration, linear, hist
                    t_over)
 
 
+def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_max, model, tol):
+    """The compiled engine under horizontal ``record`` and upward ``vertical`` (docs/theory.md
+    section 10): model ``"fast-vertical"``.  A vertical that is zero over the run is no vertical:
+    the horizontal-only model answers (its result bit for bit, its ``model`` named)."""
+    if not isinstance(block, Block):
+        raise TypeError("block must be a rocking.Block")
+    if not isinstance(vertical, Record):
+        raise RockingInputError("simulate: vertical must be a pulses.Record, got "
+                                f"{type(vertical).__name__}")
+    if duration is not None and not (math.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be positive and finite, got {duration!r}")
+    vertical = check_axes(record, vertical)
+    n = record.npts if duration is None else min(record.npts,
+                                                 max(1, math.ceil(duration / record.dt - 1e-9)) + 1)
+    vval = engine.as_input(vertical.acc)
+    quiet, g_min, g_max, zero, u_max = engine.vertical_bounds(record.acc, vval, 1.0 / G, 1.0 / G,
+                                                              block.tan_alpha, n)
+    if zero:
+        out = simulate(block, record, duration=duration, model=model, tol=tol, history=history,
+                       zeno_tol=zeno_tol, ph_max=ph_max)
+        return VerticalRockingResult(**{f: getattr(out, f) for f in out.__dataclass_fields__})
+    if quiet:  # |ag| <= (g + av) tan(alpha) at every sample: no uplift, no lift-off
+        start, end = record.support
+        t = np.array([start, end if duration is None else start + duration]) if history else \
+            np.zeros(0)
+        return VerticalRockingResult(False, False, 0.0, 0.0, np.zeros(0), 0, t, np.zeros_like(t),
+                                     np.zeros_like(t), "rest", "no uplift", False, block=block,
+                                     min_effective_gravity=g_min)
+    ph_max = PH_MAX if ph_max is None else ph_max
+    grid = _grid(record, block.p, False, duration, ph_max, u_max)
+    g_max = max(1.0, g_max)
+    res = _run_grid(grid, block, 0.0, 0.0, False, history, zeno_tol, method=engine.TAYLOR,
+                    ph_max=ph_max, vertical=(vval, 1.0 / G, g_max))
+    status, theta, omega, t_end, max_abs, n_imp, uplifted, impacts, t, th, om = res
+    t_over, t_lift, lifts = math.nan, math.nan, status == engine.LIFTOFF
+    if status == engine.OVERTURNED:
+        over, verdict_by, t_over = True, "integration", t_end
+    elif lifts:
+        # the block leaves the ground: the model ends there (overturned: not before it)
+        over, verdict_by, t_lift = False, "lifts off", t_end
+    elif status == engine.REST:
+        over, verdict_by = False, "integration"
+    else:  # after the records the vertical is zero: the energy rule as without it
+        over, peak = engine.energy_verdict(theta, omega, block.p, block.alpha, block.eta, False)
+        verdict_by = "energy rule"
+        max_abs = math.pi / 2 if over else max(max_abs, peak)
+    max_abs = float(max_abs)
+    return VerticalRockingResult(bool(over), bool(max_abs > block.alpha), max_abs,
+                                 max_abs / block.alpha, impacts, int(n_imp), t, th, om,
+                                 "fast-vertical", verdict_by, bool(uplifted), float(t_over),
+                                 block=block, lifts_off=lifts, t_lift_off=t_lift,
+                                 min_effective_gravity=g_min)
+
+
 # --------------------------------------------------------------------------- batch
 #: smaller batches run one by one (the engine's own loop over a single run is tighter)
 LANES_MIN_RUNS = 4
@@ -498,7 +567,8 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lane
 
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor",
-                  threads: int | None = None, lanes: bool = True) -> BatchResult:
+                  threads: int | None = None, lanes: bool = True,
+                  vertical: Record | None = None) -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
 
     Parameters
@@ -520,6 +590,11 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     lanes : bool
         True: runs under a record go through the batch engine's lanes where they apply; False:
         every run one by one (the same answers; to compare their speed).
+    vertical : pulses.Record, optional
+        Upward ground acceleration (m/s^2) on the record's time axis, scaled with it
+        (docs/theory.md section 10): the runs go one by one through the compiled engine (model
+        ``"fast-vertical"``; Taylor steps) and the result has ``lifts_off`` and ``t_lift_off``.
+        A zero vertical is no vertical (the horizontal-only batch, bit for bit).
 
     Returns
     -------
@@ -529,6 +604,22 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     """
     if model not in ("fast", "linear"):
         raise ValueError("simulate_many supports model='fast' or 'linear'")
+    vval = None
+    if vertical is not None:
+        if not isinstance(excitation, Record) or not isinstance(vertical, Record):
+            raise RockingInputError("simulate_many: a vertical record goes with a horizontal "
+                                    "pulses.Record")
+        if model != "fast" or method != "taylor":
+            raise RockingInputError("simulate_many: with a vertical record the model is 'fast' "
+                                    "with Taylor steps")
+        vval = engine.as_input(check_axes(excitation, vertical).acc)
+        _, g_min, g_max, zero, _ = engine.vertical_bounds(excitation.acc, vval, 1.0 / G, 1.0 / G,
+                                                          0.0, excitation.npts)
+        if zero:
+            out = simulate_many(blocks, excitation, scales, grid=grid, model=model,
+                                method=method, threads=threads, lanes=lanes)
+            none = np.zeros(out.overturned.shape, dtype=bool)
+            return dataclasses.replace(out, lifts_off=none, t_lift_off=np.full(none.shape, np.nan))
     linear = model == "linear"
     blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
     p = np.array([b.p for b in blocks], dtype=float)
@@ -555,10 +646,22 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
             f"than a batch holds ({PART_INTERVALS}); run its blocks one by one with simulate")
     amp = g.amp * scales
     h = g.h if g.nodes.size == 0 else float(np.max(np.diff(g.nodes)))
-    p_eff = p * np.sqrt(1.0 + g.u_peak * np.abs(scales))
+    g_hi = 1.0
+    if vval is not None:  # the largest effective gravity of each run (the vertical scaled too)
+        g_hi = np.maximum(1.0, np.maximum(1.0 + scales * (g_max - 1.0), 1.0 + scales * (g_min - 1.0)))
+    p_eff = p * np.sqrt(g_hi + g.u_peak * np.abs(scales))
     n_sub = _n_sub(h, p_eff, 0.05 if linear else ph_max)
     if linear and g.kind in (engine.NODAL, engine.RECT):
         n_sub[:] = 1
+    if vval is not None:
+        over, max_abs, n_imp, up, t_lift = run_batch(
+            False, g.kind, amp, g.tp, g.t0, g.uval, g.nodes, g.t_start, g.h, g.n_int, n_sub, p,
+            alpha, eta, False, ZENO_TOL, stepper, threads, vval=vval)
+        lifts = ~np.isnan(t_lift)
+        return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
+                           max_abs.reshape(shape), (max_abs / alpha).reshape(shape),
+                           n_imp.reshape(shape), up.reshape(shape), "fast-vertical",
+                           lifts.reshape(shape), t_lift.reshape(shape))
     over, max_abs, n_imp, up = _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads,
                                           lanes)
     ratio = max_abs / alpha

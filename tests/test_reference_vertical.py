@@ -139,8 +139,10 @@ def test_simulate_with_a_vertical_says_which_model_answered():
     block = rocking.Block.from_dimensions(3.0, 0.9)
     rec = record()
     up = pulses.Record(0.2 * G * np.sin(3 * rec.time), rec.dt)
-    res = rocking.simulate(block, rec, vertical=up)
+    res = rocking.simulate(block, rec, vertical=up, model="reference")
     ref = simulate_vertical_reference(block, rec, up)
     assert res.model == "reference-vertical" and res.max_rotation == ref.max_rotation
+    # by default the compiled engine answers (tests/test_vertical_core.py measures it)
+    assert rocking.simulate(block, rec, vertical=up).model == "fast-vertical"
     with pytest.raises(rocking.errors.RockingInputError):
         rocking.simulate(block, pulses.make_pulse("sine", 3.0, 1.0), vertical=up)
