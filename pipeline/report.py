@@ -378,6 +378,10 @@ def _real_folder(folder, top) -> bool:
 # -- the files -------------------------------------------------------------------------------------
 SUMMARY, FAILURES, COLUMNS_MD = "summary.csv", "failures.csv", "columns.md"
 SUMMARY_PLOT = "plots/summary.png"
+#: the site part's tables and figures (pipeline.site: pairs, suite, fragility)
+PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV, FRAGILITY_CURVE_CSV = ("pairs.csv", "suite.csv", "fragility.csv",
+                                                           "fragility_curve.csv")
+SUITE_PLOT, FRAGILITY_PLOT = "plots/suite.png", "plots/fragility.png"
 
 
 def record_csv_name(record_id: str) -> str:

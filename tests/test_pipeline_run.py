@@ -568,12 +568,12 @@ def test_files_the_run_did_not_write_are_left_as_they_are(tmp_path, capsys):
 def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys, monkeypatch):
     """A summary.csv the run did not write, an --out that is a file or cannot be written: exit 2 in
     one line, before any record is read."""
-    from pipeline import runner
+    from pipeline import worker
 
     def no_work(task):
         raise AssertionError("a record was processed")
 
-    monkeypatch.setattr(runner, "process_record", no_work)
+    monkeypatch.setattr(worker, "process_record", no_work)
     rec = write_good(tmp_path, 1)
     out = tmp_path / "out"
     out.mkdir()
@@ -692,9 +692,9 @@ def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
     import signal
     import time
 
-    from pipeline import runner
+    from pipeline import worker
 
-    real, seen = runner.process_record, []
+    real, seen = worker.process_record, []
 
     def swallowing(task):
         seen.append(task.record_id)
@@ -705,7 +705,7 @@ def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
             pass
         return real(task)
 
-    monkeypatch.setattr(runner, "process_record", swallowing)
+    monkeypatch.setattr(worker, "process_record", swallowing)
     recs = [str(write_good(tmp_path, k)) for k in range(3)]
     assert main(["run", *recs, *SAFE_ARGS, "--out", str(tmp_path / "out")]) == 130
     assert seen == ["good00"]

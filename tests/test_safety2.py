@@ -316,12 +316,12 @@ def test_files_of_a_folder_without_search_permission_are_failed_records(tmp_path
 def test_scales_obey_the_scale_rule(table, tmp_path, capsys, monkeypatch):
     """--scales 1e6 ran to the end at 874,060 g (exit 0), 1e-9 failed deep inside after 18 s; rows
     for one record were resolved silently.  Now each is refused at once, in one line."""
-    from pipeline import runner
+    from pipeline import worker
 
     def no_work(task):
         raise AssertionError("a record was processed")
 
-    monkeypatch.setattr(runner, "process_record", no_work)
+    monkeypatch.setattr(worker, "process_record", no_work)
     a = write_good(tmp_path, 1)
     scales = tmp_path / "scales.csv"
     scales.write_text(table)
