@@ -20,8 +20,10 @@ import pathlib
 import stat
 import tempfile
 
+from pulses.shapes import AntisymmetricRicker, OneSine, Rectangular, SymmetricRicker
+
 #: shapes that get their own group of columns, in this order (``pulses.SHAPES`` names)
-SHAPE_NAMES = ("sine", "ricker-sym", "ricker-anti", "rect")
+SHAPE_NAMES = tuple(cls.shape for cls in (OneSine, SymmetricRicker, AntisymmetricRicker, Rectangular))
 
 #: a shape "fits" a record when its score is at least this fraction of the best score
 FIT_TOLERANCE = 0.7

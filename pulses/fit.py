@@ -157,7 +157,7 @@ class Candidate:
     Attributes
     ----------
     shape : str
-        ``"rect"``, ``"sine"``, ``"ricker-sym"`` or ``"ricker-anti"``.
+        A name of :data:`pulses.SHAPES` (the shapes of docs/theory.md section 2).
     ap : float
         Amplitude, m/s^2, signed by polarity.
     tp : float
@@ -301,7 +301,7 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     record : pulses.Record
         Ground acceleration, m/s^2.
     shapes : iterable of str, optional
-        Shapes to fit (default all four: ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``, ``"rect"``).
+        Shapes to fit (names of :data:`pulses.SHAPES`; default all four).
     tp_range : (float, float), optional
         Shortest and longest period searched, s (default :func:`default_tp_range`).
     baseline : bool, optional
