@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import collections
 import contextlib
+import dataclasses
 import os
 import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import design_table, html_report, interrupts, joblog, outlock, report, resume, site
+from . import design_table, html_report, interrupts, joblog, outfiles, outlock, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
@@ -44,14 +45,8 @@ def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> rep
         outputs = report.Outputs(out)
     except report.NotOurs as exc:
         raise ArgumentError(f"--out {shown}: {exc}; choose another folder") from None
-    fixed = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.MANIFEST]
-    if plots:
-        fixed.append(report.SUMMARY_PLOT)
-    fixed += site.output_files(options) + answer_files()
-    written = fixed + [report.record_csv_name(t.record_id) for t in tasks]
-    if plots:
-        written += [report.record_plot_name(t.record_id) for t in tasks]
-        written += [report.record_widths_plot_name(t.record_id) for t in tasks]
+    fixed = outfiles.fixed_files(dataclasses.replace(options, plots=plots))
+    written = fixed + [n for t in tasks for n in outfiles.record_files(t.record_id, plots)]
     inputs = {}
     for t in tasks:
         for path in (t.path, t.path2):  # both files of a pair are inputs
@@ -111,15 +106,6 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
         res["failure"] = failure(task, "write", problems[0])
 
 
-def _own_files(tasks, options) -> list[str]:
-    """Every file a run of ``tasks`` may write into its output folder (paths relative to it)."""
-    names = [report.SUMMARY, report.FAILURES, report.COLUMNS_MD, report.SUMMARY_PLOT, report.MANIFEST,
-             resume.RESUME] + site.output_files(options) + answer_files()
-    return names + [n for t in tasks for n in (report.record_csv_name(t.record_id),
-                                               report.record_plot_name(t.record_id),
-                                               report.record_widths_plot_name(t.record_id))]
-
-
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None, tasks=None, force: bool = False,
@@ -156,12 +142,12 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
         from .outpaths import check_output_file
 
         check_output_file(log, "--log", "log", inputs=[p for t in tasks for p in (t.path, t.path2)],
-                          reserved=[out / rel for rel in _own_files(tasks, options)], command="run")
+                          reserved=[out / rel for rel in outfiles.own_files(tasks, options)], command="run")
     try:
         journal = resume.Journal(out)
     except report.NotOurs as exc:
         raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
-    resume.remove_stale_temporaries(out, _own_files(tasks, options))  # left by a run killed while writing
+    resume.remove_stale_temporaries(out, outfiles.own_files(tasks, options))  # left by a run killed while writing
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch
@@ -269,19 +255,14 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
 
 
 # -- the answer in view: design.csv, report.html (pipeline.design_table, pipeline.html_report) --------
-def answer_files() -> list[str]:
-    """The files :func:`write_answer` writes into ``--out``."""
-    return [design_table.DESIGN_CSV] + html_report.output_files()
-
-
 def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
     """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
     design = design_table.design_rows(rows, failed)
     outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.DESIGN_FIELDS, design))
     ids = [t.record_id for t in tasks]
-    this_run = set(site.output_files(options))  # a figure of an earlier run with other options is not shown
-    names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", site.SUITE_PLOT),
-                                   ("fragility", site.FRAGILITY_PLOT)) if k == "summary" or rel in this_run}
+    this_run = set(outfiles.fixed_files(options))  # a figure of an earlier run with other options is not shown
+    names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", report.SUITE_PLOT),
+                                   ("fragility", report.FRAGILITY_PLOT)) if k == "summary" or rel in this_run}
     figures = html_report.figures_in(out, ids, options.plots, names)
     outputs.write(html_report.REPORT_HTML, html_report.report_html(design, rows, failures, ids, figures))
     return design

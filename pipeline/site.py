@@ -193,16 +193,6 @@ def options_from_args(args) -> dict:
     return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to}
 
 
-def output_files(options) -> list[str]:
-    """The fixed files the site part writes into ``--out``."""
-    files = [PAIRS_CSV, SUITE_CSV]
-    if options.plots:
-        files.append(SUITE_PLOT)
-    if options.fragility:
-        files += [FRAGILITY_CSV, FRAGILITY_CURVE_CSV] + ([FRAGILITY_PLOT] if options.plots else [])
-    return files
-
-
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------
 PAIR_COLUMNS = Columns(
     ("n_directions", "-", "Directions designed for (rows of this pair and column in `summary.csv`)."),

@@ -12,13 +12,7 @@ import pathlib
 import re
 from dataclasses import dataclass, field
 
-from .report import COLUMNS_MD, FAILURES, FRAGILITY_CSV, FRAGILITY_CURVE_CSV, PAIRS_CSV, SUITE_CSV, SUMMARY
-
-#: record ids that would collide with the run's own reports (their names without extension)
-RESERVED_IDS = {name.rsplit(".", 1)[0] for name in
-                (SUMMARY, FAILURES, COLUMNS_MD, PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV,
-                 FRAGILITY_CURVE_CSV)}
-
+from .outfiles import RESERVED_IDS
 
 @dataclass(frozen=True)
 class Column:
