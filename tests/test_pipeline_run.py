@@ -129,6 +129,7 @@ def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20)
             assert len(re.findall(r"(?<!\\)\|", line)) == 4, line
 
 
+@pytest.mark.slow
 def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
     """Re-running into the same folder, now with 2 processes, leaves every file as it was."""
     code, out = batch_run
@@ -141,6 +142,7 @@ def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
 PLOT_ARGS = ["--block", "7.5x1.8", "--block", "6x1.2", "--quiet"]
 
 
+@pytest.mark.slow
 def test_plots_identical_whatever_jobs_and_on_rerun(tmp_path):
     """With plots (one figure reused per worker process): --jobs 1, --jobs 2 and a re-run into the
     same folder give the same bytes in every file, PNGs included."""
@@ -157,6 +159,7 @@ def test_plots_identical_whatever_jobs_and_on_rerun(tmp_path):
         {n: b for n, b in first.items() if n.endswith(".png") and "summary" not in n}
 
 
+@pytest.mark.slow
 def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     """A record's PNG does not depend on what the process drew before: drawn alone by a fresh
     process, and drawn last after records of other lengths and verdicts (good09 overturns at 6 m);
@@ -223,6 +226,7 @@ def test_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
     assert [p.name for p in tmp_path.iterdir()] == ["summary.csv"]
 
 
+@pytest.mark.slow
 def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
     """SIGINT in the middle of a batch: exit 130, no temporary files, every CSV complete."""
     import signal
@@ -407,6 +411,7 @@ def test_erzincan_ns_plain_text_processed(paper_run):
 
 
 # -- dask -----------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
     """A local dask cluster on part of the batch: the same per-record reports and failure rows."""
     pytest.importorskip("dask.distributed")
@@ -425,6 +430,7 @@ def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
 
 
 # -- demo -------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_demo_from_another_directory(tmp_path):
     """`pipeline demo` from an unrelated folder: bundled records, ./demo-output, plots, no noise."""
     proc = subprocess.run([sys.executable, "-m", "pipeline", "demo", "--jobs", "2"],
@@ -686,6 +692,7 @@ def test_report_rows_must_match_their_declared_columns():
         RECORD_COLUMNS.row({k: v for k, v in values.items() if k != "event"})
 
 
+@pytest.mark.slow
 def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
     """Ctrl-C whose exception is swallowed (as in a callback Python cannot raise from) still ends
     the run with status 130 before the next record."""
@@ -757,6 +764,7 @@ def _check_reports_whole(out):
             assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
 
 
+@pytest.mark.slow
 def test_double_ctrl_c_with_two_jobs_ends_at_once_and_leaves_no_process(tmp_path):
     """The issue's hang: two Ctrl-C with --jobs 2 (sent to the process group, as a terminal does).
     Exit 130 well within 10 s (measured ~0.3-1 s here), no worker or fork server left behind, every
@@ -771,6 +779,7 @@ def test_double_ctrl_c_with_two_jobs_ends_at_once_and_leaves_no_process(tmp_path
     _check_reports_whole(out)
 
 
+@pytest.mark.slow
 def test_sigterm_ends_a_pool_run_with_143(tmp_path):
     import signal
 

@@ -38,6 +38,7 @@ def whole(batch, tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_killed_batch_resumes_with_only_the_missing_records_and_same_bytes(batch, whole, tmp_path, capsys):
     out = tmp_path / "out"
     args = [a for a in BATCH_ARGS if a != "--quiet"]

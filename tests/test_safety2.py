@@ -44,6 +44,7 @@ def alone(recs, tmp_path_factory):
     return tree(out)
 
 
+@pytest.mark.slow
 def test_a_second_run_into_a_busy_out_is_refused_and_nothing_is_lost(recs, alone, tmp_path):
     """Two real processes into one --out: the second is refused at once (exit 2, one line), the
     first finishes as if alone, and the folder is usable by the next run."""

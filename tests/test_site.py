@@ -80,6 +80,7 @@ def pair_run(pairs, tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_a_failed_direction_is_counted_in_pairs_csv(pairs, pair_run, tmp_path, monkeypatch):
     # one direction of the first pair fails (its worker kills itself): the pair's governing row
     # says so, and is the widest of the other directions; the second pair is untouched
@@ -165,6 +166,7 @@ def test_direction_equals_rotated_record_file(pairs, pair_run, tmp_path):
     assert row["direction_kind"] == "even" and row["file2"] == str(a2)
 
 
+@pytest.mark.slow
 def test_jobs_do_not_change_outputs_and_bad_inputs_fail_alone(pairs, tmp_path):
     folder, ((a1, a2), (b1, b2)) = pairs
     missing = folder / "missing.sac"
