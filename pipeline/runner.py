@@ -151,18 +151,8 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch
-    texts: list[str] = [""] * len(tasks)
+    texts, keys, todo = _reusable(tasks, journal, force, options.plots)
     failures: list[dict | None] = [None] * len(tasks)
-    version = resume.package_version()
-    keys = [resume.task_key(t, version) for t in tasks]
-    todo = []
-    for t, key in zip(tasks, keys):
-        kept = None if force else journal.reusable(t, key, options.plots)
-        if kept is None:
-            journal.drop(t.record_id)
-            todo.append(t)
-        else:
-            texts[t.index] = kept
     n_reused = len(tasks) - len(todo)
     try:
         log = joblog.JobLog(log)
@@ -172,18 +162,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
         if texts[t.index]:
             log.record(None, t.record_id, reused=True)
 
-    if progress is None:
-        progress = (not quiet) and sys.stderr.isatty()
-    bar = None
-    if progress and todo:
-        import shutil
-
-        from tqdm import tqdm
-
-        # a terminal that reports a size of 0 x 0 (some pseudo-terminals) would hide the bar
-        size = shutil.get_terminal_size((100, 24))
-        bar = tqdm(total=len(todo), unit="record", file=sys.stderr, desc="pipeline run",
-                   ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
+    bar = _progress_bar(len(todo), quiet, progress)
 
     def say(msg):
         if quiet:
@@ -228,6 +207,56 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts
+    design = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
+    journal.finish([t.record_id for t in tasks])
+    n_failed = len(failures)
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
+    if not quiet:
+        msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
+        msg += f" ({n_reused} reused from an earlier run, {len(todo)} computed)"
+        if n_failed:
+            msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
+        print(design_table.table_text(design, failures), end="")
+        print(f"{msg}; reports in {report.display(out)}")
+    return summary
+
+
+def _reusable(tasks, journal, force: bool, plots: bool):
+    """``(texts, keys, todo)``: each task's rows as its kept report holds them ("" where it must be
+    computed), its resume key, and the tasks to compute (their journal entries dropped)."""
+    texts: list[str] = [""] * len(tasks)
+    version = resume.package_version()
+    keys = [resume.task_key(t, version) for t in tasks]
+    todo = []
+    for t, key in zip(tasks, keys):
+        kept = None if force else journal.reusable(t, key, plots)
+        if kept is None:
+            journal.drop(t.record_id)
+            todo.append(t)
+        else:
+            texts[t.index] = kept
+    return texts, keys, todo
+
+
+def _progress_bar(n_todo: int, quiet: bool, progress: bool | None):
+    """A tqdm bar over ``n_todo`` records on a terminal (``progress`` None: when stderr is one), or None."""
+    if progress is None:
+        progress = (not quiet) and sys.stderr.isatty()
+    if not (progress and n_todo):
+        return None
+    import shutil
+
+    from tqdm import tqdm
+
+    # a terminal that reports a size of 0 x 0 (some pseudo-terminals) would hide the bar
+    size = shutil.get_terminal_size((100, 24))
+    return tqdm(total=n_todo, unit="record", file=sys.stderr, desc="pipeline run",
+                ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
+
+
+def _write_tables(outputs, out, tasks, header, text, failures, failed, options) -> list[dict]:
+    """Write the run's own files from every record's rows (``text``: summary.csv's rows as the records'
+    reports hold them, below ``header``); return the design rows."""
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
@@ -241,17 +270,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
         outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
     outputs.finish()
-    journal.finish([t.record_id for t in tasks])
-    n_failed = len(failures)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
-    if not quiet:
-        msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
-        msg += f" ({n_reused} reused from an earlier run, {len(todo)} computed)"
-        if n_failed:
-            msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
-        print(design_table.table_text(design, failures), end="")
-        print(f"{msg}; reports in {report.display(out)}")
-    return summary
+    return design
 
 
 # -- the answer in view: design.csv, report.html (pipeline.design_table, pipeline.html_report) --------
