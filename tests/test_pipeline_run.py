@@ -100,6 +100,7 @@ def batch_run(batch20, tmp_path_factory):
 
 
 # -- robustness ------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20):
     code, out = batch_run
     assert code == 1
@@ -196,6 +197,7 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     assert plots.run_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
 
 
+@pytest.mark.slow
 def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
     rec = write_good(tmp_path, 1)
     out = tmp_path / "out"
@@ -256,6 +258,7 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
         assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
 
 
+@pytest.mark.slow
 def test_progress_bar_only_when_asked_or_on_a_terminal(tmp_path, capsys):
     from pipeline.runner import run
 
@@ -275,6 +278,7 @@ def test_record_ids_are_unique_and_safe():
 
 
 # -- end to end on converted SAC files, numbers against the library called directly ---------------
+@pytest.mark.slow
 def test_cli_end_to_end_numbers_match_library(tmp_path):
     """A plain-text record (cm/s2) -> `pipeline convert --to sac` -> `pipeline run`; every number in
     the report is checked against the library functions called directly on the converted file."""
@@ -363,6 +367,7 @@ def paper_run(tmp_path_factory):
     return code, out
 
 
+@pytest.mark.slow
 def test_rinaldi_eq31_and_survival_of_the_temple_column(paper_run):
     code, out = paper_run
     assert code == 0, read_csv(out / "failures.csv")
@@ -492,6 +497,7 @@ def test_record_options_are_the_same_for_every_reading_command():
     assert all(opts == expected for opts in parsed.values()), parsed
 
 
+@pytest.mark.slow
 def test_run_reads_the_trace_asked_for(tmp_path):
     """A two-trace MiniSEED file: without --trace the record fails with a message naming --trace;
     with --trace HNN the report's PGA is that trace's peak (numpy's max of the samples written)."""
@@ -538,6 +544,7 @@ def test_an_input_inside_out_is_never_overwritten(tmp_path, capsys):
     assert sorted(p.name for p in b1.iterdir()) == ["erzikan.csv"]  # nothing else written either
 
 
+@pytest.mark.slow
 def test_files_the_run_did_not_write_are_left_as_they_are(tmp_path, capsys):
     """A user's own <id>.csv, an edited report, and a failed record's namesake are never replaced
     or deleted; the run says so, and the record's rows still reach summary.csv."""
@@ -596,6 +603,7 @@ def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys,
     assert (out / "summary.csv").read_text() == "mine\n" and afile.read_text() == "x"
 
 
+@pytest.mark.slow
 def test_write_errors_and_odd_names_fail_one_record_only(tmp_path):
     """A 250-character file name, a name whose bytes are not UTF-8, and a report path taken by a
     folder: each is handled or fails alone; the batch writes summary.csv and failures.csv."""
@@ -621,6 +629,7 @@ def test_write_errors_and_odd_names_fail_one_record_only(tmp_path):
     assert max(len(os.fsencode(p.name)) for p in out.iterdir()) < 120
 
 
+@pytest.mark.slow
 def test_no_write_goes_through_a_planted_symlink(tmp_path):
     """Symbolic links planted in --out (at the old predictable temporary name, and at a report's
     name) never lead a write to their target."""
@@ -648,6 +657,7 @@ def test_no_write_goes_through_a_planted_symlink(tmp_path):
     assert list(elsewhere.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_text_cells_are_never_formulas(tmp_path, monkeypatch):
     """Header text and file names that a spreadsheet would evaluate get a leading apostrophe;
     numbers (negative ones included) are written as they are."""

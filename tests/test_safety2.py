@@ -191,6 +191,7 @@ def test_run_log_never_onto_an_input_or_the_runs_own_files(tmp_path, capsys):
     assert main(["run", str(b), *SAFE_ARGS, "--out", str(out)]) == 0  # the folder is usable
 
 
+@pytest.mark.slow
 def test_classify_plot_never_replaces_a_users_png(tmp_path, capsys):
     """``classify --plot DIR`` replaced a user's PNG of the same name; now only its own PNGs."""
     a = write_good(tmp_path, 1)
@@ -241,6 +242,7 @@ def test_every_command_checks_its_file_outputs_the_same_way(tmp_path, capsys, mo
 
 
 # -- 4. folder inputs: broken entries are failed records, never skipped -----------------------------
+@pytest.mark.slow
 def test_broken_entries_of_a_folder_are_failed_records(tmp_path, capsys):
     """A dangling link and a link loop in a folder were skipped (exit 0); given by a glob they failed.
     Now both ways give the same failed records, with the reason."""
@@ -486,6 +488,7 @@ def test_the_strongest_map_gives_what_the_whole_map_gives():
             strongest.clear(cleared)
 
 
+@pytest.mark.slow
 def test_classification_caches_stay_within_their_bytes():
     """A 10 kHz record: the filters' caches hold at most their budgets (they held 10.9 GB after a
     2e6-sample record)."""
