@@ -12,7 +12,6 @@ MAX_LINES = 100
 #: entry is removed when its function is split (issue 26 lists them)
 KNOWN_LONG = {
     "pulses/fit.py:_refine_weighted": 168,
-    "rocking/widths.py:_record_width": 162,
 }
 
 
