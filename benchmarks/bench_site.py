@@ -30,11 +30,11 @@ def shared_pairs():
 
 
 def cost(pair, columns, n_even, fragility):
-    from pipeline import site
+    from pipeline import pairs
     from pipeline.batch import Options, process_record
 
     opts = Options(plots=False, fragility=fragility)
-    tasks = site.make_tasks([], [pair], "none", columns, opts, n_even, say=lambda m: None)
+    tasks = pairs.pair_tasks([], [pair], "none", columns, opts, n_even, say=lambda m: None)
     t0, c0 = time.perf_counter(), time.process_time()
     out = [process_record(t) for t in tasks]
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0

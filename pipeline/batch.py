@@ -9,117 +9,21 @@ blocks at once), ``rocking.required_width``); nothing here is a second implement
 """
 from __future__ import annotations
 
-import hashlib
 import math
-import os
-import pathlib
-import re
 import threading
 import time
-from dataclasses import dataclass, field
+
+from pulses.shapes import AntisymmetricRicker
 
 from . import peer_inputs, site, vertical
-from .report import COLUMNS_MD, FAILURES, FIT_TOLERANCE, SHAPE_NAMES, SUMMARY, Columns, _shape_key
-
-#: record ids that would collide with the run's own reports (their names without extension)
-RESERVED_IDS = {name.rsplit(".", 1)[0] for name in
-                (SUMMARY, FAILURES, COLUMNS_MD, site.PAIRS_CSV, site.SUITE_CSV, site.FRAGILITY_CSV,
-                 site.FRAGILITY_CURVE_CSV)}
-
-
-@dataclass(frozen=True)
-class Column:
-    """A column as it stands (``width`` set) or only a height to size (``width`` None)."""
-
-    height: float
-    width: float | None = None
-
-    @property
-    def label(self) -> str:
-        return f"{self.height:g}x{self.width:g}" if self.width is not None else f"{self.height:g}"
-
-    @property
-    def kind(self) -> str:
-        return "block" if self.width is not None else "height"
-
-
-@dataclass(frozen=True)
-class Options:
-    shapes: tuple | None = None
-    #: the pulse fit's least squares (``pulses.fit_pulse``'s ``weighting``)
-    weighting: str = "background"
-    units: str | None = None
-    dt: float | None = None
-    column: int | None = None
-    format: str | None = None
-    trace: str | None = None
-    plots: bool = True
-    #: a rocking frame's cap beam mass over the columns' (0: lone columns); see pipeline.site
-    cap_mass_ratio: float = 0.0
-    fragility: bool = False
-    up_to: float = 10.0
-    #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
-    vertical: str = "auto"
-
-
-@dataclass(frozen=True)
-class Task:
-    index: int
-    record_id: str
-    path: str
-    columns: tuple = ()
-    options: Options = field(default_factory=Options)
-    #: a direction of a pair (pipeline.site): the second file, the angle (deg) and why it was chosen
-    path2: str | None = None
-    direction: float | None = None
-    direction_kind: str = ""
-    pair: str = ""
-    scale: float = 1.0
-    pair_fields: tuple = ()
-    #: a record of a PEER download (pipeline.peer_inputs.PeerSource): where its files are read from
-    peer: object = None
-    #: the vertical component's file of a pair (pipeline.vertical: --triplet, --pairs auto)
-    vertical: str | None = None
-
+from .report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
+from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
 class StageError(Exception):
     def __init__(self, stage, exc):
         super().__init__(str(exc))
         self.stage = stage
         self.exc = exc
-
-
-# -- record ids ------------------------------------------------------------------------------------
-#: longest record id (characters, all ASCII): ``<id>.csv`` and its temporary name stay far below the
-#: 255 bytes file systems allow, whatever the input's name
-MAX_ID_LENGTH = 96
-
-
-def record_ids(paths) -> list[str]:
-    """Unique, file-system-safe ids from the file names, in input order.
-
-    Characters other than ASCII letters, digits and ``._+-`` become ``_`` (a name's bytes need not
-    be UTF-8); an id never starts with ``.``, ``+`` or ``-``; a name longer than
-    :data:`MAX_ID_LENGTH` is cut and ends in a short hash of the whole name.
-    """
-    ids, seen = [], {}
-    for path in paths:
-        name = pathlib.PurePath(str(path)).name
-        stem = name.rsplit(".", 1)[0] if "." in name.lstrip(".") else name
-        stem = re.sub(r"[^A-Za-z0-9._+-]+", "_", stem)
-        stem = re.sub(r"^[._+-]+|[._]+$", "", stem) or "record"
-        if len(stem) > MAX_ID_LENGTH:
-            digest = hashlib.sha1(os.fsencode(name)).hexdigest()[:8]
-            stem = stem[:MAX_ID_LENGTH - 9].rstrip("._") + "-" + digest
-        if stem.lower() in RESERVED_IDS:
-            stem += "-record"
-        base, k = stem, 1
-        while stem.lower() in seen:
-            k += 1
-            stem = f"{base}-{k}"
-        seen[stem.lower()] = True
-        ids.append(stem)
-    return ids
 
 
 # -- the work ---------------------------------------------------------------------------------------
@@ -268,7 +172,7 @@ RECORD_COLUMNS = Columns(
     ("pgv_m_s", "m/s", "Peak absolute ground velocity (from the fitter, after its baseline correction)."),
     ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated."),
     ("pulse_shape", "-", "Best-fitting pulse shape: `sine` (one-sine, Eq. 9), `ricker-sym` (symmetric "
-                         "Ricker, Eq. 7), `ricker-anti` (antisymmetric Ricker, Eq. 8) or `rect` "
+                         "Ricker, Eq. 7), `" + AntisymmetricRicker.shape + "` (antisymmetric Ricker, Eq. 8) or `rect` "
                          "(rectangular)."),
     ("pulse_ap_g", "g", "Amplitude ap of the best-fitting pulse, signed by its polarity."),
     ("pulse_tp_s", "s", "Period Tp of the best-fitting pulse (for the Rickers, the period at the peak "

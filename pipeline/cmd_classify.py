@@ -6,8 +6,8 @@ period Tp, the peak velocity and the orientation of the strongest pulse.  Files 
 what they say (``--pairs auto``, the default: NGA-West2 names, ``_1``/``_2``, the header's
 station and event; verticals are left out) or as named with ``--pair A B``.
 
-:func:`classify_fields` gives the columns ``pipeline run`` adds to its reports, from the same
-place as this command's rows.
+:mod:`pipeline.pulse_row` gives this command's rows and the columns ``pipeline run`` adds to its
+reports, from one place.
 """
 from __future__ import annotations
 
@@ -15,36 +15,7 @@ import json
 import sys
 
 from .args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
-
-#: columns of one row, in order (units in the names)
-COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
-           "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio"]
-#: the subset ``pipeline run`` reports
-RUN_COLUMNS = ["pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "orientation_deg", "azimuth_deg"]
-
-def result_row(result, file="", file2="") -> dict:
-    """One report row of a :class:`pulses.PulseClassification` (see :data:`COLUMNS`)."""
-    return {"file": str(file), "file2": str(file2) if file2 else "", "pulse_like": bool(result.is_pulse),
-            "velocity_pulse_indicator": float(result.indicator), "velocity_tp_s": float(result.tp),
-            "pgv_m_s": float(result.pgv), "orientation_deg": float(result.orientation),
-            "azimuth_deg": None if result.azimuth is None else float(result.azimuth),
-            "arrival_s": float(result.arrival), "late": bool(result.late),
-            "pgv_ratio": float(result.pgv_ratio), "energy_ratio": float(result.energy_ratio)}
-
-
-def classify_fields(record, other=None) -> dict:
-    """The velocity-pulse columns of ``pipeline run`` for one record or pair.
-
-    Returns ``pulse_like`` (bool), ``velocity_pulse_indicator`` (Shahi & Baker's PI),
-    ``velocity_tp_s`` (s), ``orientation_deg`` (from the first component towards the second; 0
-    for one component) and ``azimuth_deg`` (clockwise from north, 0..180, or None).  Raises
-    :class:`pulses.RecordError` for a pair that cannot be used.
-    """
-    from pulses import classify_pulse
-
-    row = result_row(classify_pulse(record, other))
-    return {k: row[k] for k in RUN_COLUMNS}
-
+from .pulse_row import COLUMNS, RUN_COLUMNS, classify_fields, result_row  # noqa: F401 (this command's row)
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
@@ -72,7 +43,7 @@ def _message(path, exc) -> str:
 def main(args) -> int:
     import pulses
 
-    from .runner import expand_inputs
+    from .tasks import expand_inputs
 
     if not args.files and not args.pair:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
@@ -160,7 +131,7 @@ def main(args) -> int:
 
 def _unique_stem(name, taken) -> str:
     """A file-system-safe stem for ``name`` not in ``taken`` (``-2``, ``-3``, ... appended)."""
-    from .batch import record_ids
+    from .tasks import record_ids
 
     base = record_ids([name])[0]
     stem, k = base, 1

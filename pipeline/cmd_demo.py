@@ -37,7 +37,7 @@ def bundled_records():
 
 
 def main(args) -> int:
-    from .batch import Column
+    from .tasks import Column
     from .args import parse_block
     from .runner import run
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from . import peer_inputs, site, vertical
+from . import pairs, peer_inputs, site, vertical
 from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
                    parse_shapes, record_options)
 
@@ -85,7 +85,7 @@ def parse_jobs(text) -> int | None:
 
 
 def build_columns(blocks, heights):
-    from .batch import Column
+    from .tasks import Column
 
     columns = [Column(*parse_block(b)) for b in blocks]
     columns += [Column(parse_length(h, "--height (m)")) for h in heights]
@@ -95,7 +95,7 @@ def build_columns(blocks, heights):
 
 
 def options_from(args, **overrides):
-    from .batch import Options
+    from .tasks import Options
 
     kw = dict(plots=bool(args.plots))
     kw.update(overrides)
@@ -103,7 +103,8 @@ def options_from(args, **overrides):
 
 
 def main(args) -> int:
-    from .runner import expand_inputs, run
+    from .runner import run
+    from .tasks import expand_inputs
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
@@ -120,13 +121,7 @@ def main(args) -> int:
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
-    if downloads:
-        tasks = peer_inputs.tasks_from_args(args, downloads, paths, columns, options)
-    else:
-        if args.peer_scales:
-            raise ArgumentError("--peer-scales applies to PEER downloads (a .zip, or a folder holding "
-                                "_SearchResults.csv); none was given")
-        tasks = site.tasks_from_args(args, paths, columns, options)
+    tasks = pairs.tasks_from_args(args, downloads, paths, columns, options)
     if tasks is not None and args.vertical == "auto":
         found = {}
         if args.pairs == "auto":

@@ -3,7 +3,7 @@
 
 The search report ``_SearchResults.csv`` (:mod:`pulses.peer`) says which files form a record: each
 record with both horizontals in the download is designed as a pair, in every direction
-(:mod:`pipeline.site`, as ``--pair`` does), with the report's metadata in every row
+(:mod:`pipeline.pairs`, as ``--pair`` does), with the report's metadata in every row
 (:data:`PEER_COLUMNS`, and ``peer_tp_s`` next to the package's ``velocity_tp_s``).  A record whose
 listed files are not all in the download fails, with the files it lacks, in ``failures.csv``: the
 run goes on and exits with status 1.  Records are designed as recorded unless ``--peer-scales``
@@ -14,7 +14,6 @@ record carries a :class:`PeerSource` (plain data): the worker reads its files fr
 """
 from __future__ import annotations
 
-import dataclasses
 import functools
 import os
 from dataclasses import dataclass
@@ -151,64 +150,6 @@ def record_units(download, scaled: bool, say) -> list[tuple]:
     return units
 
 
-def make_tasks(downloads, columns, options, n_directions, scale, scales, peer_scales: bool, say):
-    """The tasks of the PEER downloads: each complete record a pair in every direction
-    (:func:`pipeline.site.directions`), each incomplete one a task that fails when read, with the
-    reason.  Indices and record ids are set by :func:`combine`."""
-    from pulses import RecordError, check_pair
-
-    from . import site
-    from .batch import Task
-
-    tasks = []
-    for download in downloads:
-        for entry, src in record_units(download, peer_scales, say):
-            if entry is None:  # the download itself cannot be read: one failure for it
-                tasks.append(Task(0, _stem(download) + ".zip", download, tuple(columns), options,
-                                  peer=src))
-                continue
-            d = open_download(download)
-            path1, path2 = d.display(src.h1), d.display(src.h2) if src.h2 else None
-            pname = site.pair_name(path1, path2 or path1)
-            k = float(entry.metadata.get("scale_factor") or 1.0) if peer_scales else 1.0
-            names = [path1, pname, f"RSN{entry.rsn}", src.h1 or ""]
-            if scales is not None:
-                k *= site._scale_for(scales, 1.0, names)
-            k *= scale
-            fields, angles = {}, [(0.0, "component-1")]
-            if not src.missing:
-                try:
-                    first, second = check_pair(d.read_component(src.h1), d.read_component(src.h2))
-                    fields = site._pair_classification(first, second)
-                    angles = site.directions(fields.get("orientation_deg"), n_directions)
-                except RecordError:
-                    pass  # the task fails at reading, with the reason
-            if src.missing:  # a failure of the record, not of a direction
-                tasks.append(Task(0, pname + ".pair", path1, tuple(columns), options, path2=path2,
-                                  pair=pname, scale=k, peer=src))
-                continue
-            for angle, kind in angles:
-                tasks.append(Task(0, f"{pname}_{angle:05.1f}deg.dir", path1, tuple(columns), options,
-                                  path2=path2, direction=angle, direction_kind=kind, pair=pname,
-                                  scale=k, pair_fields=tuple(fields.items()), peer=src))
-    return tasks
-
-
-def _stem(path) -> str:
-    return os.path.splitext(os.path.basename(os.path.normpath(str(path))))[0] or "download"
-
-
-def combine(*groups) -> list:
-    """Tasks of several sources as one batch: indices in order, record ids unique over all."""
-    from .batch import record_ids
-
-    tasks = [t for g in groups for t in g]
-    # a PEER task's id is still its name with an extension (``.dir``); the others' are final
-    names = [t.record_id if t.peer is not None else t.record_id + ".id" for t in tasks]
-    ids = record_ids(names)
-    return [dataclasses.replace(t, index=i, record_id=rid) for i, (t, rid) in enumerate(zip(tasks, ids))]
-
-
 # -- in the worker -----------------------------------------------------------------------------------
 def read_components(task, vertical: bool = True):
     """``(first, second, vertical or None, vertical's name)`` of a PEER task, as read (unscaled,
@@ -248,22 +189,3 @@ def tp(task):
     return None if src is None else src.tp
 
 
-# -- command line ------------------------------------------------------------------------------------
-def tasks_from_args(args, downloads, paths, columns, options):
-    """Every task of ``pipeline run`` when PEER downloads are among the inputs: the other files as
-    :func:`pipeline.site.tasks_from_args` makes them (one per file, or pairs), then the downloads'."""
-    import sys
-
-    from . import runner, site
-    from .args import ArgumentError
-
-    n, scale, scales = site.settings_from_args(args)
-    if scales is not None and args.peer_scales:
-        raise ArgumentError("give --scales or --peer-scales, not both")
-    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=sys.stderr))
-    others = []
-    if paths or args.pair:
-        others = site.tasks_from_args(args, paths, columns, options)
-        if others is None:
-            others = runner.make_tasks(paths, columns, options)
-    return combine(others, make_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say))

@@ -20,7 +20,8 @@ import shutil
 import tempfile
 import uuid
 
-from .batch import Task, process_record
+from .batch import process_record
+from .tasks import Task
 
 
 def read_bytes(path: str) -> bytes | None:
@@ -34,12 +35,12 @@ def read_bytes(path: str) -> bytes | None:
 
 
 def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
-    """Run on a worker: :func:`pipeline.runner.work` on ``data`` (and ``data2``, the second file of
+    """Run on a worker: :func:`pipeline.worker.work` on ``data`` (and ``data2``, the second file of
     a pair), written to private files named as the originals; the result names the original paths."""
-    from . import runner
+    from . import worker
 
-    if not runner._in_worker:
-        runner.init_worker()  # also in a worker the nanny restarted after a death
+    if not worker._in_worker:
+        worker.init_worker()  # also in a worker the nanny restarted after a death
     folder = tempfile.mkdtemp(prefix="pipeline-record-")
     swaps = {}
     try:
@@ -55,7 +56,7 @@ def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
         changes = {"path": local["1"]}
         if "2" in local:
             changes["path2"] = local["2"]
-        res = runner.work(dataclasses.replace(task, **changes))
+        res = worker.work(dataclasses.replace(task, **changes))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     res["file"] = task.path
@@ -74,7 +75,7 @@ def run_dask(tasks, client, workers: int):
     """Results of every task on ``client``'s cluster, in completion order."""
     from dask.distributed import as_completed
 
-    from .runner import worker_failure
+    from .worker import worker_failure
 
     queue = collections.deque(tasks)
     retries = collections.deque()  # records whose worker died once: one at a time

@@ -20,8 +20,10 @@ import pathlib
 import stat
 import tempfile
 
+from pulses.shapes import AntisymmetricRicker, OneSine, Rectangular, SymmetricRicker
+
 #: shapes that get their own group of columns, in this order (``pulses.SHAPES`` names)
-SHAPE_NAMES = ("sine", "ricker-sym", "ricker-anti", "rect")
+SHAPE_NAMES = tuple(cls.shape for cls in (OneSine, SymmetricRicker, AntisymmetricRicker, Rectangular))
 
 #: a shape "fits" a record when its score is at least this fraction of the best score
 FIT_TOLERANCE = 0.7
@@ -378,6 +380,10 @@ def _real_folder(folder, top) -> bool:
 # -- the files -------------------------------------------------------------------------------------
 SUMMARY, FAILURES, COLUMNS_MD = "summary.csv", "failures.csv", "columns.md"
 SUMMARY_PLOT = "plots/summary.png"
+#: the site part's tables and figures (pipeline.site: pairs, suite, fragility)
+PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV, FRAGILITY_CURVE_CSV = ("pairs.csv", "suite.csv", "fragility.csv",
+                                                           "fragility_curve.csv")
+SUITE_PLOT, FRAGILITY_PLOT = "plots/suite.png", "plots/fragility.png"
 
 
 def record_csv_name(record_id: str) -> str:

@@ -1,12 +1,10 @@
-"""Design for a site in ``pipeline run``: pairs of components in every direction, scaled suites,
-velocity-pulse columns, suite results and collapse fragility.
+"""Design for a site in ``pipeline run``: the site's options and columns of a task's rows (pair,
+direction, scale, velocity pulse), the task's ground motion, suite results and collapse fragility.
 
 A *task* of ``pipeline run`` is one ground motion to design for: a single component file, or one
-horizontal direction of a pair of components (``--pair A B``, ``--pairs auto``).  For a pair the
-directions are, by default, the two recorded components (0 and 90 deg from the first towards the
-second), the direction of the strongest velocity pulse (``pulses.classify_pulse``) and its normal;
-``--directions N`` adds ``k 180/N`` deg, ``k = 0..N-1`` (a direction and its opposite give the same
-width: the column is symmetric).  The component at ``theta`` is ``pulses.component(a1, a2, theta)``.
+horizontal direction of a pair of components (:mod:`pipeline.pairs` makes them; a direction and its
+opposite give the same width: the column is symmetric).  The component at ``theta`` is
+``pulses.component(a1, a2, theta)``.
 
 After the run, the rows of every task are gathered here: ``pairs.csv`` (each pair's governing
 direction: the widest verified width), ``suite.csv`` (widths and survival shares over the records
@@ -16,21 +14,17 @@ widths, simulations and critical scales from :mod:`rocking`.
 """
 from __future__ import annotations
 
-import csv
 import math
-import os
-import pathlib
 
 from . import peer_inputs
-from .args import SCALE_RANGE, ArgumentError, pair_files, parse_scale
-from .report import Columns
+from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
+from .pulse_row import NOT_PULSE_WARNING, classification_fields  # noqa: F401 (tests import them here)
+from .args import SCALE_RANGE, parse_scale
+from .report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
+                     Columns)
 
-#: directions closer than this (deg, modulo 180) are one direction
-ANGLE_TOL_DEG = 1e-6
-#: most evenly spaced directions accepted (``--directions``): 1 deg apart
-MAX_DIRECTIONS = 180
 
-NOT_PULSE_WARNING = "Eq. 31 assumes a pulse; the verified width does not"
+
 
 # -- report columns ----------------------------------------------------------------------------------
 SITE_COLUMNS = Columns(
@@ -87,27 +81,6 @@ FRAGILITY_COLUMNS = Columns(
     ("uplift_scale", "-", "Below this factor the column never uplifts (g tan(alpha) / PGA)."),
     ("fragility_up_to", "-", "Largest factor examined."),
 )
-
-
-def classification_fields(record, other=None, pair_fields=None) -> tuple[dict, str | None]:
-    """The velocity-pulse columns of a row, and a warning (or None).
-
-    ``pair_fields`` (already computed for the pair, in the main process) are used as they are.
-    """
-    from .cmd_classify import classify_fields
-
-    blank = dict.fromkeys(["pulse_like", "velocity_pulse_indicator", "velocity_tp_s",
-                           "orientation_deg", "azimuth_deg"])
-    if pair_fields and "error" in pair_fields:  # the pair's classification failed: no direction
-        return blank, f"velocity-pulse classification of the pair failed: {pair_fields['error']}"
-    if pair_fields:
-        fields = dict(pair_fields)
-    else:
-        try:
-            fields = classify_fields(record, other)
-        except Exception as exc:  # an unusual record: designed all the same, and said so
-            return blank, f"velocity-pulse classification failed: {' '.join(str(exc).split())}"
-    return fields, (None if fields.get("pulse_like") else NOT_PULSE_WARNING)
 
 
 def pair_of(task) -> str:
@@ -218,210 +191,6 @@ def options_from_args(args) -> dict:
     gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
     up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
     return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to}
-
-
-def tasks_from_args(args, paths, columns, options):
-    """The tasks of ``pipeline run`` when pairs or scales are asked for; None otherwise (the
-    runner's own tasks, one per file)."""
-    n, scale, scales = settings_from_args(args)
-    if not args.pair and args.pairs == "none" and scale == 1.0 and scales is None:
-        return None
-    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
-    return make_tasks(paths, pair_files(args.pair), args.pairs, columns, options, n, scale,
-                      scales, say=say)
-
-
-def settings_from_args(args):
-    """``(directions N, --scale factor, --scales table or None)``, checked."""
-    try:
-        n = int(str(args.directions))
-    except ValueError:
-        raise SiteError(f"--directions expects a whole number, got {args.directions!r}") from None
-    if not 0 <= n <= MAX_DIRECTIONS:
-        raise SiteError(f"--directions must be 0 to {MAX_DIRECTIONS}, got {n}")
-    if args.scale is not None and args.scales is not None:
-        raise SiteError("give --scale or --scales, not both")
-    scale = 1.0 if args.scale is None else parse_scale(args.scale, "--scale")
-    scales = None if args.scales is None else read_scales(args.scales)
-    return n, scale, scales
-
-
-def output_files(options) -> list[str]:
-    """The fixed files the site part writes into ``--out``."""
-    files = [PAIRS_CSV, SUITE_CSV]
-    if options.plots:
-        files.append(SUITE_PLOT)
-    if options.fragility:
-        files += [FRAGILITY_CSV, FRAGILITY_CURVE_CSV] + ([FRAGILITY_PLOT] if options.plots else [])
-    return files
-
-
-# -- directions and tasks ----------------------------------------------------------------------------
-def directions(orientation, n_even: int = 0) -> list[tuple[float, str]]:
-    """``(angle_deg, kind)`` of a pair's directions, sorted by angle in [0, 180).
-
-    The recorded components (0, 90), the pulse direction ``orientation`` and its normal, and
-    ``n_even`` evenly spaced directions; a direction met twice keeps its first kind.
-    """
-    wanted = [(0.0, "component-1"), (90.0, "component-2")]
-    if orientation is not None and math.isfinite(orientation):
-        wanted += [(orientation % 180.0, "pulse"), ((orientation + 90.0) % 180.0, "pulse-normal")]
-    wanted += [(k * 180.0 / n_even, "even") for k in range(n_even)]
-    out = []
-    for angle, kind in wanted:
-        angle = 0.0 if abs(angle - 180.0) < ANGLE_TOL_DEG else angle
-        if not any(min(abs(angle - a), 180.0 - abs(angle - a)) < ANGLE_TOL_DEG for a, _ in out):
-            out.append((angle, kind))
-    return sorted(out)
-
-
-def _stem(path) -> str:
-    from .batch import record_ids
-
-    return record_ids([path])[0]
-
-
-def pair_name(path1, path2) -> str:
-    """``RSN1063_NORTHR_RRS228+318``: the first file's id, ``+``, the second's after their common start."""
-    s1, s2 = _stem(path1), _stem(path2)
-    common = len(os.path.commonprefix([s1, s2]))
-    return f"{s1}+{s2[common:] or s2}"
-
-
-class SiteError(ArgumentError):
-    """A site option that cannot be used (an argument error: exit status 2)."""
-
-
-def read_scales(path) -> dict:
-    """``--scales FILE.csv``: ``{record or file: scale}`` from a CSV with a ``record`` (or
-    ``file``) column and a ``scale`` column."""
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise SiteError(f"--scales {path}: cannot read it: {exc}") from None
-    if not rows:
-        raise SiteError(f"--scales {path}: no rows")
-    keys = {k.strip().lower(): k for k in rows[0] if k}
-    name_key = keys.get("record") or keys.get("file")
-    if name_key is None or "scale" not in keys:
-        raise SiteError(f"--scales {path}: needs a 'record' (or 'file') column and a 'scale' column")
-    out, lines = {}, {}
-    for i, row in enumerate(rows, start=2):
-        name = (row.get(name_key) or "").strip()
-        if not name:
-            raise SiteError(f"--scales {path}, line {i}: expected a record name and a scale")
-        k = parse_scale(row.get(keys["scale"]) or "", f"--scales {path}, line {i}: the scale")
-        if name in out:  # which one was meant is not known: never resolved silently
-            raise SiteError(f"--scales {path}, lines {lines[name]} and {i}: two rows for {name}")
-        out[name], lines[name] = k, i
-    return out
-
-
-def _scale_for(scales, default, names) -> float:
-    if scales is None:
-        return default
-    found = {n: scales[n] for n in dict.fromkeys(names) if n in scales}
-    if len(set(found.values())) > 1:  # rows naming one record differently (path, file, id)
-        raise SiteError(f"--scales gives {names[0]} several scales: "
-                        + ", ".join(f"{k:g} (as {n})" for n, k in found.items()))
-    if found:
-        return next(iter(found.values()))
-    raise SiteError(f"--scales gives no scale for {names[0]} (looked up as {', '.join(dict.fromkeys(names))})")
-
-
-def _lookup_names(path, *ids) -> list[str]:
-    p = pathlib.PurePath(str(path))
-    return [str(path), p.name, p.stem, *ids]
-
-
-def make_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale=1.0, scales=None,
-               say=print):
-    """Tasks of ``pipeline run``: single files as today, pairs as one task per direction.
-
-    ``pairs`` are the ``--pair A B`` couples; with ``pairs_mode == "auto"`` the other files are
-    paired from what they say (:func:`pulses.pair_files`).  Pairs are read and classified here
-    (their directions depend on the pulse's); a pair that cannot be read becomes one task that
-    fails in the worker with the reader's message, as a bad single file does.
-    """
-    import pulses
-
-    from .batch import Task, record_ids
-
-    opts = dict(format=options.format, units=options.units, dt=options.dt, column=options.column,
-                trace=options.trace)
-    paired = {p for ab in pairs for p in ab}
-    rest = [p for p in paths if p not in paired]
-    units = [(a, b, True) for a, b in pairs]  # (first, second or None, named with --pair)
-    if pairs_mode == "auto" and rest:
-        meta = {}
-        for p in rest:
-            try:
-                meta[p] = pulses.read_record(p, **opts).metadata
-            except Exception:  # reported when the task reads it
-                pass
-        found = pulses.pair_files(rest, metadata=meta)
-        for note in found.notes:
-            say(f"pipeline run: note: {note}")
-        for v in found.verticals:
-            say(f"pipeline run: note: {v}: vertical component, left out")
-        order = {p: i for i, p in enumerate(rest)}
-        auto = [(order[a], a, b) for a, b in found.pairs] + [(order[s], s, None) for s in found.singles]
-        units += [(a, b, False) for _, a, b in sorted(auto, key=lambda u: u[0])]
-    else:
-        units += [(p, None, False) for p in rest]
-
-    specs = []  # (name for the id, path, path2, direction, kind, pair name, pair fields, lookup names)
-    pair_names = record_ids([pair_name(a, b) + ".pair" if b is not None else a for a, b, _ in units])
-    for (a, b, explicit), pname in zip(units, pair_names):
-        if b is None:
-            specs.append((a, a, None, None, "", "", (), _lookup_names(a, pname)))
-            continue
-        try:
-            first, second = pulses.read_pair(a, b, **opts)
-            fields = _pair_classification(first, second)
-            angles = directions(fields.get("orientation_deg"), n_directions)
-        except pulses.RecordError as exc:
-            if not explicit and _both_readable(a, b, opts):
-                say(f"pipeline run: note: {exc}; designing {a} and {b} one by one")
-                specs += [(p, p, None, None, "", "", (), _lookup_names(p)) for p in (a, b)]
-                continue
-            fields, angles = {}, [(0.0, "component-1")]  # the task fails at reading, with the reason
-        except Exception:  # unreadable: the task fails at reading, with the reason
-            fields, angles = {}, [(0.0, "component-1")]
-        names = _lookup_names(a, pname) + _lookup_names(b)
-        for angle, kind in angles:
-            specs.append((f"{pname}_{angle:05.1f}deg.dir", a, b, angle, kind, pname,
-                          tuple(fields.items()), names))
-    ids = record_ids([s[0] for s in specs])
-    tasks = []
-    for i, (rid, (_, a, b, angle, kind, pname, fields, names)) in enumerate(zip(ids, specs)):
-        k = _scale_for(scales, scale, names + [rid])
-        tasks.append(Task(i, rid, str(a), tuple(columns), options, path2=None if b is None else str(b),
-                          direction=angle, direction_kind=kind, pair=pname, scale=k, pair_fields=fields))
-    return tasks
-
-
-def _pair_classification(first, second) -> dict:
-    """The pair's velocity-pulse fields; where the classification fails, ``{"error": reason}``:
-    the pair is then designed in its recorded components and every row says why."""
-    from .cmd_classify import classify_fields
-
-    try:
-        return classify_fields(first, second)
-    except Exception as exc:
-        return {"error": " ".join(str(exc).split()) or type(exc).__name__}
-
-
-def _both_readable(a, b, opts) -> bool:
-    import pulses
-
-    try:
-        pulses.read_record(a, **opts)
-        pulses.read_record(b, **opts)
-    except Exception:
-        return False
-    return True
 
 
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------
@@ -608,9 +377,6 @@ def fragility_tables(rows):
 
 
 # -- files -----------------------------------------------------------------------------------------------
-PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV, FRAGILITY_CURVE_CSV = ("pairs.csv", "suite.csv", "fragility.csv",
-                                                           "fragility_curve.csv")
-SUITE_PLOT, FRAGILITY_PLOT = "plots/suite.png", "plots/fragility.png"
 
 
 def write_outputs(outputs, rows, fields, options, failed=None) -> None:

@@ -34,12 +34,12 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
-from .shapes import SHAPES, shape_class
+from .shapes import SHAPES, AntisymmetricRicker, SymmetricRicker, shape_class
 
 #: Tp = MEXH_TP_PER_SCALE * s for PyWavelets' ``mexh`` at scale s (SPEC section 3)
-MEXH_TP_PER_SCALE = SHAPES["ricker-sym"].pywt[1]
+MEXH_TP_PER_SCALE = SymmetricRicker.pywt[1]
 #: Tp = GAUS3_TP_PER_SCALE * s for PyWavelets' ``gaus3`` at scale s (SPEC section 3)
-GAUS3_TP_PER_SCALE = SHAPES["ricker-anti"].pywt[1]
+GAUS3_TP_PER_SCALE = AntisymmetricRicker.pywt[1]
 #: PyWavelets wavelet of each shape that has one, and its Tp per unit scale
 PYWT_WAVELETS = {name: cls.pywt for name, cls in SHAPES.items() if cls.pywt is not None}
 

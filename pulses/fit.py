@@ -157,7 +157,7 @@ class Candidate:
     Attributes
     ----------
     shape : str
-        ``"rect"``, ``"sine"``, ``"ricker-sym"`` or ``"ricker-anti"``.
+        A name of :data:`pulses.SHAPES` (the shapes of docs/theory.md section 2).
     ap : float
         Amplitude, m/s^2, signed by polarity.
     tp : float
@@ -301,7 +301,7 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
     record : pulses.Record
         Ground acceleration, m/s^2.
     shapes : iterable of str, optional
-        Shapes to fit (default all four: ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``, ``"rect"``).
+        Shapes to fit (names of :data:`pulses.SHAPES`; default all four).
     tp_range : (float, float), optional
         Shortest and longest period searched, s (default :func:`default_tp_range`).
     baseline : bool, optional
@@ -687,135 +687,18 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     i0 = max(0, int(math.floor((t0 + lo * tp - margin) / dt)))
     i1 = min(x.size, int(math.ceil((t0 + hi * tp + margin) / dt)) + 1)
     idx = slice(i0, i1)
-    tw, xw = t[idx], x[idx]
-    nfft = sfft.next_fast_len(tw.size, real=True)
-    w = background.weights(nfft)
-    X = sfft.rfft(xw, nfft)
-    Xw = X * w  # every product is with one weighted side
-
-    def gram(U, Vw):
-        """``u' S^-1 v`` for the rows of ``U`` and of ``Vw`` (the latter already weighted): the
-        sum of ``Re(U) Re(Vw) + Im(U) Im(Vw)``, on the arrays' float views."""
-        return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
-
-    # the pulse and its derivatives vanish outside its support: computed there only
-    sup_lo, sup_hi = cls.support_tau
-
-    def support(tp_, t0_):
-        a = max(0, int(math.floor((t0_ + sup_lo * tp_ - tw[0]) / dt)) - 1)
-        b = min(tw.size, int(math.ceil((t0_ + sup_hi * tp_ - tw[0]) / dt)) + 2)
-        return slice(a, max(a, b))
-
-    # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
-    def sampled(tp_, t0_):
-        out = np.zeros((1, nfft))
-        k = support(tp_, t0_)
-        out[0, k] = cls.sampled(tp_, t0_, tw[k], dt)
-        return out
-
-    def sampled_with_derivatives(tp_, t0_):
-        out = np.zeros((3, nfft))
-        k = support(tp_, t0_)
-        out[:, k] = cls.sampled_with_derivatives(tp_, t0_, tw[k], dt)
-        return out
-
-    xx = float(gram(X[None], Xw[None])[0, 0])
-    if baseline:
-        B = sfft.rfft(np.stack((np.ones_like(tw), tw - float(tw.mean()))), nfft, axis=-1)
-        Bw = B * w
-        BB_inv = np.linalg.inv(gram(B, Bw))
-        BX = gram(B, Xw[None])[:, 0]
-        xx -= float(BX @ BB_inv @ BX)
-
-    # the record's and the baseline's weighted spectra, stacked: one product with the columns
-    fixed = np.concatenate((Xw[None], Bw)) if baseline else Xw[None]
-
-    def products(cols):
-        """Weighted ``u'v`` among the columns and with the record, the baseline projected out."""
-        U = sfft.rfft(cols, axis=-1, overwrite_x=True)
-        UU, UF = gram(U, U * w), gram(U, fixed)
-        UX = UF[:, 0]
-        if baseline:
-            UB = UF[:, 1:]
-            UU -= UB @ BB_inv @ UB.T
-            UX = UX - UB @ BB_inv @ BX
-        return UU, UX
-
-    def profiled(tp_, t0_):
-        UU, UX = products(sampled(tp_, t0_))
-        return xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
-
-    def normal(p):
-        a = p[0]
-        UU, UX = products(sampled_with_derivatives(max(p[1], 1e-9), p[2]))
-        d = np.array([1.0, a, a])
-        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
-        cost = xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
-        return cost, UU * np.outer(d, d), -d * ur
-
+    gls = _Weighted(cls, x[idx], t[idx], dt, background, baseline, tp)
     difference = _difference_covariance(
-        sfft.rfft(sampled_with_derivatives(tp, t0), axis=-1) * np.array([[1.0], [ap], [ap]]),
-        B if baseline else None, w, nfft, gram)
+        sfft.rfft(gls.sampled_with_derivatives(tp, t0), axis=-1) * np.array([[1.0], [ap], [ap]]),
+        gls.B if baseline else None, gls.w, gls.nfft, _gram)
     if difference is None:
         return start
-    start_cost, _ = profiled(tp, t0)
-    # each candidate pulse's best whole-sample shift from the weighted cross-correlation (one
-    # inverse FFT per candidate, all at once; baseline left out)
-    shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
-    k_near = np.flatnonzero(np.abs(shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
-    # irfft counts the interior bins twice, which the weights already do
-    Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
-
-    def scan(tps, t0s, whitened=None):
-        """The best of the pulses ``(tps, t0s)``, each moved by its best whole-sample shift, by
-        the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``.  Given the record ``whitened`` (in time,
-        ``irfft(Xw)``: its circular cross-correlation with ``u`` at lag ``m`` is ``u'S^-1 x``
-        for ``u`` moved by ``m`` samples), the shifts are within 2 samples, summed over the
-        pulses' support instead of an inverse FFT each."""
-        # every candidate sampled at once, over the union of their supports
-        a = max(0, int(math.floor((np.min(t0s + sup_lo * tps) - tw[0]) / dt)) - 1)
-        b = max(a, min(tw.size, int(math.ceil((np.max(t0s + sup_hi * tps) - tw[0]) / dt)) + 2))
-        cols = np.zeros((len(tps), nfft))
-        cols[:, a:b] = cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
-        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
-        mm = np.einsum("ik,ik->i", M.view(float), (M * w).view(float))
-        if whitened is None:
-            lags = shifts[k_near]
-            corr = sfft.irfft(Xw_half * M.conj(), nfft, axis=-1)[:, k_near] * nfft
-        else:
-            lags = np.arange(-2, 3)
-            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
-        j = np.argmax(np.abs(corr), axis=1)
-        gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
-        i = int(np.argmax(gain))
-        return tps[i], t0s[i] + lags[j[i]] * dt
-
+    start_cost, _ = gls.profiled(tp, t0)
     _, tp0, t00 = match
-    lower = np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0])
-    upper = np.array([np.inf, tp0 * TP_LEASH, t00 + tp0])
-
-    def descent(tp_, t0_):
-        _, ap_ = profiled(tp_, t0_)
-        return _levenberg_marquardt(normal, np.array([ap_, tp_, t0_]), scale=np.array([abs(ap_) or 1.0, tp_, tp_]),
-                                    ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS, lower=lower, upper=upper)
-
+    gls.lower = np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0])
+    gls.upper = np.array([np.inf, tp0 * TP_LEASH, t00 + tp0])
     try:
-        if not cls.cornered():
-            p_new, cost = descent(tp, t0)
-        else:
-            # a scan of the period about the start, the pulse's centre kept, then the descent
-            tps = tp * np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN))
-            p_new, cost = descent(*scan(tps, t0 + cls.centre_tau * (tp - tps)))
-            # the descent stops in the first kink it meets, a sample or two from the optimum:
-            # a lattice of both edges about where it stopped, then the descent from its best
-            lo_, hi_ = cls.support_tau
-            widths, starts = (v.ravel() for v in np.meshgrid(
-                (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
-                p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
-            tps = widths / (hi_ - lo_)
-            p_lattice, cost_lattice = descent(*scan(tps, starts - lo_ * tps, sfft.irfft(Xw_half, nfft) * nfft))
-            if cost_lattice < cost:
-                p_new, cost = p_lattice, cost_lattice
+        p_new, cost = gls.search(tp, t0)
     except np.linalg.LinAlgError:
         return start
     ap_new, tp_new, t0_new = (float(v) for v in p_new)
@@ -830,6 +713,137 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     if float(d @ np.linalg.pinv(difference) @ d) > GLS_HAUSMAN:
         return start
     return (ap_new, tp_new, t0_new, idx)
+
+
+def _gram(U, Vw):
+    """``u' S^-1 v`` for the rows of ``U`` and of ``Vw`` (the latter already weighted): the
+    sum of ``Re(U) Re(Vw) + Im(U) Im(Vw)``, on the arrays' float views."""
+    return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
+
+
+class _Weighted:
+    """The weighted least squares of one shape on one window of a record (``xw`` at times ``tw``):
+    the record's and the baseline's weighted spectra, and the objective's pieces for a pulse
+    ``(ap, tp, t0)``.  ``lower``/``upper``: bounds of the descent, set by the caller."""
+
+    def __init__(self, cls, xw, tw, dt, background, baseline, tp):
+        self.cls, self.tw, self.dt, self.baseline = cls, tw, dt, baseline
+        self.nfft = nfft = sfft.next_fast_len(tw.size, real=True)
+        self.w = w = background.weights(nfft)
+        X = sfft.rfft(xw, nfft)
+        self.Xw = Xw = X * w  # every product is with one weighted side
+        # the pulse and its derivatives vanish outside its support: computed there only
+        self.sup_lo, self.sup_hi = cls.support_tau
+        self.xx = float(_gram(X[None], Xw[None])[0, 0])
+        if baseline:
+            self.B = B = sfft.rfft(np.stack((np.ones_like(tw), tw - float(tw.mean()))), nfft, axis=-1)
+            Bw = B * w
+            self.BB_inv = np.linalg.inv(_gram(B, Bw))
+            self.BX = _gram(B, Xw[None])[:, 0]
+            self.xx -= float(self.BX @ self.BB_inv @ self.BX)
+        # the record's and the baseline's weighted spectra, stacked: one product with the columns
+        self.fixed = np.concatenate((Xw[None], Bw)) if baseline else Xw[None]
+        # each candidate pulse's best whole-sample shift from the weighted cross-correlation (one
+        # inverse FFT per candidate, all at once; baseline left out)
+        self.shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
+        self.k_near = np.flatnonzero(np.abs(self.shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
+        # irfft counts the interior bins twice, which the weights already do
+        self.Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+
+    def support(self, tp_, t0_):
+        tw, dt = self.tw, self.dt
+        a = max(0, int(math.floor((t0_ + self.sup_lo * tp_ - tw[0]) / dt)) - 1)
+        b = min(tw.size, int(math.ceil((t0_ + self.sup_hi * tp_ - tw[0]) / dt)) + 2)
+        return slice(a, max(a, b))
+
+    # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
+    def sampled(self, tp_, t0_):
+        out = np.zeros((1, self.nfft))
+        k = self.support(tp_, t0_)
+        out[0, k] = self.cls.sampled(tp_, t0_, self.tw[k], self.dt)
+        return out
+
+    def sampled_with_derivatives(self, tp_, t0_):
+        out = np.zeros((3, self.nfft))
+        k = self.support(tp_, t0_)
+        out[:, k] = self.cls.sampled_with_derivatives(tp_, t0_, self.tw[k], self.dt)
+        return out
+
+    def products(self, cols):
+        """Weighted ``u'v`` among the columns and with the record, the baseline projected out."""
+        U = sfft.rfft(cols, axis=-1, overwrite_x=True)
+        UU, UF = _gram(U, U * self.w), _gram(U, self.fixed)
+        UX = UF[:, 0]
+        if self.baseline:
+            UB = UF[:, 1:]
+            UU -= UB @ self.BB_inv @ UB.T
+            UX = UX - UB @ self.BB_inv @ self.BX
+        return UU, UX
+
+    def profiled(self, tp_, t0_):
+        UU, UX = self.products(self.sampled(tp_, t0_))
+        return self.xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
+
+    def normal(self, p):
+        a = p[0]
+        UU, UX = self.products(self.sampled_with_derivatives(max(p[1], 1e-9), p[2]))
+        d = np.array([1.0, a, a])
+        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
+        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
+        return cost, UU * np.outer(d, d), -d * ur
+
+    def scan(self, tps, t0s, whitened=None):
+        """The best of the pulses ``(tps, t0s)``, each moved by its best whole-sample shift, by
+        the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``.  Given the record ``whitened`` (in time,
+        ``irfft(Xw)``: its circular cross-correlation with ``u`` at lag ``m`` is ``u'S^-1 x``
+        for ``u`` moved by ``m`` samples), the shifts are within 2 samples, summed over the
+        pulses' support instead of an inverse FFT each."""
+        tw, dt, nfft = self.tw, self.dt, self.nfft
+        # every candidate sampled at once, over the union of their supports
+        a = max(0, int(math.floor((np.min(t0s + self.sup_lo * tps) - tw[0]) / dt)) - 1)
+        b = max(a, min(tw.size, int(math.ceil((np.max(t0s + self.sup_hi * tps) - tw[0]) / dt)) + 2))
+        cols = np.zeros((len(tps), nfft))
+        cols[:, a:b] = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
+        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
+        mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
+        if whitened is None:
+            lags = self.shifts[self.k_near]
+            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, self.k_near] * nfft
+        else:
+            lags = np.arange(-2, 3)
+            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        j = np.argmax(np.abs(corr), axis=1)
+        gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
+        i = int(np.argmax(gain))
+        return tps[i], t0s[i] + lags[j[i]] * dt
+
+    def descent(self, tp_, t0_):
+        _, ap_ = self.profiled(tp_, t0_)
+        return _levenberg_marquardt(self.normal, np.array([ap_, tp_, t0_]),
+                                    scale=np.array([abs(ap_) or 1.0, tp_, tp_]),
+                                    ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS, lower=self.lower, upper=self.upper)
+
+    def search(self, tp, t0):
+        """``(p, cost)``: the descent from ``(tp, t0)``; for a shape with corners from the best of a
+        scan of the period, then again from the best of a lattice of the pulse's edges."""
+        cls, dt = self.cls, self.dt
+        if not cls.cornered():
+            return self.descent(tp, t0)
+        # a scan of the period about the start, the pulse's centre kept, then the descent
+        tps = tp * np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN))
+        p_new, cost = self.descent(*self.scan(tps, t0 + cls.centre_tau * (tp - tps)))
+        # the descent stops in the first kink it meets, a sample or two from the optimum:
+        # a lattice of both edges about where it stopped, then the descent from its best
+        lo_, hi_ = cls.support_tau
+        widths, starts = (v.ravel() for v in np.meshgrid(
+            (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
+            p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
+        tps = widths / (hi_ - lo_)
+        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps,
+                                                          sfft.irfft(self.Xw_half, self.nfft) * self.nfft))
+        if cost_lattice < cost:
+            p_new, cost = p_lattice, cost_lattice
+        return p_new, cost
 
 
 def _difference_covariance(U, B, w, nfft, gram):

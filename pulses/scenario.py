@@ -42,7 +42,7 @@ def design_pulse(magnitude: float, shape: str = "sine", vp: float = 0.9, t0: flo
     magnitude : float
         Moment magnitude ``Mw`` (Eq. 6 was fitted for about 5.5-7.6, sites within ~10 km).
     shape : str
-        ``"sine"`` (default), ``"ricker-sym"``, ``"ricker-anti"`` or ``"rect"``.
+        ``"sine"`` (default) or another name of :data:`pulses.SHAPES`.
     vp : float
         Peak ground velocity of the pulse, m/s (0.6-1.2 near the fault, 0.9 typical).
     t0 : float

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from pulses import G
+from pulses.shapes import AntisymmetricRicker
 
 from .errors import RockingInputError
 
@@ -72,7 +73,7 @@ ENVELOPE = {
     None: ("hill", 2.5, 1.86),
     "sine": ("hill", 2.5, 1.86),
     "ricker-sym": ("hill", 1.75, 4.0),
-    "ricker-anti": ("hill", 3.0, 5.13),
+    AntisymmetricRicker.shape: ("hill", 3.0, 5.13),
     "rect": ("exp", 2.0),
 }
 #: range over which the envelope was derived and checked conservative

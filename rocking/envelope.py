@@ -29,11 +29,13 @@ import time
 
 import numpy as np
 
+from pulses.shapes import AntisymmetricRicker, OneSine, SymmetricRicker
+
 #: exponents tried for the generalised Eq. 31
 HILL_N = (1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0)
 #: relative margin added to the fitted coefficient (c divided by, lambda multiplied by 1 + SAFETY)
 SAFETY = 0.01
-REALISABLE = ("sine", "ricker-sym", "ricker-anti")
+REALISABLE = (OneSine.shape, SymmetricRicker.shape, AntisymmetricRicker.shape)
 #: table grid
 PTP_TABLE = (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 15.0, 20.0)
 APG_TABLE = tuple(np.round(np.linspace(0.1, 1.5, 15), 6))
@@ -128,7 +130,8 @@ def main(argv=None) -> int:
 
     # plot: ratio against pTp, band over ap/g, per shape
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    colors = {"rect": "k", "sine": "tab:red", "ricker-sym": "tab:blue", "ricker-anti": "tab:green"}
+    colors = {"rect": "k", OneSine.shape: "tab:red", SymmetricRicker.shape: "tab:blue",
+              AntisymmetricRicker.shape: "tab:green"}
     for s in ("rect",) + REALISABLE:
         sub = frame[frame["shape"] == s]
         g = sub.groupby("pTp")["ratio"]

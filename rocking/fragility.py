@@ -23,6 +23,7 @@ import numpy as np
 
 from pulses import G
 
+from . import scan
 from .block import Block
 from .search import _peak
 
@@ -136,11 +137,34 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
     "Rocking frames and collapse fragility").  ``tests/test_fragility.py`` checks the answer against a 1000-factor brute-force
     scan on three real records.
     """
-    import rocking
-
     if not isinstance(block, Block):
         raise TypeError("critical_scale: block must be a rocking.Block")
     up_to = float(up_to)
+    _check_settings(up_to, n_scan, step, resolution, near, rtol)
+    pga = _peak(record)
+    uplift = block.uplift_acceleration / pga if pga > 0 else math.inf
+    settings = dict(up_to=up_to, uplift_scale=uplift, pga=pga, n_scan=int(n_scan),
+                    step=float(step), resolution=float(resolution), near=float(near), rtol=float(rtol))
+    if not up_to > uplift:
+        return CriticalScale(None, [], runs=0, calls=0, **settings)
+    pts = scan.Points(_verdicts(block, record, model), uplift)
+    # 1. the scan (the uplift factor itself is known: at |ug''| = g tan(alpha) nothing moves)
+    pts.add(np.geomspace(uplift, up_to, int(n_scan) + 1)[1:])
+    # 2. halve the gaps below the first failure (or everywhere, if none): to `step` where the
+    #    block rocked, to `resolution` where it nearly tipped
+    scan.refine_gaps(pts, step, resolution, near, MAX_ROUNDS)
+    x, f, _ = pts.sorted()
+    if not f.any():
+        return CriticalScale(None, [], runs=pts.runs, calls=pts.calls, **settings)
+    # 3. bisect the first fail bracket (the lowest failure is the one followed) to rtol
+    scale = scan.bisect_first(pts, rtol)
+    # 4. islands above: every verdict change above the first failure bisected to `step`
+    islands, transitions = _islands(pts, scale, step, up_to)
+    return CriticalScale(scale, islands, runs=pts.runs, calls=pts.calls,
+                         transitions=transitions, **settings)
+
+
+def _check_settings(up_to, n_scan, step, resolution, near, rtol) -> None:
     if not (math.isfinite(up_to) and up_to > 0):
         raise ValueError(f"critical_scale: up_to must be positive and finite, got {up_to!r}")
     if int(n_scan) != n_scan or n_scan < 2:
@@ -150,63 +174,26 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
                                 ("rtol", rtol, 0.0, 1.0)):
         if not (lo < float(value) <= hi):
             raise ValueError(f"critical_scale: {name} must lie in ({lo:g}, {hi:g}], got {value!r}")
-    pga = _peak(record)
-    uplift = block.uplift_acceleration / pga if pga > 0 else math.inf
-    settings = dict(up_to=up_to, uplift_scale=uplift, pga=pga, n_scan=int(n_scan),
-                    step=float(step), resolution=float(resolution), near=float(near), rtol=float(rtol))
-    if not up_to > uplift:
-        return CriticalScale(None, [], runs=0, calls=0, **settings)
 
-    xs, fs, rs = [np.array([uplift])], [np.zeros(1, dtype=bool)], [np.zeros(1)]
-    count = {"runs": 0, "calls": 0}
+
+def _verdicts(block, record, model):
+    """``run(scales) -> (overturned, nearness)`` of ``block`` under ``scales`` times ``record``,
+    in one batch; a failing run counts as near tipping (nearness inf), else ``max|theta|/alpha``."""
+    import rocking
 
     def run(scales):
-        scales = np.atleast_1d(np.asarray(scales, dtype=float))
         res = rocking.simulate_many(block, record, scales, model=model)
-        count["runs"] += scales.size
-        count["calls"] += 1
         f = np.asarray(res.overturned, dtype=bool)
-        xs.append(scales)
-        fs.append(f)
-        # a failing end counts as near tipping
-        rs.append(np.where(f, np.inf, np.asarray(res.max_rotation_ratio, dtype=float)))
-        return f
+        return f, np.where(f, np.inf, np.asarray(res.max_rotation_ratio, dtype=float))
 
-    def scanned():
-        x, f, r = np.concatenate(xs), np.concatenate(fs), np.concatenate(rs)
-        order = np.argsort(x, kind="stable")
-        return x[order], f[order], r[order]
+    return run
 
-    # 1. the scan (the uplift factor itself is known: at |ug''| = g tan(alpha) nothing moves)
-    run(np.geomspace(uplift, up_to, int(n_scan) + 1)[1:])
-    # 2. halve the gaps below the first failure (or everywhere, if none): to `step` where the
-    #    block rocked, to `resolution` where it nearly tipped
-    for _ in range(MAX_ROUNDS):
-        x, f, r = scanned()
-        end = np.nonzero(f)[0][0] if f.any() else x.size - 1
-        x, r = x[:end + 1], r[:end + 1]
-        gap = (x[1:] - x[:-1]) / x[1:]
-        most = np.maximum(r[1:], r[:-1])
-        m = np.nonzero(((gap > resolution) & (most >= near)) | ((gap > step) & (most > 0.0)))[0]
-        if not m.size:
-            break
-        run(0.5 * (x[m] + x[m + 1]))
-    x, f, _ = scanned()
-    if not f.any():
-        return CriticalScale(None, [], runs=count["runs"], calls=count["calls"], **settings)
-    # 3. bisect the first fail bracket (the lowest failure is the one followed) to rtol
-    j = np.nonzero(f)[0][0]
-    lo, hi = x[j - 1], x[j]                    # x[0] = uplift survives, so j >= 1
-    while hi - lo > rtol * hi:
-        mid = 0.5 * (lo + hi)
-        if run([mid])[0]:
-            hi = mid
-        else:
-            lo = mid
-    scale = float(hi)
-    # 4. islands above: every verdict change above the first failure bisected to `step`, all
-    #    together (one batch per halving); each bracket keeps the half where the verdict changes
-    x, f, _ = scanned()
+
+def _islands(pts, scale, step, up_to):
+    """The failing islands above ``scale`` and the factors where the verdict changes: every change
+    above the first failure bisected to ``step``, all together (one batch per halving); each bracket
+    keeps the half where the verdict changes."""
+    x, f, _ = pts.sorted()
     sel = x >= scale
     x, f = x[sel], f[sel]
     ch = np.nonzero(f[1:] != f[:-1])[0]
@@ -216,7 +203,7 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
         if not wide.any():
             break
         mid = 0.5 * (blo[wide] + bhi[wide])
-        vm = run(mid)
+        vm = pts.add(mid)
         lo_w, hi_w = blo[wide], bhi[wide]
         same = vm == flo[wide]                 # the change lies in the upper half
         blo[wide] = np.where(same, mid, lo_w)
@@ -232,9 +219,7 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
             start = None
     if start is not None:
         islands.append((float(start), up_to))
-    transitions = tuple(float(v) for v, _ in edges)
-    return CriticalScale(scale, islands, runs=count["runs"], calls=count["calls"],
-                         transitions=transitions, **settings)
+    return islands, tuple(float(v) for v, _ in edges)
 
 
 # ---------------------------------------------------------------------------------------------

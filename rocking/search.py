@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import scan
 from .block import Block
 
 #: failure criteria: which verdict of the solver counts as failure
@@ -210,48 +211,10 @@ def _scan_refine(evaluate, x, settings, known=None, zone=True, refine="all", max
     xs = [x[i] for i in range(n_prob)]
     fs = [fail[i] for i in range(n_prob)]
     if zone:
-        top = x[:, -1]
-        todo = [i for i in range(n_prob) if fs[i].any()]
-        prev = {i: -np.inf for i in todo}
-        for _ in range(settings.zone_rounds):
-            pi, px = [], []
-            for i in todo:
-                xf = xs[i][np.nonzero(fs[i])[0][-1]]
-                hi = min(top[i], xf * (1.0 + settings.zone_fraction))
-                z = xf + (hi - xf) * np.arange(1, n_zone + 1) / n_zone
-                z = z[z < top[i]]
-                prev[i] = (xf, hi)
-                pi.append(np.full(z.size, i))
-                px.append(z)
-            if not pi:
-                break
-            pi, px = np.concatenate(pi), np.concatenate(px)
-            if not px.size:
-                break
-            pf = np.asarray(evaluate(pi, px), dtype=bool)
-            runs += int(px.size)
-            calls += 1
-            nxt = []
-            for i in todo:
-                sel = pi == i
-                xx = np.concatenate([xs[i], px[sel]])
-                ff = np.concatenate([fs[i], pf[sel]])
-                order = np.argsort(xx, kind="stable")
-                xs[i], fs[i] = xx[order], ff[order]
-                xf0, hi = prev[i]
-                new_top = xs[i][np.nonzero(fs[i])[0][-1]]
-                if new_top > xf0 + 0.5 * (hi - xf0) and hi < top[i]:
-                    nxt.append(i)
-            todo = nxt
+        r, c = scan.zone_points(evaluate, xs, fs, x[:, -1], n_zone, settings.zone_fraction, settings.zone_rounds)
+        runs, calls = runs + r, calls + c
     # brackets: every change of verdict between neighbouring scan points
-    prob, lo, hi, flo, fhi = [], [], [], [], []
-    for i in range(n_prob):
-        ch = np.nonzero(fs[i][1:] != fs[i][:-1])[0]
-        prob.extend([i] * ch.size)
-        lo.extend(xs[i][ch]), hi.extend(xs[i][ch + 1])
-        flo.extend(fs[i][ch]), fhi.extend(fs[i][ch + 1])
-    prob, lo, hi = np.array(prob, dtype=int), np.array(lo, dtype=float), np.array(hi, dtype=float)
-    flo, fhi = np.array(flo, dtype=bool), np.array(fhi, dtype=bool)
+    prob, lo, hi, flo, fhi = scan.brackets(xs, fs)
     if refine == "top":
         # only the last fail->survive change of each problem; the rest stay at scan resolution
         top_mask = np.zeros(prob.size, dtype=bool)
@@ -265,30 +228,12 @@ def _scan_refine(evaluate, x, settings, known=None, zone=True, refine="all", max
         prob, lo, hi, flo, fhi = prob[top_mask], lo[top_mask], hi[top_mask], flo[top_mask], fhi[top_mask]
     else:
         done_p, done_lo, done_hi, done_flo, done_fhi = [], [], [], [], []
-    k = int(settings.ksection)
-    frac = np.arange(1, k) / k
-    for _ in range(max_iter):
-        narrow = (hi - lo) <= rtol * np.abs(hi)
-        done_p.append(prob[narrow]), done_lo.append(lo[narrow]), done_hi.append(hi[narrow])
-        done_flo.append(flo[narrow]), done_fhi.append(fhi[narrow])
-        keep = ~narrow
-        prob, lo, hi, flo, fhi = prob[keep], lo[keep], hi[keep], flo[keep], fhi[keep]
-        if not prob.size:
-            break
-        mids = lo[:, None] + (hi - lo)[:, None] * frac[None, :]          # (n, k-1)
-        vm = np.asarray(evaluate(np.repeat(prob, k - 1), mids.ravel()), dtype=bool)
-        runs += int(vm.size)
-        calls += 1
-        pts = np.concatenate([lo[:, None], mids, hi[:, None]], axis=1)   # (n, k+1)
-        ver = np.concatenate([flo[:, None], vm.reshape(-1, k - 1), fhi[:, None]], axis=1)
-        change = ver[:, 1:] != ver[:, :-1]                              # (n, k)
-        bi = np.arange(prob.size)
-        bj = (k - 1) - np.argmax(change[:, ::-1], axis=1)               # highest change
-        lo, hi = pts[bi, bj], pts[bi, bj + 1]
-        flo, fhi = ver[bi, bj], ver[bi, bj + 1]
+    done, rest, r, c = scan.ksect(evaluate, (prob, lo, hi, flo, fhi), int(settings.ksection), rtol, max_iter)
+    runs, calls = runs + r, calls + c
+    parts = [d0 + d + [x] for d0, d, x in zip((done_p, done_lo, done_hi, done_flo, done_fhi), done, rest)]
     cat = lambda parts, dt: np.concatenate(parts).astype(dt) if parts else np.zeros(0, dt)
-    prob, lo, hi = cat(done_p + [prob], int), cat(done_lo + [lo], float), cat(done_hi + [hi], float)
-    flo, fhi = cat(done_flo + [flo], bool), cat(done_fhi + [fhi], bool)
+    prob, lo, hi = cat(parts[0], int), cat(parts[1], float), cat(parts[2], float)
+    flo, fhi = cat(parts[3], bool), cat(parts[4], bool)
     order = np.lexsort((lo, prob))
     brackets = [[] for _ in range(n_prob)]
     for m in order:

@@ -232,7 +232,7 @@ def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n
     ----------
     block : Block
     shape : str
-        ``"rect"``, ``"sine"``, ``"ricker-sym"`` or ``"ricker-anti"``.
+        A name of :data:`pulses.SHAPES` (the shapes of docs/theory.md section 2).
     tp : float
         Pulse period, s.
     up_to : float, optional

@@ -95,7 +95,7 @@ def overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, *, eta=None, mod
     alpha : float
         Slenderness angle, rad.
     shape : str
-        ``"rect"``, ``"sine"``, ``"ricker-sym"`` or ``"ricker-anti"``.
+        A name of :data:`pulses.SHAPES` (the shapes of docs/theory.md section 2).
     wp_over_p : array_like
         Frequency ratios ``omega_p / p`` (x axis of Fig. 5).
     ap_over_gtan : array_like

@@ -11,6 +11,7 @@ import numpy as np
 
 from pulses import G, SHAPES
 
+from . import scan
 from .block import Block
 from .frame import check_cap_mass_ratio, frame_p
 from .closed_forms import envelope_rule, eq20, eq31
@@ -371,73 +372,11 @@ def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SET
     ``tests/test_design.py`` checks the answer against dense brute-force scans.
     """
     s = settings
-    n_scan, rtol, n_zone = s.record_scan, s.rtol, s.record_zone_points
-    if s.record_spacing == "geometric":
-        low = s.record_low
-        xs = top * np.geomspace(low, 1.0, n_scan)
-    else:
-        low = 1.0 / n_scan
-        xs = top * np.arange(1, n_scan + 1) / n_scan
-    xs = np.concatenate([top * low * 2.0 ** -np.arange(s.record_tail, 0, -1), xs])
-    runs = calls = 0
-    pts_x, pts_f, pts_r = [xs[-1:]], [np.zeros(1, dtype=bool)], [np.zeros(1)]  # top: no uplift
-
-    def run(widths):
-        nonlocal runs, calls
-        widths = np.atleast_1d(np.asarray(widths, dtype=float))
-        f, r = evaluate(widths)
-        runs += widths.size
-        calls += 1
-        pts_x.append(widths)
-        pts_f.append(np.asarray(f, dtype=bool))
-        pts_r.append(np.asarray(r, dtype=float))
-        return pts_f[-1]
-
-    def scanned():
-        x, f, r = np.concatenate(pts_x), np.concatenate(pts_f), np.concatenate(pts_r)
-        order = np.argsort(x, kind="stable")
-        return x[order], f[order], r[order]
-
-    def run_down(widths):
-        """Run ``widths`` from the widest down, ``record_chunk`` at a time, stopping after the
-        first chunk with a failure: narrower widths cannot change the answer (it lies above the
-        widest failure), so they are not run.  Returns whether any failed."""
-        widths = np.sort(np.asarray(widths, dtype=float))[::-1]
-        for k in range(0, widths.size, s.record_chunk):
-            if run(widths[k:k + s.record_chunk]).any():
-                return True
-        return False
-
-    def top_bracket():
-        x, f, _ = scanned()
-        if not f.any():
-            return None
-        j = np.nonzero(f)[0][-1]
-        return x[j], x[j + 1]                     # x[-1] = top survives, so j + 1 exists
-
-    def bisect(lo, hi, tol):
-        while hi - lo > tol * hi:
-            mid = 0.5 * (lo + hi)
-            if run([mid])[0]:
-                lo = mid
-            else:
-                hi = mid
-        return lo, hi
-
-    def near_gaps(w):
-        """Midpoints of the gaps above ``w`` to halve (step 5)."""
-        x, f, r = scanned()
-        sel = x >= w
-        x, r = x[sel], r[sel]
-        wide = (x[1:] - x[:-1]) > s.record_gap * x[:-1]
-        near = np.maximum(r[1:], r[:-1]) >= s.record_near
-        m = np.nonzero(wide & near)[0]
-        return 0.5 * (x[m] + x[m + 1])
-
-    run(xs[:-1])
-    fine_done = np.zeros(0)
-    limited = False
-    br = top_bracket()
+    xs = _scan_widths(top, s)
+    pts = scan.Points(lambda w: tuple(np.asarray(v, dtype=dt) for v, dt in zip(evaluate(w), (bool, float))),
+                      xs[-1])  # top: no uplift
+    pts.add(xs[:-1])
+    br = _top_bracket(pts)
     narrowest = xs[0]
     for _ in range(DOWN_HALVINGS // 10):
         if br is not None:
@@ -445,18 +384,47 @@ def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SET
         # nothing scanned failed: halve below the narrowest width, ten at a time, until a width
         # fails (a tall column survives more than its scan's floor, top / 1024, suggests)
         down = narrowest * 2.0 ** -np.arange(1, 11)
-        run(down)
+        pts.add(down)
         narrowest = down[-1]
-        br = top_bracket()
+        br = _top_bracket(pts)
+    br, rounds, limited = _rounds(pts, br, top, s)
+    width, below_scan = narrowest, True
+    if br is not None:
+        width, below_scan = _bisect(pts, *_top_bracket(pts), s.rtol)[1], False
+    x, f, _ = pts.sorted()
+    ch = np.nonzero(f[1:] != f[:-1])[0]
+    transitions = tuple(float(t) for t in 0.5 * (x[ch] + x[ch + 1]))
+    return RequiredWidth(
+        width=float(width), height=height, rule="exact", iterations=pts.calls,
+        method=_method(xs.size, top, rounds, limited, below_scan, pts, s),
+        criterion=criterion, transitions=transitions, runs=pts.runs, eta=eta, below_scan=below_scan)
+
+
+def _scan_widths(top, s):
+    """Step 1's widths, narrowest first, the no-uplift width ``top`` last."""
+    n_scan = s.record_scan
+    if s.record_spacing == "geometric":
+        low = s.record_low
+        xs = top * np.geomspace(low, 1.0, n_scan)
+    else:
+        low = 1.0 / n_scan
+        xs = top * np.arange(1, n_scan + 1) / n_scan
+    return np.concatenate([top * low * 2.0 ** -np.arange(s.record_tail, 0, -1), xs])
+
+
+def _rounds(pts, br, top, s):
+    """Steps 2-6: ``(top bracket or None, rounds, limited)``."""
+    n_zone, rtol = s.record_zone_points, s.rtol
+    fine_done = np.zeros(0)
     rounds = 0
     while br is not None and rounds < s.record_rounds:
         rounds += 1
-        lo, hi = bisect(*br, max(s.record_zone_first / 4.0, rtol))
+        lo, hi = _bisect(pts, *br, max(s.record_zone_first / 4.0, rtol))
         found = False
         if n_zone > 0:
             z = hi * (1.0 + np.geomspace(s.record_zone_first, s.record_zone_fraction, int(n_zone)))
             z = z[z < top]
-            found = bool(z.size) and bool(run(z).any())
+            found = bool(z.size) and bool(pts.add(z).any())
         if not found and s.record_fine > 0:
             # every width of the fixed fine grid top (1 + s.record_fine)^-k in (hi, hi (1 + s.record_fine_span)]
             # not run yet (a later round only adds the part above the previous one)
@@ -466,33 +434,68 @@ def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SET
             z = np.setdiff1d(z[(z > hi) & (z < top)], fine_done)
             if z.size:
                 fine_done = np.union1d(fine_done, z)
-                found = run_down(z)
+                found = _run_down(pts, z, s.record_chunk)
         while not found:
-            mids = near_gaps(hi)
+            mids = _near_gaps(pts, hi, s)
             if not mids.size:
                 break
-            found = bool(run(mids).any())
+            found = bool(pts.add(mids).any())
         if not found:
-            break
-        br = top_bracket()
-    else:
-        limited = br is not None   # failures were still being found above the candidate
-    width, below_scan = narrowest, True
-    if br is not None:
-        width, below_scan = bisect(*top_bracket(), rtol)[1], False
-    x, f, _ = scanned()
-    ch = np.nonzero(f[1:] != f[:-1])[0]
-    transitions = tuple(float(t) for t in 0.5 * (x[ch] + x[ch + 1]))
-    return RequiredWidth(
-        width=float(width), height=height, rule="exact", iterations=calls,
-        method=(f"verified width: scan of {xs.size} widths up to the no-uplift width {top:.4g} m, "
-                f"then {rounds} round(s) of bisection above the widest failure and checks above "
-                f"it (widths {s.record_fine:.2%} apart up to {s.record_fine_span:.0%} above, "
-                + (f"a zone of {int(n_zone)} widths up to {s.record_zone_fraction:.0%} above, " if n_zone else "")
-                + f"gaps halved to {s.record_gap:.0%} where the block nearly tipped"
-                + ("; round limit reached" if limited else "")
-                + ("; no width examined failed: the answer is at most this width"
-                   if below_scan else "")
-                + f"); {runs} solver runs in {calls} batches"),
-        criterion=criterion, transitions=transitions, runs=runs, eta=eta, below_scan=below_scan)
+            return br, rounds, False
+        br = _top_bracket(pts)
+    return br, rounds, br is not None   # limited: failures were still being found above the candidate
+
+
+def _run_down(pts, widths, chunk) -> bool:
+    """Run ``widths`` from the widest down, ``chunk`` at a time, stopping after the first chunk with
+    a failure: narrower widths cannot change the answer (it lies above the widest failure), so
+    they are not run.  Returns whether any failed."""
+    widths = np.sort(np.asarray(widths, dtype=float))[::-1]
+    for k in range(0, widths.size, chunk):
+        if pts.add(widths[k:k + chunk]).any():
+            return True
+    return False
+
+
+def _top_bracket(pts):
+    x, f, _ = pts.sorted()
+    if not f.any():
+        return None
+    j = np.nonzero(f)[0][-1]
+    return x[j], x[j + 1]                     # x[-1] = top survives, so j + 1 exists
+
+
+def _bisect(pts, lo, hi, tol):
+    """Bisect a bracket whose narrow end fails to ``tol`` relative."""
+    while hi - lo > tol * hi:
+        mid = 0.5 * (lo + hi)
+        if pts.add([mid])[0]:
+            lo = mid
+        else:
+            hi = mid
+    return lo, hi
+
+
+def _near_gaps(pts, w, s):
+    """Midpoints of the gaps above ``w`` to halve (step 5)."""
+    x, f, r = pts.sorted()
+    sel = x >= w
+    x, r = x[sel], r[sel]
+    wide = (x[1:] - x[:-1]) > s.record_gap * x[:-1]
+    near = np.maximum(r[1:], r[:-1]) >= s.record_near
+    m = np.nonzero(wide & near)[0]
+    return 0.5 * (x[m] + x[m + 1])
+
+
+def _method(n_scanned, top, rounds, limited, below_scan, pts, s) -> str:
+    n_zone = s.record_zone_points
+    return (f"verified width: scan of {n_scanned} widths up to the no-uplift width {top:.4g} m, "
+            f"then {rounds} round(s) of bisection above the widest failure and checks above "
+            f"it (widths {s.record_fine:.2%} apart up to {s.record_fine_span:.0%} above, "
+            + (f"a zone of {int(n_zone)} widths up to {s.record_zone_fraction:.0%} above, " if n_zone else "")
+            + f"gaps halved to {s.record_gap:.0%} where the block nearly tipped"
+            + ("; round limit reached" if limited else "")
+            + ("; no width examined failed: the answer is at most this width"
+               if below_scan else "")
+            + f"); {pts.runs} solver runs in {pts.calls} batches")
 

@@ -35,6 +35,7 @@ def _check_worker_failure(out, reference, killer="good02"):
     assert [r["record"] for r in rows] == [f"good{k:02d}" for k in range(6) if f"good{k:02d}" != killer]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", [["--jobs", "2"], ["--dask", "local", "--jobs", "2"]], ids=["pool", "dask"])
 def test_a_worker_killed_at_one_record_fails_that_record_only(how, six, reference, tmp_path, monkeypatch):
     if "--dask" in how:
@@ -49,6 +50,7 @@ def test_a_worker_killed_at_one_record_fails_that_record_only(how, six, referenc
     assert tree(out) == reference
 
 
+@pytest.mark.slow
 def test_dask_workers_need_no_access_to_the_inputs(six, reference, tmp_path, monkeypatch):
     """Every input file is deleted as soon as the client has read it: the workers (other processes)
     can only have the bytes the client shipped, and the reports are those of a serial run."""

@@ -5,7 +5,10 @@ import importlib.machinery
 import subprocess
 import sys
 
+import pytest
 
+
+@pytest.mark.slow
 def test_core_is_the_compiled_extension_and_numba_is_not_imported():
     code = ("import sys, pulses, rocking, pipeline, pipeline.cli, rocking._core as c; "
             "print(c.__file__); print('numba' in sys.modules)")

@@ -113,6 +113,7 @@ def _naive_pulse(signal, col, row, scales):
     return scale, pulse
 
 
+@pytest.mark.slow
 def test_pulse_extraction_equals_the_literal_algorithm():
     # _analyze transforms only the search window and reuses one shifted kernel for wavelets
     # inside the record; the literal loop transforms the whole residual each time.  Candidates
@@ -190,6 +191,7 @@ def test_rotating_a_pair_shifts_the_orientation_only():
 
 # -- published classifications ---------------------------------------------------------------
 
+@pytest.mark.slow
 @pytest.mark.parametrize("first,second,rsn", PULSE_PAIRS, ids=[str(p[2]) for p in PULSE_PAIRS])
 def test_published_pulse_pairs(first, second, rsn):
     row = _published(rsn)
@@ -304,6 +306,7 @@ def test_pair_files_ambiguous_group_stays_single():
 
 # -- command line ----------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_pipeline_classify_command(tmp_path, capsys):
     from pipeline.cli import main
     from pipeline.cmd_classify import COLUMNS, RUN_COLUMNS, classify_fields
@@ -342,6 +345,7 @@ def test_pipeline_classify_refuses_an_explicit_bad_pair(capsys):
     assert "RSN6_IMPVALL.I_I-ELC180.AT2" in err and "RSN6_2.AT2" in err and "26 samples" in err
 
 
+@pytest.mark.slow
 def test_pipeline_classify_keeps_the_users_files(tmp_path, capsys):
     """--csv naming an input is refused before any work (exit 2, the input intact); two inputs of
     the same name in different folders get a PNG each, not one over the other."""

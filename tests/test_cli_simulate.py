@@ -22,6 +22,7 @@ def test_simulate_json_matches_library(capsys):
     assert out["block"]["p_rad_s"] == pytest.approx(1.381, abs=5e-4)
 
 
+@pytest.mark.slow
 def test_simulate_history_csv_and_plot(tmp_path, capsys):
     csv, png = tmp_path / "h.csv", tmp_path / "h.png"
     assert main(["simulate", "--block", "2x3", "--pulse", "ricker-sym", "--ap=-2.0g", "--tp",

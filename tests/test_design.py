@@ -326,6 +326,7 @@ def _near_fault_record(seed=3, duration=25.0, dt=0.01):
     return pulses.Record(noise + make_pulse("sine", 0.5 * G, 1.4, 0.4 * duration)(t), dt)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("height", [7.5, 6.0])
 def test_record_width_search_matches_brute_force_synthetic(height):
     """The verified-width search (~520 runs) against 1500 runs of a uniform scan."""
@@ -349,6 +350,7 @@ def test_record_width_search_matches_brute_force_synthetic(height):
         assert rocking.simulate(blk, rec, model="reference", history=False).overturned is expect
 
 
+@pytest.mark.slow
 def test_record_width_search_matches_brute_force_rinaldi(shared_records):
     """Rinaldi 228 (NGA no. 1063), real record: the README's 1.650 m for the Temple column's
     height; a 1000-point scan of 1.3-2.3 m finds no failure above it (resolution 1 mm), and the
@@ -364,6 +366,7 @@ def test_record_width_search_matches_brute_force_rinaldi(shared_records):
 @pytest.mark.parametrize("name,height", [("RSN1084_NORTHR_SCS052.AT2", 6.0),
                                          ("RSN15_KERN_TAF021.AT2", 6.0),
                                          ("RSN6_IMPVALL.I_I-ELC180.AT2", 6.0)])
+@pytest.mark.slow
 def test_record_width_search_not_below_brute_force_real(name, height):
     """Chaotic real records with isolated failing slivers well above the main transition (the
     former 64-width search answered 1.653, 0.439 and 0.633 m here): the search is not below a
@@ -380,6 +383,7 @@ def test_record_width_search_not_below_brute_force_real(name, height):
     # (no check that it fails just below: these top slivers can be thinner than 1e-6 relative;
     # Kern Taft at 6 m survives at 1 - 1e-6 of the answer, failing within its 1e-9 bracket)
 
+@pytest.mark.slow
 def test_min_slenderness_top_bisection_same_answer():
     """refine="top", ksection=2 (what pipeline run uses) against the default full refinement,
     including a case with a safe island below the answer (symmetric Ricker, Rinaldi)."""
@@ -391,6 +395,7 @@ def test_min_slenderness_top_bisection_same_answer():
             assert b.tan_alpha == pytest.approx(a.tan_alpha, rel=2e-9)
 
 
+@pytest.mark.slow
 def test_verified_width_never_zero_for_a_very_tall_column(shared_records):
     """Issue 19: a 1000 m x 1 m column under Rinaldi 228 was reported at width 0 ("adequate"):
     every width of the scan survived (its floor is the no-uplift width / 1024, 0.8 m).  The

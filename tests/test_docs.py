@@ -47,6 +47,7 @@ def test_readme_table_is_a_real_run():
         assert h in head
 
 
+@pytest.mark.slow
 def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     (code,) = _python_blocks(README.read_text(encoding="utf-8"))
     monkeypatch.chdir(tmp_path)

@@ -110,6 +110,7 @@ def test_transform_matches_pywavelets_cwt():
 
 
 # -- accuracy without noise ------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("shape", SHAPES)
 def test_noise_free_recovery(shape):
     rng = np.random.default_rng(11)
@@ -208,6 +209,7 @@ def _check_at_noise_limit(cases):
         assert math.sqrt(np.mean(z**2)) < 1.35, (key, math.sqrt(np.mean(z**2)))
 
 
+@pytest.mark.slow
 def test_noise_5_percent():
     # 3 records per shape and Tp (60 fits); the floors of the issue (ap and Tp within 3 % in 90 %
     # of cases) hold where the noise limit allows them: for Tp >= 2 s the limit is <= 1.3 %
@@ -219,6 +221,7 @@ def test_noise_5_percent():
     _check_at_noise_limit(cases)
 
 
+@pytest.mark.slow
 def test_noise_15_percent():
     cases = _cases(0.15, TPS, 3, seed=15)
     long = [c for c in cases if c["tp"] >= 2.0]
@@ -230,6 +233,7 @@ def test_noise_15_percent():
     _check_at_noise_limit(cases)
 
 
+@pytest.mark.slow
 def test_noise_30_percent_shape():
     cases = _cases(0.30, (0.5, 1.0, 2.0, 5.0), 3, seed=30)
     # right shape in 90 % for Tp >= 1 s; at 0.5 s the shapes are ambiguous in this noise (docs/fitting.md)
@@ -240,6 +244,7 @@ def test_noise_30_percent_shape():
 
 
 # -- weighted least squares ---------------------------------------------------------------------------
+@pytest.mark.slow
 def test_weighted_fit_pins_the_edges_in_a_band_the_readme_does_not_use():
     # 15 % background in 0.8-12 Hz (the tables of docs/fitting.md use 0.5-10 and 0.1-25 Hz), pulses inside
     # the band; the same records fitted both ways.  The one-sine's and rectangle's edges carry
@@ -270,6 +275,7 @@ def test_weighted_fit_pins_the_edges_in_a_band_the_readme_does_not_use():
     assert rms_ap["background"] < 0.75 * rms_ap["plain"], rms_ap
 
 
+@pytest.mark.slow
 def test_weighted_fit_of_short_cornered_pulses_in_a_wide_band():
     # 0.2 s one-sines and rectangles in 15 % background of 0.1-25 Hz (seeds docs/fitting.md does not
     # use).  Above 25 Hz the weights are about 4000 times those in the band, so the corners pin
@@ -295,6 +301,7 @@ def test_weighted_fit_of_short_cornered_pulses_in_a_wide_band():
         assert rms[shape, "background"][0] < 0.8 * rms[shape, "plain"][0], rms
 
 
+@pytest.mark.slow
 def test_weighted_fit_of_a_low_passed_record_keeps_the_pulse():
     # Real records are low-pass filtered: above the filter's corner they hold neither background
     # nor a one-sine's corners or a rectangle's edges, and a fit weighted by the (tiny) power
@@ -320,6 +327,7 @@ def test_weighted_fit_of_a_low_passed_record_keeps_the_pulse():
                 assert weighted[shape].ap == pytest.approx(plain[shape].ap, rel=0.03), (shape, tp)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shape", SHAPES)
 def test_noise_free_recovery_weighted(shape):
     # without noise the plain fit leaves round-off (the rectangle's cell averages: not exactly
@@ -359,6 +367,7 @@ def test_background_spectrum_leaves_out_the_pulse():
     assert high(Background(noise + misfit, DT, skip=(7.75, 8.75))) == pytest.approx(alone, rel=0.1)
 
 
+@pytest.mark.slow
 def test_weighted_score_of_long_pulses():
     # 5 s pulses in 40 s records, 30 % background in 0.5-10 Hz (seeds docs/fitting.md does not use).
     # Weighted by the inverse of the background's spectrum, the record's energy is almost all
@@ -460,6 +469,7 @@ def test_result_objects():
 
 
 # -- pipeline fit ----------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_pipeline_fit_table_csv_json_plot(tmp_path, capsys):
     import json
 
@@ -600,6 +610,7 @@ SHARED_AT2 = ["Rinaldi228.AT2", "Rinaldi318.AT2", "NGA_no_1063_RRS228.AT2", "RSN
               "RSN879_LANDERS_LCN260.AT2", "RSN879_LANDERS_LCN345.AT2"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", SHARED_AT2)
 def test_a_shapes_fit_is_the_same_whichever_shapes_are_asked(name):
     """``fit_pulse(r, shapes=[s])`` gave Rinaldi 228's one-sine as 0.652 g, 0.891 s while the sine

@@ -33,6 +33,7 @@ def brute():
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", RECORDS)
 def test_critical_scale_against_brute_force_scan(brute, name):
     rec, block, cs, ks, over = brute[name]
@@ -59,6 +60,7 @@ def test_critical_scale_against_brute_force_scan(brute, name):
     assert cs.uplift_scale == pytest.approx(block.uplift_acceleration / rec.pga, rel=1e-15)
 
 
+@pytest.mark.slow
 def test_critical_scale_of_a_pulse_matches_critical_amplitudes():
     # a second method: critical_amplitudes scans amplitudes (m/s^2) uniformly from the uplift
     # acceleration and bisects to 1e-9; both answers are refined brackets, so they agree to the
@@ -73,6 +75,7 @@ def test_critical_scale_of_a_pulse_matches_critical_amplitudes():
             assert cs.scale * G == pytest.approx(amps.minimum, rel=2e-6)
 
 
+@pytest.mark.slow
 def test_frame_with_zero_cap_mass_is_the_column(brute):
     rec, block, cs, *_ = brute[RECORDS[2]]
     frame = Block.from_dimensions(7.5, 1.8, cap_mass_ratio=0)
@@ -90,6 +93,7 @@ def test_critical_scale_no_overturn_and_bad_input():
         rocking.critical_scale(block, pulse, step=0)
 
 
+@pytest.mark.slow
 def test_fragility_fit_against_scipy():
     rng = np.random.default_rng(7)
     k = np.exp(rng.normal(math.log(1.3), 0.4, size=25))

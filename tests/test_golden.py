@@ -85,6 +85,7 @@ def _values(want, got, key, rel):
 CASES = sorted(k for k in GOLDEN if k != "demo/summary")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("key", CASES)
 def test_same_answers_as_the_numba_engine(current, key):
     want = GOLDEN[key]

@@ -49,6 +49,7 @@ def _demo_ids():
         return [pathlib.Path(p).stem for p in paths]
 
 
+@pytest.mark.slow
 def test_printed_table_and_design_csv(demo):
     out, proc = demo
     ids = _demo_ids()
@@ -81,6 +82,7 @@ def test_printed_table_and_design_csv(demo):
     assert "## Columns of `design.csv`" in (out / "columns.md").read_text()
 
 
+@pytest.mark.slow
 def test_quiet_prints_nothing(tmp_path):
     proc = _run_demo(tmp_path / "q", "--quiet", "--no-plots")
     assert proc.returncode == 0, proc.stderr
@@ -90,6 +92,7 @@ def test_quiet_prints_nothing(tmp_path):
     assert "<img" not in page  # no figures drawn, none linked
 
 
+@pytest.mark.slow
 def test_report_html_content_and_size(demo):
     out, _ = demo
     page = (out / "report.html").read_text()
@@ -106,6 +109,7 @@ def test_report_html_content_and_size(demo):
     assert total <= MAX_BYTES, total
 
 
+@pytest.mark.slow
 def test_rerun_gives_identical_bytes(demo, tmp_path):
     out, _ = demo
     again = tmp_path / "again"
@@ -115,6 +119,7 @@ def test_rerun_gives_identical_bytes(demo, tmp_path):
         assert (again / rel).read_bytes() == (out / rel).read_bytes(), rel
 
 
+@pytest.mark.slow
 def test_failures_listed(tmp_path):
     """A record that cannot be read is a row of the page's failure table and a line of the
     printed table, with its reason."""

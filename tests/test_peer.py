@@ -168,6 +168,7 @@ def test_unsafe_members_are_never_read_and_fail_their_record(tmp_path, monkeypat
     assert sorted(p for p in tmp_path.rglob("*")) == before  # nothing extracted or written
 
 
+@pytest.mark.slow
 def test_unsafe_zip_in_pipeline_run(tmp_path):
     """``pipeline run`` on such a zip: the record that is complete is designed (a pair, scaled by
     the search's factor with --peer-scales), the others are failures with their reasons, status 1."""
@@ -219,6 +220,7 @@ def test_vertical_polarity_is_never_guessed(tmp_path, name, component, expected)
 
 
 # -- pipeline run on the shared download -------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("as_zip", [False, True], ids=["folder", "zip"])
 def test_pipeline_run_on_the_shared_download(download, download_zip, tmp_path, as_zip, capsys):
     """The floor: one pair row per complete record, the metadata columns equal to the report's,

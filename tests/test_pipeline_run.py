@@ -100,6 +100,7 @@ def batch_run(batch20, tmp_path_factory):
 
 
 # -- robustness ------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20):
     code, out = batch_run
     assert code == 1
@@ -129,6 +130,7 @@ def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20)
             assert len(re.findall(r"(?<!\\)\|", line)) == 4, line
 
 
+@pytest.mark.slow
 def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
     """Re-running into the same folder, now with 2 processes, leaves every file as it was."""
     code, out = batch_run
@@ -141,6 +143,7 @@ def test_rerun_into_same_folder_is_identical_whatever_jobs(batch_run, batch20):
 PLOT_ARGS = ["--block", "7.5x1.8", "--block", "6x1.2", "--quiet"]
 
 
+@pytest.mark.slow
 def test_plots_identical_whatever_jobs_and_on_rerun(tmp_path):
     """With plots (one figure reused per worker process): --jobs 1, --jobs 2 and a re-run into the
     same folder give the same bytes in every file, PNGs included."""
@@ -157,6 +160,7 @@ def test_plots_identical_whatever_jobs_and_on_rerun(tmp_path):
         {n: b for n, b in first.items() if n.endswith(".png") and "summary" not in n}
 
 
+@pytest.mark.slow
 def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     """A record's PNG does not depend on what the process drew before: drawn alone by a fresh
     process, and drawn last after records of other lengths and verdicts (good09 overturns at 6 m);
@@ -193,6 +197,7 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     assert plots.run_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
 
 
+@pytest.mark.slow
 def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
     rec = write_good(tmp_path, 1)
     out = tmp_path / "out"
@@ -223,6 +228,7 @@ def test_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
     assert [p.name for p in tmp_path.iterdir()] == ["summary.csv"]
 
 
+@pytest.mark.slow
 def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
     """SIGINT in the middle of a batch: exit 130, no temporary files, every CSV complete."""
     import signal
@@ -252,6 +258,7 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
         assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
 
 
+@pytest.mark.slow
 def test_progress_bar_only_when_asked_or_on_a_terminal(tmp_path, capsys):
     from pipeline.runner import run
 
@@ -271,6 +278,7 @@ def test_record_ids_are_unique_and_safe():
 
 
 # -- end to end on converted SAC files, numbers against the library called directly ---------------
+@pytest.mark.slow
 def test_cli_end_to_end_numbers_match_library(tmp_path):
     """A plain-text record (cm/s2) -> `pipeline convert --to sac` -> `pipeline run`; every number in
     the report is checked against the library functions called directly on the converted file."""
@@ -359,6 +367,7 @@ def paper_run(tmp_path_factory):
     return code, out
 
 
+@pytest.mark.slow
 def test_rinaldi_eq31_and_survival_of_the_temple_column(paper_run):
     code, out = paper_run
     assert code == 0, read_csv(out / "failures.csv")
@@ -407,6 +416,7 @@ def test_erzincan_ns_plain_text_processed(paper_run):
 
 
 # -- dask -----------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
     """A local dask cluster on part of the batch: the same per-record reports and failure rows."""
     pytest.importorskip("dask.distributed")
@@ -425,6 +435,7 @@ def test_dask_local_cluster_gives_the_same_files(batch_run, batch20, tmp_path):
 
 
 # -- demo -------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_demo_from_another_directory(tmp_path):
     """`pipeline demo` from an unrelated folder: bundled records, ./demo-output, plots, no noise."""
     proc = subprocess.run([sys.executable, "-m", "pipeline", "demo", "--jobs", "2"],
@@ -486,6 +497,7 @@ def test_record_options_are_the_same_for_every_reading_command():
     assert all(opts == expected for opts in parsed.values()), parsed
 
 
+@pytest.mark.slow
 def test_run_reads_the_trace_asked_for(tmp_path):
     """A two-trace MiniSEED file: without --trace the record fails with a message naming --trace;
     with --trace HNN the report's PGA is that trace's peak (numpy's max of the samples written)."""
@@ -532,6 +544,7 @@ def test_an_input_inside_out_is_never_overwritten(tmp_path, capsys):
     assert sorted(p.name for p in b1.iterdir()) == ["erzikan.csv"]  # nothing else written either
 
 
+@pytest.mark.slow
 def test_files_the_run_did_not_write_are_left_as_they_are(tmp_path, capsys):
     """A user's own <id>.csv, an edited report, and a failed record's namesake are never replaced
     or deleted; the run says so, and the record's rows still reach summary.csv."""
@@ -568,12 +581,12 @@ def test_files_the_run_did_not_write_are_left_as_they_are(tmp_path, capsys):
 def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys, monkeypatch):
     """A summary.csv the run did not write, an --out that is a file or cannot be written: exit 2 in
     one line, before any record is read."""
-    from pipeline import runner
+    from pipeline import worker
 
     def no_work(task):
         raise AssertionError("a record was processed")
 
-    monkeypatch.setattr(runner, "process_record", no_work)
+    monkeypatch.setattr(worker, "process_record", no_work)
     rec = write_good(tmp_path, 1)
     out = tmp_path / "out"
     out.mkdir()
@@ -590,6 +603,7 @@ def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys,
     assert (out / "summary.csv").read_text() == "mine\n" and afile.read_text() == "x"
 
 
+@pytest.mark.slow
 def test_write_errors_and_odd_names_fail_one_record_only(tmp_path):
     """A 250-character file name, a name whose bytes are not UTF-8, and a report path taken by a
     folder: each is handled or fails alone; the batch writes summary.csv and failures.csv."""
@@ -615,6 +629,7 @@ def test_write_errors_and_odd_names_fail_one_record_only(tmp_path):
     assert max(len(os.fsencode(p.name)) for p in out.iterdir()) < 120
 
 
+@pytest.mark.slow
 def test_no_write_goes_through_a_planted_symlink(tmp_path):
     """Symbolic links planted in --out (at the old predictable temporary name, and at a report's
     name) never lead a write to their target."""
@@ -642,6 +657,7 @@ def test_no_write_goes_through_a_planted_symlink(tmp_path):
     assert list(elsewhere.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_text_cells_are_never_formulas(tmp_path, monkeypatch):
     """Header text and file names that a spreadsheet would evaluate get a leading apostrophe;
     numbers (negative ones included) are written as they are."""
@@ -686,15 +702,16 @@ def test_report_rows_must_match_their_declared_columns():
         RECORD_COLUMNS.row({k: v for k, v in values.items() if k != "event"})
 
 
+@pytest.mark.slow
 def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
     """Ctrl-C whose exception is swallowed (as in a callback Python cannot raise from) still ends
     the run with status 130 before the next record."""
     import signal
     import time
 
-    from pipeline import runner
+    from pipeline import worker
 
-    real, seen = runner.process_record, []
+    real, seen = worker.process_record, []
 
     def swallowing(task):
         seen.append(task.record_id)
@@ -705,7 +722,7 @@ def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
             pass
         return real(task)
 
-    monkeypatch.setattr(runner, "process_record", swallowing)
+    monkeypatch.setattr(worker, "process_record", swallowing)
     recs = [str(write_good(tmp_path, k)) for k in range(3)]
     assert main(["run", *recs, *SAFE_ARGS, "--out", str(tmp_path / "out")]) == 130
     assert seen == ["good00"]
@@ -757,6 +774,7 @@ def _check_reports_whole(out):
             assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
 
 
+@pytest.mark.slow
 def test_double_ctrl_c_with_two_jobs_ends_at_once_and_leaves_no_process(tmp_path):
     """The issue's hang: two Ctrl-C with --jobs 2 (sent to the process group, as a terminal does).
     Exit 130 well within 10 s (measured ~0.3-1 s here), no worker or fork server left behind, every
@@ -771,6 +789,7 @@ def test_double_ctrl_c_with_two_jobs_ends_at_once_and_leaves_no_process(tmp_path
     _check_reports_whole(out)
 
 
+@pytest.mark.slow
 def test_sigterm_ends_a_pool_run_with_143(tmp_path):
     import signal
 

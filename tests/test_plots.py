@@ -20,6 +20,7 @@ def _png_info(png: bytes):
         return im.format, im.size, dict(im.info)
 
 
+@pytest.mark.slow
 def test_record_figure_draws_the_record_its_pulses_and_rotations(tmp_path):
     """Each panel holds what the run computed: the record and the fitted pulses in g, theta / alpha
     of each column with the alpha lines, the verdicts in the legends, one time axis."""
@@ -79,6 +80,7 @@ def _text_boxes(fig):
     return boxes
 
 
+@pytest.mark.slow
 def test_record_figure_labels_inside_and_apart(tmp_path):
     """The record figure's margins are fixed in inches: every label stays inside the figure and off
     the others, also with wide tick labels (a weak record: ticks like -0.010) and one column."""
@@ -112,6 +114,7 @@ def test_long_records_are_thinned_for_drawing_only():
     np.testing.assert_array_equal(yy, np.sin(t)[::3])
 
 
+@pytest.mark.slow
 def test_summary_figure_plots_the_rows():
     """The summary's points are the rows' numbers: required against actual tan(alpha) for columns as
     they stand, split by verdict, and verified against Eq. 31 design for every row."""
@@ -147,6 +150,7 @@ def test_summary_figure_without_columns_says_so():
     assert fig.axes[0].get_legend() is None and fig.axes[1].get_legend() is None
 
 
+@pytest.mark.slow
 def test_record_figure_velocity_pulse_and_verified_width(tmp_path):
     """The run's figure adds the record's velocity with the extracted velocity pulse (the
     classification's own arrays) and the column at its verified width (the row's width)."""

@@ -81,6 +81,7 @@ def test_at2_touching_numbers_no_leading_zero_short_last_line(tmp_path):
     np.testing.assert_allclose(rec.acc, expect, rtol=1e-15)
 
 
+@pytest.mark.slow
 def test_obspy_reads_at2_through_the_plugin():
     import obspy
 
@@ -469,6 +470,7 @@ def test_names_not_utf8_with_controls_and_long(tmp_path):
 
 
 # -- pipeline convert ------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_pipeline_convert_to_sac_and_mseed(tmp_path, capsys):
     from pipeline.cli import main
 

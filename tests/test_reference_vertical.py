@@ -33,6 +33,7 @@ BLOCKS = [rocking.Block.from_dimensions(3.0, 0.6), rocking.Block.from_dimensions
           rocking.Block.from_dimensions(7.5, 1.8)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("block", BLOCKS, ids=["overturns", "rocks", "stands-tall"])
 def test_zero_vertical_equals_the_horizontal_reference(block):
     rec = record()
@@ -49,6 +50,7 @@ def test_zero_vertical_equals_the_horizontal_reference(block):
             np.testing.assert_allclose(res.impacts[:n], ref.impacts[:n], atol=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("c_g", [0.3, -0.3, 0.6, -0.5])
 @pytest.mark.parametrize("block", BLOCKS[:2], ids=["slender", "stocky"])
 def test_constant_vertical_is_the_similar_block(block, c_g):
@@ -107,6 +109,7 @@ def test_axes_must_agree():
     (77, "RSN77_SFERN_PUL164.AT2", "RSN77_SFERN_PUL254.AT2", "RSN77_SFERN_PULDWN.AT2", -1),
     (15, "RSN15_KERN_TAF021.AT2", "RSN15_KERN_TAF111.AT2", "RSN15_KERN_TAF-UP.AT2", 1),
 ])
+@pytest.mark.slow
 def test_real_three_component_records(rsn, h1, h2, v, polarity):
     """On the shared PEER records (a DWN and an UP vertical): the vertical read with its polarity;
     the zero-vertical run equals the horizontal reference; the vertical's effect is measured."""
@@ -135,6 +138,7 @@ def test_real_three_component_records(rsn, h1, h2, v, polarity):
     assert (with_v.max_rotation, with_v.t_overturn) != (flipped.max_rotation, flipped.t_overturn)
 
 
+@pytest.mark.slow
 def test_simulate_with_a_vertical_says_which_model_answered():
     block = rocking.Block.from_dimensions(3.0, 0.9)
     rec = record()

@@ -38,6 +38,7 @@ def whole(batch, tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_killed_batch_resumes_with_only_the_missing_records_and_same_bytes(batch, whole, tmp_path, capsys):
     out = tmp_path / "out"
     args = [a for a in BATCH_ARGS if a != "--quiet"]
@@ -61,6 +62,7 @@ def test_killed_batch_resumes_with_only_the_missing_records_and_same_bytes(batch
     assert tree(out) == tree(whole)
 
 
+@pytest.mark.slow
 def test_stale_reports_failures_and_force_are_computed_again(batch, whole, tmp_path, capsys):
     """A removed report, a changed input, a changed option and a failed record are computed again;
     --force computes all; the summary always holds every record, in input order."""

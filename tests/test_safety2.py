@@ -44,6 +44,7 @@ def alone(recs, tmp_path_factory):
     return tree(out)
 
 
+@pytest.mark.slow
 def test_a_second_run_into_a_busy_out_is_refused_and_nothing_is_lost(recs, alone, tmp_path):
     """Two real processes into one --out: the second is refused at once (exit 2, one line), the
     first finishes as if alone, and the folder is usable by the next run."""
@@ -190,6 +191,7 @@ def test_run_log_never_onto_an_input_or_the_runs_own_files(tmp_path, capsys):
     assert main(["run", str(b), *SAFE_ARGS, "--out", str(out)]) == 0  # the folder is usable
 
 
+@pytest.mark.slow
 def test_classify_plot_never_replaces_a_users_png(tmp_path, capsys):
     """``classify --plot DIR`` replaced a user's PNG of the same name; now only its own PNGs."""
     a = write_good(tmp_path, 1)
@@ -240,6 +242,7 @@ def test_every_command_checks_its_file_outputs_the_same_way(tmp_path, capsys, mo
 
 
 # -- 4. folder inputs: broken entries are failed records, never skipped -----------------------------
+@pytest.mark.slow
 def test_broken_entries_of_a_folder_are_failed_records(tmp_path, capsys):
     """A dangling link and a link loop in a folder were skipped (exit 0); given by a glob they failed.
     Now both ways give the same failed records, with the reason."""
@@ -316,12 +319,12 @@ def test_files_of_a_folder_without_search_permission_are_failed_records(tmp_path
 def test_scales_obey_the_scale_rule(table, tmp_path, capsys, monkeypatch):
     """--scales 1e6 ran to the end at 874,060 g (exit 0), 1e-9 failed deep inside after 18 s; rows
     for one record were resolved silently.  Now each is refused at once, in one line."""
-    from pipeline import runner
+    from pipeline import worker
 
     def no_work(task):
         raise AssertionError("a record was processed")
 
-    monkeypatch.setattr(runner, "process_record", no_work)
+    monkeypatch.setattr(worker, "process_record", no_work)
     a = write_good(tmp_path, 1)
     scales = tmp_path / "scales.csv"
     scales.write_text(table)
@@ -485,6 +488,7 @@ def test_the_strongest_map_gives_what_the_whole_map_gives():
             strongest.clear(cleared)
 
 
+@pytest.mark.slow
 def test_classification_caches_stay_within_their_bytes():
     """A 10 kHz record: the filters' caches hold at most their budgets (they held 10.9 GB after a
     2e6-sample record)."""

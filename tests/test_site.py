@@ -80,6 +80,7 @@ def pair_run(pairs, tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_a_failed_direction_is_counted_in_pairs_csv(pairs, pair_run, tmp_path, monkeypatch):
     # one direction of the first pair fails (its worker kills itself): the pair's governing row
     # says so, and is the widest of the other directions; the second pair is untouched
@@ -103,6 +104,7 @@ def test_a_failed_direction_is_counted_in_pairs_csv(pairs, pair_run, tmp_path, m
     assert int(gov[second]["n_directions_failed"]) == 0 and gov[second] == reference[second]
 
 
+@pytest.mark.slow
 def test_pair_rows_governing_and_suite(pairs, pair_run, tmp_path):
     folder, ((a1, a2), (b1, b2)) = pairs
     rows = _read(pair_run / "summary.csv")
@@ -165,6 +167,7 @@ def test_direction_equals_rotated_record_file(pairs, pair_run, tmp_path):
     assert row["direction_kind"] == "even" and row["file2"] == str(a2)
 
 
+@pytest.mark.slow
 def test_jobs_do_not_change_outputs_and_bad_inputs_fail_alone(pairs, tmp_path):
     folder, ((a1, a2), (b1, b2)) = pairs
     missing = folder / "missing.sac"
@@ -188,6 +191,7 @@ def test_jobs_do_not_change_outputs_and_bad_inputs_fail_alone(pairs, tmp_path):
     assert _read(out1 / "suite.csv")[0]["n_records"] == "1"
 
 
+@pytest.mark.slow
 def test_scale_and_scales(pairs, tmp_path):
     folder, ((a1, a2), _) = pairs
     out1, out2 = tmp_path / "k1", tmp_path / "k2"
@@ -210,6 +214,7 @@ def test_scale_and_scales(pairs, tmp_path):
     assert _run(tmp_path / "k4", a1, a2, "--height", H, "--scales", table) == 2
 
 
+@pytest.mark.slow
 def test_pulse_columns_and_warning(pairs, tmp_path):
     folder, ((a1, a2), _) = pairs
     out = tmp_path / "cls"
@@ -247,6 +252,7 @@ def test_frame_reports(pairs, tmp_path):
     assert _run(tmp_path / "bad", a1, "--height", H, "--cap-mass-ratio", "-1") == 2
 
 
+@pytest.mark.slow
 def test_fragility_outputs(pairs, tmp_path):
     folder, ((a1, a2), (b1, b2)) = pairs
     out = tmp_path / "frag"
@@ -276,6 +282,7 @@ def test_fragility_outputs(pairs, tmp_path):
     assert p == sorted(p) and p[0] < 0.01 and p[-1] > 0.99
 
 
+@pytest.mark.slow
 def test_suite_and_fragility_plots():
     """The suite plot draws the share of records verified at each width (step curve through the
     sorted governing widths) and marks the column; PNGs are at least 1000 px wide."""

@@ -79,6 +79,7 @@ def test_check_widths_layout():
         SearchSettings(check_span=1.0)
 
 
+@pytest.mark.slow
 def test_check_against_dense_scans_synthetic():
     """A synthetic chaotic record: the check changes nothing else, is repeatable, reports only
     widths that overturn, and its share just above the verified width agrees with a dense
@@ -116,6 +117,7 @@ def test_check_against_dense_scans_synthetic():
     assert abs(k - m * p) <= 4.0 * sigma + 2.0, (k, m, p)
 
 
+@pytest.mark.slow
 def test_check_against_dense_scan_real_record():
     """Landers, Lucerne 345 (real, 7.5 m): an independent linear scan of 4000 widths of (w, 2w]
     finds failing widths more than 1 % above the verified width; the check reports a widest
@@ -134,6 +136,7 @@ def test_check_against_dense_scan_real_record():
     assert ref.overturned
 
 
+@pytest.mark.slow
 def test_pipeline_reports_the_check(tmp_path):
     """`pipeline run`: the check's columns in the record's report equal `required_width`'s, the
     suite's checked share follows from them, and the barcode figure is written where the check

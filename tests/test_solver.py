@@ -37,6 +37,7 @@ def test_block_geometry_matches_spec_table():
 
 
 # ----------------------------------------------------------------------------- Eq. 23
+@pytest.mark.slow
 @pytest.mark.parametrize("tan_alpha", [0.1, 0.24, 0.5, 1.0])
 @pytest.mark.parametrize("model", ["fast", "reference"])
 def test_eq23_verge_velocity(tan_alpha, model):
@@ -292,6 +293,7 @@ def _broadband(n, dt, seed, peak_g):
     return acc / np.abs(acc).max() * peak_g * G
 
 
+@pytest.mark.slow
 def test_coarse_sampling_record():
     dt = 0.02
     rec = Record(_broadband(1000, dt, 3, 0.5), dt)
@@ -321,6 +323,7 @@ def test_one_hour_record_at_200_hz_in_bounded_memory():
 
 
 # ----------------------------------------------------------------------------- real record
+@pytest.mark.slow
 def test_temple_column_under_rinaldi_record_all_models():
     rec = pulses.read_record(shared_record("Rinaldi228.AT2"))
     fast = simulate(TEMPLE, rec, model="fast")

@@ -29,6 +29,7 @@ def rows(out, name="summary.csv"):
     return list(csv.DictReader(open(out / name)))
 
 
+@pytest.mark.slow
 def test_triplet_adds_the_response_with_the_vertical(files, tmp_path):
     out = tmp_path / "out"
     # scaled by 5 (PGA 0.1 to 0.13 g): the column rocks in some directions; the vertical is scaled too
@@ -59,6 +60,7 @@ def test_triplet_adds_the_response_with_the_vertical(files, tmp_path):
         assert r["vertical_lifts_off"] == "False"
 
 
+@pytest.mark.slow
 def test_pairs_auto_finds_the_vertical_and_none_leaves_it_out(files, tmp_path):
     out = tmp_path / "auto"
     assert main(["run", *files, "--pairs", "auto", *RUN_ARGS, "--out", str(out)]) == 0
@@ -70,6 +72,7 @@ def test_pairs_auto_finds_the_vertical_and_none_leaves_it_out(files, tmp_path):
     assert all(r["vertical_file"] == "" and r["vertical_overturns"] == "" for r in rows(out))
 
 
+@pytest.mark.slow
 def test_a_vertical_without_polarity_is_not_used_and_said(files, tmp_path):
     text = pathlib.Path(files[2]).read_text().splitlines()
     text[1] = text[1].replace("DWN", "V1")  # the header no longer states the polarity

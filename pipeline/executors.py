@@ -1,0 +1,262 @@
+"""Where the records of a batch run: in this process, a process pool (``--jobs N``) or dask
+(``--dask``).  Each gives the results of :func:`pipeline.worker.work` for every task, in completion
+order; none changes a result.
+"""
+from __future__ import annotations
+
+import collections
+import contextlib
+import logging
+import os
+
+from . import interrupts
+from .args import ArgumentError
+from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, worker_failure
+
+
+def _serial(tasks):
+    """Records one after the other in this process."""
+    for task in tasks:
+        interrupts.check()
+        yield work(task)
+
+
+def _size(task) -> int:
+    try:
+        return os.path.getsize(task.path)
+    except OSError:
+        return 0
+
+
+def _pool(tasks, jobs):
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    plots = any(t.options.plots for t in tasks)
+    # Not plain fork: the parent may already run threads (the solver's batch threads), and
+    # forking such a process is unsafe.  The fork server starts clean, imports the package once
+    # and forks the workers from there (cheap).
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    if ctx.get_start_method() == "forkserver":
+        preload = ["pipeline.batch", "pipeline.runner", "pulses", "rocking"]
+        if plots:
+            preload.append("pipeline.plots")  # matplotlib: ~0.2 s a worker otherwise
+        ctx.set_forkserver_preload(preload)
+    if plots:
+        # the summary plot needs matplotlib here too: import it while the workers start
+        import threading
+
+        threading.Thread(target=_import_plots, daemon=True).start()
+    others = _child_processes()
+    # the largest files first (longer records take longer), so that no long record is left alone at
+    # the end while the other workers idle; results are placed by index, so the reports do not
+    # depend on this order
+    queue = collections.deque(sorted(tasks, key=_size, reverse=True))
+    # records in the pool when a worker process died: each is run once more alone, so that the
+    # one that kills its worker is known and fails, and the others complete
+    suspects = collections.deque()
+    # at most this many records submitted at once: a few queued per worker keep them busy, and a
+    # dead worker makes only these suspects (and the pool holds no future per record of a long batch)
+    window = 2 * jobs
+    pool = None
+    finished = False
+    def new_pool():
+        return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
+                                   initargs=(os.environ.get(TEST_KILL_ENV),))
+
+    try:
+        while queue or suspects:
+            if pool is None:
+                pool = new_pool()
+            if suspects:  # one record alone in the pool
+                task = suspects.popleft()
+                fut = pool.submit(work, task)
+                while not wait([fut], timeout=0.25)[0]:
+                    interrupts.check()
+                try:
+                    yield fut.result()
+                except BrokenProcessPool as exc:  # its second death: a worker failure
+                    pool.shutdown(wait=True)
+                    pool = None
+                    yield worker_failure(task, exc)
+                except Exception as exc:
+                    yield worker_failure(task, exc)
+                continue
+            running: dict = {}
+            broken = False
+            while (queue or running) and not broken:
+                while queue and len(running) < window:
+                    task = queue.popleft()
+                    try:
+                        running[pool.submit(work, task)] = task
+                    except BrokenProcessPool:
+                        queue.appendleft(task)
+                        broken = True
+                        break
+                # a short wait, so that an interrupt whose exception was swallowed still stops the run
+                done, _ = wait(running, timeout=0.25, return_when=FIRST_COMPLETED)
+                interrupts.check()
+                for fut in done:
+                    task = running.pop(fut)
+                    try:
+                        yield fut.result()
+                    except BrokenProcessPool:
+                        suspects.append(task)
+                        broken = True
+                    except Exception as exc:  # e.g. a result that cannot be sent back
+                        yield worker_failure(task, exc)
+            if broken:  # every record still in the broken pool is a suspect
+                for fut, task in running.items():
+                    if fut.done() and not fut.cancelled() and fut.exception() is None:
+                        yield fut.result()
+                    else:
+                        suspects.append(task)
+                pool.shutdown(wait=True)
+                pool = None
+        finished = True
+    finally:
+        if pool is not None:
+            if finished:
+                pool.shutdown(wait=True)
+            else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
+                _stop(pool, others)
+
+
+def _child_processes() -> set:
+    """This process's live child processes: those of :mod:`multiprocessing` and, on Linux, any other
+    (the fork server, which :mod:`multiprocessing` does not list)."""
+    import multiprocessing
+
+    children = {("mp", p.pid, p) for p in multiprocessing.active_children()}
+    try:
+        for task in os.listdir("/proc/self/task"):
+            with open(f"/proc/self/task/{task}/children") as fh:
+                children |= {("pid", int(pid), None) for pid in fh.read().split()}
+    except (OSError, ValueError):  # not Linux: the fork server ends when this process does
+        pass
+    return children
+
+
+def _stop(pool, others, grace: float = 1.0) -> None:
+    """Stop ``pool`` now: pending records cancelled, its workers (and the fork server it started)
+    terminated, killed if they have not ended after ``grace`` seconds.  Processes in ``others``
+    (children that existed before the pool) are left alone."""
+    import signal
+    import time
+
+    with interrupts.deferred():
+        pool.shutdown(wait=False, cancel_futures=True)
+        known = {pid for _, pid, _ in others}
+        found = {}
+        for kind, pid, proc in _child_processes():  # a process of multiprocessing's, if it is one
+            if pid not in known and found.get(pid) is None:
+                found[pid] = proc
+        # the resource tracker is left running: it ends by itself when this process does, and
+        # this process's queues still report to it
+        targets = [(pid, proc) for pid, proc in found.items()
+                   if proc is not None or not _is_resource_tracker(pid)]
+        for pid, proc in targets:
+            _signal(pid, proc, signal.SIGTERM)
+        deadline = time.monotonic() + grace
+        for pid, proc in targets:
+            if proc is not None:
+                proc.join(max(0.0, deadline - time.monotonic()))
+        for pid, proc in targets:
+            if proc is not None and proc.is_alive():
+                proc.kill()
+                proc.join(1.0)
+            elif proc is None:
+                _reap(pid, deadline)
+
+
+def _signal(pid, proc, signum) -> None:
+    with contextlib.suppress(OSError):
+        if proc is not None:
+            proc.terminate()
+        else:
+            os.kill(pid, signum)
+
+
+def _reap(pid, deadline) -> None:
+    """Kill a child that :mod:`multiprocessing` does not track (the fork server) if it has not ended
+    by ``deadline``.  It is not waited for: :mod:`multiprocessing` reaps it (and starts a new one
+    if this process runs another pool)."""
+    import signal
+    import time
+
+    while _alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    if _alive(pid):
+        with contextlib.suppress(OSError):
+            os.kill(pid, signal.SIGKILL)
+
+
+def _alive(pid) -> bool:
+    """Whether ``pid`` runs (a process that has ended but is not reaped yet does not)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] not in (b"Z", b"X")
+    except (OSError, IndexError):
+        return False
+
+
+def _is_resource_tracker(pid) -> bool:
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as fh:
+            return b"resource_tracker" in fh.read()
+    except OSError:
+        return False
+
+
+def dask_client(address: str, jobs: int | None):
+    """A ``dask.distributed.Client`` on ``address`` or on a new local cluster (``"local"``)."""
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise ArgumentError("--dask needs dask.distributed: pip install 'rocking-columns[dask]'") from None
+    if address == "local":
+        import dask
+
+        # a task whose worker dies comes back at once; pipeline.remote retries it once itself
+        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+            cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1,
+                                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
+        return Client(cluster), cluster
+    try:
+        return Client(address, timeout="20s"), None
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ArgumentError(f"--dask: cannot connect to the scheduler at {address!r}: {exc}") from None
+
+
+def _dask(tasks, address, jobs):
+    from .remote import run_dask
+
+    client, cluster = dask_client(address, jobs)
+    try:
+        client.run(init_worker)
+        workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
+        yield from run_dask(tasks, client, workers)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def execute(tasks, jobs: int | None = 1, dask: str | None = None):
+    """Results of :func:`process_record` for every task, in completion order.
+
+    ``jobs`` None (not given) or 1: the records in this process."""
+    if dask:
+        return _dask(tasks, dask, jobs)
+    if jobs is None or jobs <= 1 or len(tasks) <= 1:
+        return _serial(tasks)
+    return _pool(tasks, min(jobs, len(tasks)))
+
+
+def _import_plots():
+    try:
+        import pipeline.plots  # noqa: F401
+    except Exception:  # pragma: no cover - reported when the summary plot is drawn
+        pass

@@ -1,0 +1,63 @@
+"""The velocity-pulse row: Shahi & Baker's (2014) classification (:func:`pulses.classify_pulse`) of a
+record or pair as ``pipeline classify`` reports it, and the subset ``pipeline run`` adds to its rows.
+"""
+from __future__ import annotations
+
+#: columns of one row, in order (units in the names)
+COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
+           "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio"]
+#: the subset ``pipeline run`` reports
+RUN_COLUMNS = ["pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "orientation_deg", "azimuth_deg"]
+
+def result_row(result, file="", file2="") -> dict:
+    """One report row of a :class:`pulses.PulseClassification` (see :data:`COLUMNS`)."""
+    return {"file": str(file), "file2": str(file2) if file2 else "", "pulse_like": bool(result.is_pulse),
+            "velocity_pulse_indicator": float(result.indicator), "velocity_tp_s": float(result.tp),
+            "pgv_m_s": float(result.pgv), "orientation_deg": float(result.orientation),
+            "azimuth_deg": None if result.azimuth is None else float(result.azimuth),
+            "arrival_s": float(result.arrival), "late": bool(result.late),
+            "pgv_ratio": float(result.pgv_ratio), "energy_ratio": float(result.energy_ratio)}
+
+
+def classify_fields(record, other=None) -> dict:
+    """The velocity-pulse columns of ``pipeline run`` for one record or pair.
+
+    Returns ``pulse_like`` (bool), ``velocity_pulse_indicator`` (Shahi & Baker's PI),
+    ``velocity_tp_s`` (s), ``orientation_deg`` (from the first component towards the second; 0
+    for one component) and ``azimuth_deg`` (clockwise from north, 0..180, or None).  Raises
+    :class:`pulses.RecordError` for a pair that cannot be used.
+    """
+    from pulses import classify_pulse
+
+    row = result_row(classify_pulse(record, other))
+    return {k: row[k] for k in RUN_COLUMNS}
+
+
+NOT_PULSE_WARNING = "Eq. 31 assumes a pulse; the verified width does not"
+
+
+def classification_fields(record, other=None, pair_fields=None) -> tuple[dict, str | None]:
+    """The velocity-pulse columns of a row, and a warning (or None).
+
+    ``pair_fields`` (already computed for the pair, in the main process) are used as they are.
+    """
+    blank = dict.fromkeys(RUN_COLUMNS)
+    if pair_fields and "error" in pair_fields:  # the pair's classification failed: no direction
+        return blank, f"velocity-pulse classification of the pair failed: {pair_fields['error']}"
+    if pair_fields:
+        fields = dict(pair_fields)
+    else:
+        try:
+            fields = classify_fields(record, other)
+        except Exception as exc:  # an unusual record: designed all the same, and said so
+            return blank, f"velocity-pulse classification failed: {' '.join(str(exc).split())}"
+    return fields, (None if fields.get("pulse_like") else NOT_PULSE_WARNING)
+
+
+def pair_classification(first, second) -> dict:
+    """The pair's velocity-pulse fields; where the classification fails, ``{"error": reason}``:
+    the pair is then designed in its recorded components and every row says why."""
+    try:
+        return classify_fields(first, second)
+    except Exception as exc:
+        return {"error": " ".join(str(exc).split()) or type(exc).__name__}

@@ -1,0 +1,152 @@
+"""What one unit of work of ``pipeline run`` is: a :class:`Task` (a record, or a direction of a pair,
+with its :class:`Column` s and :class:`Options`), the records' ids, and the input list.
+
+Plain, picklable data: a task runs the same in this process, in a process pool or on a dask worker.
+"""
+from __future__ import annotations
+
+import glob
+import hashlib
+import os
+import pathlib
+import re
+from dataclasses import dataclass, field
+
+from .outfiles import RESERVED_IDS
+
+@dataclass(frozen=True)
+class Column:
+    """A column as it stands (``width`` set) or only a height to size (``width`` None)."""
+
+    height: float
+    width: float | None = None
+
+    @property
+    def label(self) -> str:
+        return f"{self.height:g}x{self.width:g}" if self.width is not None else f"{self.height:g}"
+
+    @property
+    def kind(self) -> str:
+        return "block" if self.width is not None else "height"
+
+
+@dataclass(frozen=True)
+class Options:
+    shapes: tuple | None = None
+    #: the pulse fit's least squares (``pulses.fit_pulse``'s ``weighting``)
+    weighting: str = "background"
+    units: str | None = None
+    dt: float | None = None
+    column: int | None = None
+    format: str | None = None
+    trace: str | None = None
+    plots: bool = True
+    #: a rocking frame's cap beam mass over the columns' (0: lone columns); see pipeline.site
+    cap_mass_ratio: float = 0.0
+    fragility: bool = False
+    up_to: float = 10.0
+    #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
+    vertical: str = "auto"
+
+
+@dataclass(frozen=True)
+class Task:
+    index: int
+    record_id: str
+    path: str
+    columns: tuple = ()
+    options: Options = field(default_factory=Options)
+    #: a direction of a pair (pipeline.site): the second file, the angle (deg) and why it was chosen
+    path2: str | None = None
+    direction: float | None = None
+    direction_kind: str = ""
+    pair: str = ""
+    scale: float = 1.0
+    pair_fields: tuple = ()
+    #: a record of a PEER download (pipeline.peer_inputs.PeerSource): where its files are read from
+    peer: object = None
+    #: the vertical component's file of a pair (pipeline.vertical: --triplet, --pairs auto)
+    vertical: str | None = None
+
+
+# -- record ids ------------------------------------------------------------------------------------
+#: longest record id (characters, all ASCII): ``<id>.csv`` and its temporary name stay far below the
+#: 255 bytes file systems allow, whatever the input's name
+MAX_ID_LENGTH = 96
+
+
+def record_ids(paths) -> list[str]:
+    """Unique, file-system-safe ids from the file names, in input order.
+
+    Characters other than ASCII letters, digits and ``._+-`` become ``_`` (a name's bytes need not
+    be UTF-8); an id never starts with ``.``, ``+`` or ``-``; a name longer than
+    :data:`MAX_ID_LENGTH` is cut and ends in a short hash of the whole name.
+    """
+    ids, seen = [], {}
+    for path in paths:
+        name = pathlib.PurePath(str(path)).name
+        stem = name.rsplit(".", 1)[0] if "." in name.lstrip(".") else name
+        stem = re.sub(r"[^A-Za-z0-9._+-]+", "_", stem)
+        stem = re.sub(r"^[._+-]+|[._]+$", "", stem) or "record"
+        if len(stem) > MAX_ID_LENGTH:
+            digest = hashlib.sha1(os.fsencode(name)).hexdigest()[:8]
+            stem = stem[:MAX_ID_LENGTH - 9].rstrip("._") + "-" + digest
+        if stem.lower() in RESERVED_IDS:
+            stem += "-record"
+        base, k = stem, 1
+        while stem.lower() in seen:
+            k += 1
+            stem = f"{base}-{k}"
+        seen[stem.lower()] = True
+        ids.append(stem)
+    return ids
+
+
+def make_tasks(paths, columns, options: Options) -> list[Task]:
+    """One task per file (no pairs): the tasks of a plain ``pipeline run``."""
+    ids = record_ids(paths)
+    return [Task(i, rid, str(path), tuple(columns), options) for i, (rid, path) in enumerate(zip(ids, paths))]
+
+
+# -- inputs ----------------------------------------------------------------------------------------
+def expand_inputs(items) -> list[str]:
+    """File arguments as given; folders give their entries (sorted; not hidden ones, not folders);
+    unexpanded wildcards are globbed.
+
+    A path that does not exist stays in the list: it is reported as a failed record, not an argument
+    error, so one missing file does not stop a batch.  So are a folder's entries that cannot be
+    read (a symbolic link to nothing, a loop of links, files of a folder without search
+    permission), and a folder that cannot be listed: each fails at reading, with the reason.
+    """
+    paths: list[str] = []
+    seen = set()
+
+    def add(p):
+        key = os.path.abspath(p)
+        if key not in seen:
+            seen.add(key)
+            paths.append(p)
+
+    for item in items:
+        item = str(item)
+        if os.path.isdir(item):
+            try:
+                names = sorted(os.listdir(item))
+            except OSError:  # a folder that cannot be read: a failed record, with the reason
+                add(item)
+                continue
+            for name in names:
+                full = os.path.join(item, name)
+                # every entry but hidden ones and folders: a broken link, a link loop or a file
+                # that cannot be looked at is a failed record with the reason, never skipped
+                if not name.startswith(".") and not os.path.isdir(full):
+                    add(full)
+        elif not os.path.exists(item) and glob.has_magic(item):
+            matches = sorted(glob.glob(item))
+            if not matches:
+                add(item)  # reported as not found
+            for m in matches:
+                add(m)
+        else:
+            add(item)
+    return paths

@@ -1,0 +1,64 @@
+"""One task in a worker: :func:`work` runs :func:`pipeline.batch.process_record` as a worker (this
+process, a pool's process or a dask worker) runs it, with the time it took and where.
+"""
+from __future__ import annotations
+
+import os
+
+from . import joblog
+from .batch import failure, process_record
+from .tasks import Task
+
+
+def init_worker() -> None:
+    """Set up a worker process: one solver thread (the processes share the CPUs; the solver's
+    batches then run on one thread, with the same runs and the same results)."""
+    global _in_worker
+    _in_worker = True
+    from rocking import lanes
+
+    lanes.set_threads(1)
+
+
+def _init_pool_worker(kill_at: str | None = None) -> None:
+    """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
+    the workers itself (a worker interrupted on its own would only print a traceback).
+    ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
+    the workers may have been started before it was set)."""
+    import signal
+
+    if kill_at is None:
+        os.environ.pop(TEST_KILL_ENV, None)
+    else:
+        os.environ[TEST_KILL_ENV] = kill_at
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    init_worker()
+
+
+#: test-only: a record id at which a worker process (never the main one) kills itself with SIGKILL,
+#: to test what a batch does when a worker dies; not for use
+TEST_KILL_ENV = "PIPELINE_TEST_KILL_WORKER_AT"
+
+_in_worker = False  # set in worker processes by init_worker
+
+
+def work(task: Task) -> dict:
+    """:func:`process_record` as a worker runs it."""
+    if _in_worker and os.environ.get(TEST_KILL_ENV) == task.record_id:
+        import signal
+
+        os.kill(os.getpid(), signal.SIGKILL)
+    import time
+
+    start = time.perf_counter()
+    res = process_record(task)
+    res[joblog.SECONDS] = time.perf_counter() - start
+    res[joblog.WORKER] = joblog.here()
+    return res
+
+
+def worker_failure(task: Task, exc: BaseException) -> dict:
+    """The result of a record whose worker process died (twice) while running it."""
+    return {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
+            "plot": None, "failure": failure(task, "worker", exc)}
