@@ -207,7 +207,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts
-    design = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
+    design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
@@ -259,9 +259,9 @@ def _progress_bar(n_todo: int, quiet: bool, progress: bool | None):
                 ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
 
 
-def _write_tables(outputs, out, tasks, header, text, failures, failed, options) -> list[dict]:
+def _write_tables(outputs, out, tasks, header, text, failures, failed, options):
     """Write the run's own files from every record's rows (``text``: summary.csv's rows as the records'
-    reports hold them, below ``header``); return the design rows."""
+    reports hold them, below ``header``); return the design rows and the rows of summary.csv."""
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
@@ -275,7 +275,7 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options) 
         outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
     outputs.finish()
-    return design
+    return design, rows
 
 
 # -- the answer in view: design.csv, report.html (pipeline.design_table, pipeline.html_report) --------

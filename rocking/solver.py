@@ -565,6 +565,21 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lane
     return out
 
 
+def _batch_vertical(excitation, vertical, model, method):
+    """``(vval, g_min, g_max)`` of a batch's vertical record (``av/g`` on the record's samples and
+    the extremes of ``1 + av/g``), checked; None when the vertical is zero."""
+    if not isinstance(excitation, Record) or not isinstance(vertical, Record):
+        raise RockingInputError("simulate_many: a vertical record goes with a horizontal "
+                                "pulses.Record")
+    if model != "fast" or method != "taylor":
+        raise RockingInputError("simulate_many: with a vertical record the model is 'fast' "
+                                "with Taylor steps")
+    vval = engine.as_input(check_axes(excitation, vertical).acc)
+    _, g_min, g_max, zero, _ = engine.vertical_bounds(excitation.acc, vval, 1.0 / G, 1.0 / G,
+                                                      0.0, excitation.npts)
+    return None if zero else (vval, g_min, g_max)
+
+
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor",
                   threads: int | None = None, lanes: bool = True,
@@ -606,20 +621,13 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         raise ValueError("simulate_many supports model='fast' or 'linear'")
     vval = None
     if vertical is not None:
-        if not isinstance(excitation, Record) or not isinstance(vertical, Record):
-            raise RockingInputError("simulate_many: a vertical record goes with a horizontal "
-                                    "pulses.Record")
-        if model != "fast" or method != "taylor":
-            raise RockingInputError("simulate_many: with a vertical record the model is 'fast' "
-                                    "with Taylor steps")
-        vval = engine.as_input(check_axes(excitation, vertical).acc)
-        _, g_min, g_max, zero, _ = engine.vertical_bounds(excitation.acc, vval, 1.0 / G, 1.0 / G,
-                                                          0.0, excitation.npts)
-        if zero:
+        bounds = _batch_vertical(excitation, vertical, model, method)
+        if bounds is None:  # a zero vertical is no vertical
             out = simulate_many(blocks, excitation, scales, grid=grid, model=model,
                                 method=method, threads=threads, lanes=lanes)
             none = np.zeros(out.overturned.shape, dtype=bool)
             return dataclasses.replace(out, lifts_off=none, t_lift_off=np.full(none.shape, np.nan))
+        vval, g_min, g_max = bounds
     linear = model == "linear"
     blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
     p = np.array([b.p for b in blocks], dtype=float)

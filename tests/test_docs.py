@@ -27,7 +27,10 @@ def test_readme_is_a_first_page():
     # the two commands come first, right after the title, exactly as CI and users run them
     blocks = re.findall(r"^```bash\n(.*?)^```", text, re.S | re.M)
     assert blocks[0].split("#")[0].strip() == "pip install . && pipeline demo"
-    assert blocks[1].split("#")[0].strip() == 'pip install ".[test]" && python -m pytest'
+    test_command = blocks[1].split("#")[0].strip()
+    assert test_command == 'pip install -e ".[test]" && python -m pytest'
+    # CI runs the README's test command verbatim
+    assert test_command in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
     assert text.index(blocks[1]) < text.index("\n## ")
     # every relative link points at a file of the repository
     for target in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", text):
