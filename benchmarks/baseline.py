@@ -3,7 +3,7 @@
 This is how rocking blocks are commonly solved in Python scripts and the yardstick of issue 2's
 speed target ("at least 1000x faster and 1000x more accurate than the usual approach"):
 
-- the full nonlinear Eq. 3 of SPEC section 2 in ``solve_ivp`` (RK45 by default, default tolerances
+- the full nonlinear Eq. 3 of docs/theory.md section 2 in ``solve_ivp`` (RK45 by default, default tolerances
   ``rtol=1e-3, atol=1e-6``), ``max_step`` equal to the record's time step so that no sample is
   stepped over (for an analytic pulse: ``Tp / 200``);
 - the ground acceleration read linearly between samples (the same forcing every model sees);

@@ -4,7 +4,7 @@
     python benchmarks/bench_fragility.py --brute    # also a 1000-factor brute scan per case
 
 For every PEER record at the top of ../shared/records/raw (or $ROCKING_RECORDS) and two columns
-(the 7.5 x 1.8 m column of SPEC section 1 and a slender 2.5 x 0.5 m one) plus the 7.5 x 1.8 m
+(the 7.5 x 1.8 m column of docs/theory.md section 1 and a slender 2.5 x 0.5 m one) plus the 7.5 x 1.8 m
 columns as a frame with a beam twice their mass (``cap_mass_ratio=2``), it times
 ``critical_scale(block, record, up_to=10)`` (default settings, the compiled solver warmed up
 first), prints the time and solver runs per record (median, min, max), and the lognormal fit

@@ -4,7 +4,7 @@ Run from anywhere: ``python data/make_examples.py`` (or ``python -m pipeline.dat
 It rewrites the ``*.sac`` files and ``examples.csv`` beside this script, deterministically (fixed
 seeds), so the committed files can be checked by regenerating them.
 
-Every record is a pulse of one of the paper's shapes (SPEC section 3) added to band-limited
+Every record is a pulse of one of the paper's shapes (docs/theory.md section 3) added to band-limited
 broadband motion (filtered Gaussian noise under a rise-plateau-decay envelope), plus one record
 with broadband motion only (no pulse), as a control.  They are 25 s long at 100 Hz (2500 samples,
 about 10 kB each), written as SAC with ``idep = iacc`` and the samples in nm/s^2, as the SAC

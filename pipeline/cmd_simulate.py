@@ -20,7 +20,7 @@ from .args import (ArgumentError, parse_scale, ShapeNames, add_record_options, p
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "simulate", help="rocking response of one column to a pulse or a record",
-        description="Solve Housner's rocking block (SPEC section 2) under a pulse or a full record "
+        description="Solve Housner's rocking block (docs/theory.md section 2) under a pulse or a full record "
                     "and report overturning, max|theta|/alpha, impacts and the model that answered.")
     p.add_argument("--block", required=True, help="HEIGHTxWIDTH in m, e.g. 7.5x1.8")
     source = p.add_mutually_exclusive_group(required=True)

@@ -46,7 +46,7 @@ SITE_COLUMNS = Columns(
                    "otherwise). Every other column describes the scaled record."),
     ("cap_mass_ratio", "-", "Mass of the cap beam over the columns' total mass (`--cap-mass-ratio`): "
                             "0 for a lone column, above 0 for a rocking frame of such columns "
-                            "(SPEC section 8: the frame's p and restitution are used throughout)."),
+                            "(docs/theory.md section 8: the frame's p and restitution are used throughout)."),
     ("pulse_like", "-", "The record (for a pair: the pair) is pulse-like by Shahi & Baker's (2014) "
                         "velocity-pulse classification (`pulses.classify_pulse`). When it is not, "
                         "`warnings` notes that Eq. 31 assumes a pulse."),

@@ -10,12 +10,12 @@ amplitude of a pulse placed at ``tau`` is ``c / ||w||^2`` and the share of the r
 explains is ``c^2 / (||w||^2 ||x||^2)``: the best match maximises that share.
 
 The two Ricker shapes are PyWavelets' ``mexh`` (second derivative of a Gaussian) and ``gaus3``
-(third derivative) at scale ``s``.  Their Tp follows from SPEC section 3, not from pywt's rounded
+(third derivative) at scale ``s``.  Their Tp follows from docs/theory.md section 3, not from pywt's rounded
 ``central_frequency`` (0.25 and 0.4):
 
 - ``mexh``: ``psi(x) ~ (1 - x^2) exp(-x^2/2)``, ``x = t/s``; Eq. 7 is the same curve with
   ``x = sqrt(2) pi t / Tp``, so ``Tp = sqrt(2) pi s``.  Its Fourier amplitude
-  ``~ f^2 exp(-Tp^2 f^2)`` peaks at ``f = 1/Tp``, as SPEC requires (centre frequency
+  ``~ f^2 exp(-Tp^2 f^2)`` peaks at ``f = 1/Tp``, as docs/theory.md section 3 requires (centre frequency
   ``1/(sqrt(2) pi) = 0.2251``, not 0.25: pywt's value gives Tp 10 % too low).
 - ``gaus3``: ``psi(u) ~ d^3/du^3 exp(-u^2)``, ``u = t/s``; Eq. 8 is the same curve with
   ``u = x/sqrt(2) = 2 pi t / (sqrt(6) Tp)``, so ``Tp = 2 pi s / sqrt(6)``.  Its Fourier amplitude
@@ -36,9 +36,9 @@ from scipy import fft as sfft
 
 from .shapes import SHAPES, AntisymmetricRicker, SymmetricRicker, shape_class
 
-#: Tp = MEXH_TP_PER_SCALE * s for PyWavelets' ``mexh`` at scale s (SPEC section 3)
+#: Tp = MEXH_TP_PER_SCALE * s for PyWavelets' ``mexh`` at scale s (docs/theory.md section 3)
 MEXH_TP_PER_SCALE = SymmetricRicker.pywt[1]
-#: Tp = GAUS3_TP_PER_SCALE * s for PyWavelets' ``gaus3`` at scale s (SPEC section 3)
+#: Tp = GAUS3_TP_PER_SCALE * s for PyWavelets' ``gaus3`` at scale s (docs/theory.md section 3)
 GAUS3_TP_PER_SCALE = AntisymmetricRicker.pywt[1]
 #: PyWavelets wavelet of each shape that has one, and its Tp per unit scale
 PYWT_WAVELETS = {name: cls.pywt for name, cls in SHAPES.items() if cls.pywt is not None}

@@ -1,4 +1,4 @@
-"""Fitting acceleration pulses to a record (SPEC section 3; Vassiliou & Makris 2011).
+"""Fitting acceleration pulses to a record (docs/theory.md section 3; Vassiliou & Makris 2011).
 
 For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ricker):
 

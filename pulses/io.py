@@ -15,7 +15,7 @@ it and applies the checks every record gets.  Formats (``format=``):
     ``stats.calib``; the reader multiplies by it and removes the mean (the K-NET convention), so
     the units are stated (m/s^2).  Formats that state no units (MiniSEED, ...) need ``units``.
 
-Units are never guessed (SPEC section 7).  A peak below 1e-5 g or above 10 g makes the units
+Units are never guessed (docs/theory.md section 7).  A peak below 1e-5 g or above 10 g makes the units
 implausible and is refused, naming the units that would make it plausible; a peak above 5 g is
 kept with a warning in ``record.metadata["warnings"]``.
 """

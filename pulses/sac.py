@@ -2,7 +2,7 @@
 a record as SAC.
 
 By the SAC standard the dependent-variable code ``idep`` gives the quantity *and* its units:
-``iacc`` means nm/s^2, ``ivel`` nm/s, ``idisp`` nm (SPEC section 7).  Many files in the wild
+``iacc`` means nm/s^2, ``ivel`` nm/s, ``idisp`` nm (docs/theory.md section 7).  Many files in the wild
 hold m/s^2, cm/s^2 or g under ``iacc``; :func:`pulses.read_record` honours the standard unless
 the user passes units, and refuses a peak that would then be implausible.
 """

@@ -1,4 +1,4 @@
-"""Acceleration pulse shapes of Makris & Vassiliou (2012), Eqs. 7-9 (SPEC section 3).
+"""Acceleration pulse shapes of Makris & Vassiliou (2012), Eqs. 7-9 (docs/theory.md section 3).
 
 Every shape is ``Shape(ap, tp, t0=0.0)``: amplitude ``ap`` in m/s^2 (a negative ``ap``
 flips the polarity), period ``tp`` in s and time shift ``t0`` in s.  For the rectangular and

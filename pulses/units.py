@@ -1,4 +1,4 @@
-"""Units of ground acceleration accepted for records (SPEC section 7).
+"""Units of ground acceleration accepted for records (docs/theory.md section 7).
 
 Acceleration is carried in m/s^2 inside the package.  A record's units come from its header where
 the format states them and from the user otherwise; they are never guessed.

@@ -1,4 +1,4 @@
-"""The free-standing rigid rectangular block of Housner's model (SPEC section 1)."""
+"""The free-standing rigid rectangular block of Housner's model (docs/theory.md section 1)."""
 from __future__ import annotations
 
 import math
@@ -36,7 +36,7 @@ class Block:
     height, width : float, optional
         Full dimensions in m, when known (set by :meth:`from_dimensions`).
     cap_mass_ratio : float, optional
-        A rocking frame (SPEC section 8): columns capped by a free beam of ``cap_mass_ratio``
+        A rocking frame (docs/theory.md section 8): columns capped by a free beam of ``cap_mass_ratio``
         times their total mass.  ``p`` is then the frame's (see :meth:`from_dimensions`); 0 (the
         default) is the lone column.  Not part of equality: blocks with the same ``p``,
         ``alpha`` and ``eta`` rock alike.
@@ -73,7 +73,7 @@ class Block:
         """Block of full ``height`` and ``width`` (m): ``R = sqrt(h^2 + b^2)``, ``p = sqrt(3g/4R)``.
 
         With ``cap_mass_ratio = gamma > 0``: a rocking frame of such columns capped by a free beam
-        of ``gamma`` times their total mass (SPEC section 8), ``p`` multiplied by
+        of ``gamma`` times their total mass (docs/theory.md section 8), ``p`` multiplied by
         ``sqrt((1 + 2 gamma)/(1 + 3 gamma))`` and ``eta`` defaulting to the frame's.
         """
         gamma = check_cap_mass_ratio(cap_mass_ratio)

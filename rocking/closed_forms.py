@@ -1,4 +1,4 @@
-"""Closed-form design rules (SPEC section 5): Eq. 31, Eq. 20 and the envelope rule.
+"""Closed-form design rules (docs/theory.md section 5): Eq. 31, Eq. 20 and the envelope rule.
 
 Each gives the minimum ``tan(alpha)`` of a block of frequency parameter ``p`` under a pulse of
 amplitude ``ap`` (m/s^2) and period ``Tp`` (s), with no time-history analysis.

@@ -1,4 +1,4 @@
-"""Design of free-standing rocking columns (SPEC section 5; Makris & Vassiliou 2012, Section 5).
+"""Design of free-standing rocking columns (docs/theory.md section 5; Makris & Vassiliou 2012, Section 5).
 
 One module per idea, gathered here:
 

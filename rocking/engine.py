@@ -1,4 +1,4 @@
-"""Compiled event-driven engine for the rocking block (SPEC section 2).
+"""Compiled event-driven engine for the rocking block (docs/theory.md section 2).
 
 One routine, :func:`run`, integrates Eq. 3 over a grid of nodes (record samples, or pulse
 breakpoints and extrema subdivided into equal steps) and handles everything between:
@@ -25,7 +25,7 @@ breakpoints and extrema subdivided into equal steps) and handles everything betw
   on would take ever shorter hops down to rounding, millions of them);
 * **peaks**: ``max|theta|`` includes the extremum of the Hermite interpolant inside each step;
 * **overturning**: ``|theta|`` reaching ``pi/2``;
-* **end of the excitation**: the energy rule of SPEC section 2 decides overturning exactly and
+* **end of the excitation**: the energy rule of docs/theory.md section 2 decides overturning exactly and
   gives the next peak, without further integration (:func:`energy_verdict`).
 
 All angles in rad, times in s, accelerations as ``ug''/g`` (dimensionless).
@@ -162,7 +162,7 @@ def vertical_bounds(uval, vval, amp, vamp, tan_alpha, n):
 
 
 def energy_verdict(theta, omega, p, alpha, eta, linear):
-    """Decide overturning after the excitation ends (SPEC section 2), exactly.
+    """Decide overturning after the excitation ends (docs/theory.md section 2), exactly.
 
     Returns ``(overturns, next_peak)``; ``next_peak`` is the largest ``|theta|`` of the free
     motion that follows (``pi/2`` if it overturns).

@@ -1,4 +1,4 @@
-"""Rocking frames: identical free-standing columns capped by a free rigid beam (SPEC section 8).
+"""Rocking frames: identical free-standing columns capped by a free rigid beam (docs/theory.md section 8).
 
 ``N`` columns (each ``R``, ``alpha``, ``p``) carry a rigid beam of mass ``m_b`` that rests on them
 without connection (Makris & Vassiliou 2013).  With ``gamma = m_b / (N m)`` (the beam's mass over

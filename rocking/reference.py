@@ -6,7 +6,7 @@ the uplift search sees a monotonic forcing, its extrema).  Impacts (``theta = 0`
 (``omega = 0``) and overturning (``|theta| = pi/2``) are events located by scipy's root finder on
 the DOP853 dense output; uplift times are roots of the forcing itself.  The rules of the model
 (uplift, impact, Zeno accumulation, energy verdict after the excitation) are those of
-SPEC section 2, written here a second time in plain Python, independently of the compiled engine.
+docs/theory.md section 2, written here a second time in plain Python, independently of the compiled engine.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The exact searches over pulses (SPEC section 5): minimum slenderness (the paper's Fig. 8) and
+"""The exact searches over pulses (docs/theory.md section 5): minimum slenderness (the paper's Fig. 8) and
 the amplitude intervals of overturning with their safe islands (Fig. 5, one column), by
 time-history analysis with the batch solver (:mod:`rocking.search`)."""
 from __future__ import annotations
@@ -73,7 +73,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
                           settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0):
     """Exact minimum slenderness for many ``(pTp, ap/g)`` points of one pulse shape at once.
 
-    By the similarity law (SPEC section 4) the answer depends only on ``pTp`` and ``ap/g``, so
+    By the similarity law (docs/theory.md section 4) the answer depends only on ``pTp`` and ``ap/g``, so
     every point is solved with ``Tp = 1 s`` and ``p = pTp``; all scans share one batch-solver call
     and all brackets are refined together.  Returns a list of :class:`MinSlenderness`.
 
@@ -123,7 +123,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
 
 def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None, rtol=None,
                     model="fast", settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0):
-    """Exact minimum slenderness (SPEC section 5, the paper's Fig. 8).
+    """Exact minimum slenderness (docs/theory.md section 5, the paper's Fig. 8).
 
     The smallest ``tan(alpha)`` for which a block of frequency parameter ``p`` survives
     ``pulse`` at that slenderness and at every larger one.  ``tan(alpha)`` is scanned on
@@ -151,7 +151,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     settings : rocking.search.SearchSettings
         Scan settings (default :data:`rocking.search.DEFAULT_SETTINGS`).
     cap_mass_ratio : float
-        A rocking frame (SPEC section 8): ``p`` is then the frame's (``block.p``) and ``eta`` the
+        A rocking frame (docs/theory.md section 8): ``p`` is then the frame's (``block.p``) and ``eta`` the
         frame's at each slenderness; 0, the lone column.
 
     Returns

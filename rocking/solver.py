@@ -1,6 +1,6 @@
 """``simulate`` and ``simulate_many``: the rocking response of a block to a pulse or a record.
 
-Model only what the case needs (SPEC section 2):
+Model only what the case needs (docs/theory.md section 2):
 
 * ``"rest"``: the ground acceleration never reaches ``g tan(alpha)``; the block never uplifts and
   nothing is integrated;

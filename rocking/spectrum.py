@@ -1,6 +1,6 @@
 """Overturning spectra (the paper's Fig. 5) and the minimum-slenderness chart (Fig. 8).
 
-Both use the similarity law (SPEC section 4): the response depends only on ``omega_p/p``,
+Both use the similarity law (docs/theory.md section 4): the response depends only on ``omega_p/p``,
 ``tan(alpha)`` and ``ap/g``.  A spectrum is therefore one batch-solver call on a grid of
 blocks (one ``p`` per ``omega_p/p``, with a unit pulse of period 1 s) times amplitude scales.
 """

@@ -1,4 +1,4 @@
-"""Sizing a column of given height (SPEC section 5): the width it needs by a closed-form rule
+"""Sizing a column of given height (docs/theory.md section 5): the width it needs by a closed-form rule
 (solved as a fixed point in the width, since ``p`` depends on it) or by time-history analysis
 (the *verified width*, under a pulse or a whole record)."""
 from __future__ import annotations
@@ -120,7 +120,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         Settings of the exact searches (default :data:`rocking.search.DEFAULT_SETTINGS`).
     cap_mass_ratio : float
         The width of the columns of a rocking frame whose beam has this mass over the columns'
-        total mass (SPEC section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
+        total mass (docs/theory.md section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""Design (SPEC section 5): Eq. 31/20, exact minimum slenderness, safe islands, sizing.
+"""Design (docs/theory.md section 5): Eq. 31/20, exact minimum slenderness, safe islands, sizing.
 
 Every exact answer is checked against something independent of the code under test: the paper's
 printed numbers, closed-form quadrature of the rectangular pulse's energy integral, the
@@ -31,7 +31,7 @@ def test_eq31_paper_values():
     # The paper prints three decimals, so agreement to half a unit in the third decimal.
     assert rocking.eq31(0.71 * G, 0.8, 1.381) == pytest.approx(0.373, abs=5e-4)
     # Aegion (0.5 g, 0.5 s) gives 0.204; the paper's 0.166 is 0.5 x 0.5/1.5, i.e. pTp = 0.5
-    # (SPEC section 8): reproduce both to show where the mistake lies.
+    # (docs/theory.md section 8): reproduce both to show where the mistake lies.
     assert rocking.eq31(0.5 * G, 0.5, 1.381) == pytest.approx(0.204, abs=5e-4)
     assert rocking.eq31(0.5 * G, 0.5, 1.0) == pytest.approx(0.5 * 0.5 / 1.5, rel=1e-12)
     # the Temple block itself: p from its dimensions
@@ -108,7 +108,7 @@ def _rect_min_tan(ptp, apg):
     Under the constant push a = ap/g the block (phi = -theta >= 0) obeys
     phi'^2 / 2 = p^2 [a (sin a - sin(a - phi)) - (cos(a - phi) - cos a)], it rotates
     monotonically, and after the pulse it overturns iff a (sin alpha - sin(alpha - phi1)) >
-    1 - cos alpha (energy rule, SPEC section 2).  So it overturns iff the time to reach
+    1 - cos alpha (energy rule, docs/theory.md section 2).  So it overturns iff the time to reach
     phi* = alpha - asin(sin alpha - (1 - cos alpha)/a), a quadrature, is below Tp.
     """
     p, tp = ptp, 1.0

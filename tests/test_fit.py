@@ -37,7 +37,7 @@ TPS = (0.2, 0.5, 1.0, 2.0, 5.0)
 DT = 0.005
 
 
-# -- scale to Tp (SPEC section 3) -----------------------------------------------------------------
+# -- scale to Tp (docs/theory.md section 3) -----------------------------------------------------------------
 def _fourier_peak_period(shape, tp=1.0):
     """Period (s) at which the Fourier amplitude of the densely sampled pulse peaks."""
     dt = tp / 2000.0
@@ -53,7 +53,7 @@ def _fourier_peak_period(shape, tp=1.0):
 
 @pytest.mark.parametrize("shape", ["ricker-sym", "ricker-anti"])
 def test_ricker_fourier_amplitude_peaks_at_tp(shape):
-    # SPEC section 3 defines Tp of the Rickers as the period of the Fourier-amplitude peak;
+    # docs/theory.md section 3 defines Tp of the Rickers as the period of the Fourier-amplitude peak;
     # the FFT of the pulse (80 Tp window, parabolic peak) finds it to better than 1e-4
     assert _fourier_peak_period(shape, 1.3) == pytest.approx(1.3, rel=1e-4)
 

@@ -14,7 +14,7 @@ from rocking import Block
 
 from .conftest import shared_record
 
-#: three real records; the 7.5 x 1.8 m column (SPEC section 1) overturns under each between 0.9
+#: three real records; the 7.5 x 1.8 m column (docs/theory.md section 1) overturns under each between 0.9
 #: and 1.4 times the record, with safe islands above
 RECORDS = ["Rinaldi228.AT2", "RSN77_SFERN_PUL164.AT2", "RSN181_IMPVALL.H_H-E06230.AT2"]
 

@@ -1,6 +1,6 @@
-"""Rocking frames (SPEC section 8): columns capped by a free rigid beam.
+"""Rocking frames (docs/theory.md section 8): columns capped by a free rigid beam.
 
-SPEC's ``p_frame`` and ``eta_frame`` are checked against a direct two-body computation that does not
+The theory's ``p_frame`` and ``eta_frame`` are checked against a direct two-body computation that does not
 use their lumped forms: the columns and the beam are written out from their coordinates (corners
 rotated about the pivots, the beam translated with the column tops), Lagrange's equation is formed
 from the bodies' kinetic and potential energies by numerical differentiation, and the impact from
@@ -19,7 +19,7 @@ from pulses import G, make_pulse
 from rocking import Block
 from rocking.frame import eta_frame, equivalent_size, frame_p
 
-H, B = 7.5, 1.8                       # column of SPEC section 1 (Temple of Apollo)
+H, B = 7.5, 1.8                       # column of docs/theory.md section 1 (Temple of Apollo)
 #: complex step: d/dx f(x) = Im f(x + i h) / h, exact to rounding (no difference is taken)
 CSTEP = 1e-30
 
@@ -250,6 +250,6 @@ def test_from_tan_alpha_keeps_a_frame():
     from rocking.frame import eta_frame
 
     frame = rocking.Block.from_tan_alpha(1.2, 0.2, cap_mass_ratio=2.0)
-    # the frame's restitution (SPEC section 8), not the lone column's Eq. 5
+    # the frame's restitution (docs/theory.md section 8), not the lone column's Eq. 5
     assert frame.eta == eta_frame(math.atan(0.2), 2.0) < rocking.eta_housner(math.atan(0.2))
     assert rocking.Block.from_tan_alpha(1.2, 0.2) == rocking.Block(1.2, math.atan(0.2))

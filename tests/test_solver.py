@@ -1,6 +1,6 @@
 """The rocking solver against independent references: analytic solutions (Eq. 23, Housner's
 linearised free rocking), quadrature of the energy integral, the DOP853 reference model, and the
-exact symmetries of the equation (polarity, similarity of SPEC section 4)."""
+exact symmetries of the equation (polarity, similarity of docs/theory.md section 4)."""
 from __future__ import annotations
 
 import math
@@ -22,7 +22,7 @@ TEMPLE = Block.from_dimensions(7.5, 1.8)
 
 
 def test_block_geometry_matches_spec_table():
-    # SPEC section 1, Temple of Apollo column: R = 3.856 m, p = 1.381 rad/s, alpha = 13.5 deg,
+    # docs/theory.md section 1, Temple of Apollo column: R = 3.856 m, p = 1.381 rad/s, alpha = 13.5 deg,
     # eta = 0.918 (values printed to 3-4 digits, so compare to that many)
     assert TEMPLE.R == pytest.approx(3.856, abs=5e-4)
     assert TEMPLE.p == pytest.approx(1.381, abs=5e-4)
@@ -57,7 +57,7 @@ def test_eq23_verge_velocity(tan_alpha, model):
 
 # ----------------------------------------------------------------------------- free rocking
 def _energy(block, theta, omega):
-    """Energy over m g R (SPEC section 2)."""
+    """Energy over m g R (docs/theory.md section 2)."""
     return omega**2 / (2 * block.p**2) + np.cos(block.alpha - np.abs(theta)) - math.cos(block.alpha)
 
 
@@ -154,8 +154,8 @@ def test_uplift_at_the_threshold_takes_no_vanishing_hops():
     # three samples of a synthetic record where the forcing crosses g tan(alpha) (the samples are
     # 0.71, 1.0001 and 1.064 of it): the block grazes theta = 0 at the uplift; the engine
     # once hopped there with ever smaller hops at a standstill in time (999,999 impacts, stopped by
-    # the guard) instead of resting until the forcing passes the threshold (SPEC: "never loop
-    # forever or take vanishing steps")
+    # the guard) instead of resting until the forcing passes the threshold (docs/theory.md
+    # section 2: a solver never "takes vanishing steps or loops forever")
     rec = Record(np.array([-0.5472045440000001, -0.775768, -0.825751232]), 0.01, t_start=2.19)
     block = Block.from_dimensions(7.5, 0.5930384878284735)
     fast = simulate(block, rec)
@@ -188,7 +188,7 @@ def test_polarity_flips_rotation_exactly(shape):
 
 @pytest.mark.parametrize("shape", SHAPES)
 def test_similarity_law(shape):
-    # same omega_p/p, tan(alpha) and ap/g (SPEC section 4): identical theta(t/Tp)
+    # same omega_p/p, tan(alpha) and ap/g (docs/theory.md section 4): identical theta(t/Tp)
     b1, b2 = Block.from_tan_alpha(1.2, 0.2), Block.from_tan_alpha(3.0, 0.2)
     tp1 = 1.1
     tp2 = tp1 * b1.p / b2.p

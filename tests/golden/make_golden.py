@@ -34,7 +34,7 @@ RECORDS = HERE.parents[2] / "shared" / "records" / "raw"
 REAL = ["Rinaldi228.AT2", "NGA_no_1063_RRS228.AT2", "RSN77_SFERN_PUL164.AT2",
         "RSN181_IMPVALL.H_H-E06230.AT2", "RSN1084_NORTHR_SCS052.AT2", "RSN6_IMPVALL.I_I-ELC180.AT2"]
 COLUMN = (7.5, 1.8)
-TEMPLE = (9.0, 1.8)  # height, width of an ancient column (SPEC section 1's p = 1.381 rad/s-ish)
+TEMPLE = (9.0, 1.8)  # height, width of an ancient column (docs/theory.md section 1's p = 1.381 rad/s-ish)
 #: history points kept per single run (evenly spaced indices of the history)
 N_HISTORY = 24
 
