@@ -28,8 +28,9 @@ cdef extern from *:
 cdef double HALF_PI = 0.5 * PI
 cdef double TWO_PI = 2.0 * PI
 cdef double SQRT3 = sqrt(3.0)
-cdef double BETA = fabs((3.0 - sqrt(6.0) - 3.0) * sqrt(3.0 - sqrt(6.0))
-                        * exp(-(3.0 - sqrt(6.0)) / 2.0))
+# the antisymmetric Ricker's peak factor, defined once with the shape (pulses.shapes.BETA)
+from pulses.shapes import BETA as _SHAPE_BETA
+cdef double BETA = _SHAPE_BETA
 
 # forcing kinds (rocking.engine.KINDS), stepping methods (rocking.engine.METHODS), statuses
 cdef enum:
@@ -39,6 +40,10 @@ cdef enum:
     SINE = 2
     RICKER_SYM = 3
     RICKER_ANTI = 4
+#: the pulse codes the steps are compiled for, in the order rect, sine, ricker-sym, ricker-anti
+#: (rocking.engine checks them against the shapes' own codes, pulses.shapes, at import)
+KIND_CODES = (RECT, SINE, RICKER_SYM, RICKER_ANTI)
+
 cdef enum:
     TAYLOR = 0
     RK8 = 1

@@ -42,17 +42,22 @@ from collections import namedtuple
 
 import numpy as np
 
+from pulses.shapes import SHAPES, AntisymmetricRicker, OneSine, Rectangular, SymmetricRicker
+
 from . import _core
 
 HALF_PI = 0.5 * math.pi
 
-# forcing kinds (match pulses.*.kind); FREE = no ground motion
+# forcing kinds: a pulse's code is defined with its shape (pulses.shapes); FREE = no ground motion
 FREE = -1
 NODAL = 0  # piecewise linear between node values (records; sampled pulses for the linear model)
-RECT, SINE, RICKER_SYM, RICKER_ANTI = 1, 2, 3, 4
+RECT, SINE, RICKER_SYM, RICKER_ANTI = (Rectangular.kind, OneSine.kind, SymmetricRicker.kind,
+                                       AntisymmetricRicker.kind)
 #: the forcing kinds the engine computes, with their names
-KINDS = {FREE: "free", NODAL: "nodal", RECT: "rect", SINE: "sine", RICKER_SYM: "ricker-sym",
-         RICKER_ANTI: "ricker-anti"}
+KINDS = {FREE: "free", NODAL: "nodal", **{cls.kind: cls.shape for cls in SHAPES.values()}}
+if _core.KIND_CODES != (RECT, SINE, RICKER_SYM, RICKER_ANTI):  # a shape's code changed, not the core
+    raise ImportError(f"rocking._core was compiled for pulse codes {_core.KIND_CODES}, the shapes "
+                      f"have {(RECT, SINE, RICKER_SYM, RICKER_ANTI)}: rebuild the package")
 
 # stepping methods of the nonlinear equation
 TAYLOR, RK8, RK4 = 0, 1, 2
