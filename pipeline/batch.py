@@ -511,7 +511,7 @@ def _process(task: Task):
         row.update(_verified_fields(col, verified_cache[H]))
         row.update(_check_fields(verified_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, H, gamma))
         rows.append(row)
 
     return rows, (record, fit, fitting, histories), verified_cache

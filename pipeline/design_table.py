@@ -207,8 +207,18 @@ def table_text(rows, failures=(), summary=()) -> str:
     headers = HEADERS
     body = [table_cells(r) for r in rows]
     if any(r.get("survives_vertical") is not None for r in rows):
+        # the verdict with the vertical, and the verified width with it (the widest over a pair's
+        # directions, from summary.csv's rows) beside the horizontal one
+        widths = {}
+        for r in summary:
+            key = (r.get("pair") or r.get("record"), r.get("column"))
+            w = _num(r.get("vertical_verified_width_m"))
+            if w is not None:
+                widths[key] = max(w, widths.get(key, w))
         headers = HEADERS + (VERTICAL_HEADER,)
-        body = [c + (_vertical_text(r),) for c, r in zip(body, rows)]
+        body = [c + (_vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
+                                          if (r["record"], r.get("column")) in widths else ""),)
+                for c, r in zip(body, rows)]
     widths = [max([len(h)] + [len(c[i]) for c in body]) for i, h in enumerate(headers)]
     right = {4, 5, 6}  # widths, aligned on the decimal point
 

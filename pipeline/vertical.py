@@ -34,6 +34,12 @@ VERTICAL_COLUMNS = Columns(
                                 "which the rocking model does not describe; the response with the "
                                 "vertical stops there and its verdict is not a verdict."),
     ("vertical_t_lift_off_s", "s", "First time of g + av < 0 (blank when it never happens)."),
+    ("vertical_verified_width_m", "m", "Verified width with the vertical (`rocking.required_width`, "
+                                       "rule exact, `vertical=`): the smallest width surviving the "
+                                       "horizontal motion of this row together with the vertical, at "
+                                       "that width and every larger one scanned; compare "
+                                       "`verified_width_m` (horizontal alone). Blank where the vertical "
+                                       "reaches -g (the block would leave the ground)."),
     ("vertical_model", "-", "Model that answered with the vertical: `fast-vertical` (the compiled "
                             "engine, `rocking.simulate(..., vertical=)`; `rest` if the column never "
                             "uplifts)."),
@@ -133,8 +139,9 @@ def scaled(task, up):
     return up.scaled(task.scale) if (up is not None and task.scale != 1.0) else up
 
 
-def fields(block, record, up, shown_file) -> dict:
-    """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical)."""
+def fields(block, record, up, shown_file, height=None, cap_mass_ratio=0.0) -> dict:
+    """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical); ``height`` (m) of the
+    column whose verified width with the vertical is computed (None: not computed)."""
     import numpy as np
 
     import rocking
@@ -147,7 +154,10 @@ def fields(block, record, up, shown_file) -> dict:
               "vertical_pga_g": float(np.max(np.abs(up.acc))) / G,
               "vertical_min_effective_gravity": float(np.min(1.0 + up.acc / G)),
               "vertical_overturns": None, "vertical_max_theta_ratio": None, "vertical_lifts_off": None,
-              "vertical_t_lift_off_s": None, "vertical_model": None}
+              "vertical_t_lift_off_s": None, "vertical_model": None, "vertical_verified_width_m": None}
+    if height is not None and values["vertical_min_effective_gravity"] > 0.0:
+        values["vertical_verified_width_m"] = float(rocking.required_width(
+            height, record, rule="exact", vertical=up, cap_mass_ratio=cap_mass_ratio).width)
     if block is not None:
         res = rocking.simulate(block, record, vertical=up, history=False)
         values.update(vertical_overturns=bool(res.overturned), vertical_max_theta_ratio=float(res.max_rotation_ratio),

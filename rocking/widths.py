@@ -85,7 +85,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
                    shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
-                   settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0):
+                   settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -121,6 +121,12 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     cap_mass_ratio : float
         The width of the columns of a rocking frame whose beam has this mass over the columns'
         total mass (docs/theory.md section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
+    vertical : pulses.Record, optional
+        ``rule="exact"`` under a record: its upward vertical acceleration on the same time axis
+        (docs/theory.md section 10); every run of the search and of the check above it is the
+        compiled engine with the vertical, and the no-uplift width is ``H max|ag|/(g + av)``.  A
+        vertical that reaches -g (the block would leave the ground, which the model does not
+        describe) is refused.
 
     Returns
     -------
@@ -135,7 +141,10 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     gamma = check_cap_mass_ratio(cap_mass_ratio)
     if rule == "exact":
         return _exact_width(height, excitation, criterion=criterion, eta=eta, n_scan=n_scan,
-                            rtol=rtol, model=model, n_zone=n_zone, settings=settings, gamma=gamma)
+                            rtol=rtol, model=model, n_zone=n_zone, settings=settings, gamma=gamma,
+                            vertical=vertical)
+    if vertical is not None:
+        raise ValueError("a vertical record goes with rule='exact' under a record")
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
         raise ValueError(f"rule={rule!r} needs a pulse (ap, Tp); for a whole record fit its pulse "
                          "first or use rule='exact'")
@@ -167,17 +176,40 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
                                 f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
 
 
+def _uplift_ratio(record, vertical) -> float:
+    """``max |ag| / (g + av)`` over the record's samples (``tan(alpha)`` of the widest column that
+    uplifts with the vertical); RockingInputError where ``g + av`` reaches 0."""
+    import numpy as np
+
+    from .errors import RockingInputError
+
+    if not hasattr(record, "pga") or getattr(vertical, "acc", None) is None \
+            or np.shape(vertical.acc) != np.shape(record.acc):
+        raise RockingInputError("a vertical record goes with a horizontal record of the same samples")
+    gravity = G + np.asarray(vertical.acc, dtype=float)
+    if np.min(gravity) <= 0.0:
+        raise RockingInputError(f"the vertical reaches {np.max(-vertical.acc) / G:.3g} g downward: "
+                                "the block would leave the ground, which the rocking model does "
+                                "not describe; no width is verified")
+    return float(np.max(np.abs(record.acc) / gravity))
+
+
 def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None,
-                 settings=DEFAULT_SETTINGS, gamma=0.0):
+                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None):
     _check_criterion(criterion)
-    top = height * _peak(excitation) / G       # wider than this the column never uplifts
+    # wider than this the column never uplifts
+    top = height * (_peak(excitation) / G if vertical is None else _uplift_ratio(excitation, vertical))
     if top <= 0:
         return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion,
                              cap_mass_ratio=gamma)
 
     def runs(widths):
-        return _batch([Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma)
-                       for b in widths], excitation, None, model=model)
+        blocks = [Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma) for b in widths]
+        if vertical is not None:
+            import rocking
+
+            return rocking.simulate_many(blocks, excitation, vertical=vertical)
+        return _batch(blocks, excitation, None, model=model)
 
     def evaluate(idx, widths):
         return _failed(runs(widths), criterion)
@@ -192,6 +224,8 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         res = _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
                             settings=settings)
         res.cap_mass_ratio = gamma
+        if vertical is not None:
+            res.method += "; with the vertical record (compiled engine, fast-vertical)"
         if not res.below_scan and settings.check_runs > 0:
             _add_check(res, top, evaluate_record, settings,
                        _record_seed(excitation, height, criterion, eta, gamma))

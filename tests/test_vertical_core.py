@@ -257,3 +257,51 @@ def test_coarse_sampling_takes_sub_steps_and_agrees_with_the_reference():
     assert res.uplifted and res.n_impacts > 0 and not res.lifts_off
     assert res.overturned == ref.overturned
     assert abs(res.max_rotation - ref.max_rotation) <= TOL_ALPHA * block.alpha
+
+
+# -- the verified width with the vertical ------------------------------------------------------------
+def _rsn15():
+    if not DOWNLOAD.is_dir():
+        pytest.skip(f"the shared PEER download is absent ({DOWNLOAD})")
+    d = pulses.peer.PeerDownload(DOWNLOAD)
+    files = ("RSN15_KERN_TAF021.AT2", "RSN15_KERN_TAF111.AT2", "RSN15_KERN_TAF-UP.AT2")
+    first, _, up = pulses.check_triplet(*(d.read_component(f) for f in files))
+    return first, up
+
+
+@pytest.mark.slow
+def test_verified_width_with_a_zero_vertical_is_the_horizontal_one():
+    rec = record()
+    hor = rocking.required_width(3.0, rec, rule="exact")
+    ver = rocking.required_width(3.0, rec, rule="exact", vertical=pulses.Record(np.zeros(rec.npts), rec.dt))
+    assert ver.width == hor.width and ver.runs == hor.runs
+    assert ver.widest_failing_width == hor.widest_failing_width
+
+
+@pytest.mark.slow
+def test_verified_width_with_the_vertical_on_a_real_record():
+    """Taft (RSN 15, UP vertical), a 3 m column: at the verified width with the vertical the
+    column survives in the compiled engine and in the independent reference integrator, and the
+    widest width the search saw fail with the vertical overturns in the reference too."""
+    rec, up = _rsn15()
+    res = rocking.required_width(3.0, rec, rule="exact", vertical=up)
+    assert "with the vertical" in res.method
+    block = rocking.Block.from_dimensions(3.0, res.width)
+    fast = rocking.simulate(block, rec, vertical=up, history=False)
+    ref = simulate_vertical_reference(block, rec, up)
+    assert not fast.overturned and not ref.overturned
+    assert abs(fast.max_rotation - ref.max_rotation) <= TOL_ALPHA * block.alpha
+    if res.widest_failing_width is not None:  # a sliver above it, found by the check
+        sliver = rocking.Block.from_dimensions(3.0, res.widest_failing_width)
+        assert simulate_vertical_reference(sliver, rec, up).overturned
+    # the no-uplift width with the vertical: max |ag| / (g + av), not PGA / g
+    ratio = float(np.max(np.abs(rec.acc) / (G + up.acc)))
+    assert ratio != pytest.approx(rec.pga / G, rel=1e-3)
+    assert res.width < 3.0 * ratio
+
+
+def test_a_vertical_reaching_minus_g_has_no_verified_width():
+    rec = record()
+    down = pulses.Record(np.where(np.arange(rec.npts) == 50, -1.2 * G, 0.0), rec.dt)
+    with pytest.raises(rocking.errors.RockingInputError, match="leave the ground"):
+        rocking.required_width(3.0, rec, rule="exact", vertical=down)
