@@ -64,7 +64,8 @@ def _bool_all(values):
     return all(bool(v) for v in values)
 
 
-def _num(value):
+def number(value):
+    """``value`` as a finite float, or None (blank cells, text, nan and inf read back from a report)."""
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -75,7 +76,7 @@ def _num(value):
 def _widest(values, above=None):
     """The largest of ``values`` if it is above ``above`` (a failing width of one direction below the
     pair's verified width is no failure of the design), else None."""
-    values = [v for v in map(_num, values) if v is not None]
+    values = [v for v in map(number, values) if v is not None]
     if not values or (above is not None and max(values) <= above):
         return None
     return max(values)
@@ -83,7 +84,7 @@ def _widest(values, above=None):
 
 def _whole(value):
     """``15`` for the number 15.0 read back from a report (an RSN, a year), else the text."""
-    v = _num(value)
+    v = number(value)
     return str(int(v)) if v is not None and v == int(v) else str(value)
 
 
@@ -92,9 +93,9 @@ def design_rows(rows, failed=None) -> list[dict]:
     ``failed`` (``{pair: directions that failed}``)."""
     out = []
     for (pair, column), group in _groups(rows).items():
-        gov = max(group, key=lambda r: _num(r.get("verified_width_m")) or -math.inf)  # first of equals
+        gov = max(group, key=lambda r: number(r.get("verified_width_m")) or -math.inf)  # first of equals
         block = gov.get("column_kind") == "block"
-        ratios = [_num(r.get("max_theta_ratio")) for r in group]
+        ratios = [number(r.get("max_theta_ratio")) for r in group]
         ratios = [v for v in ratios if v is not None]
         out.append(DESIGN_COLUMNS.row({
             "record": pair, "column": column,
@@ -112,7 +113,7 @@ def design_rows(rows, failed=None) -> list[dict]:
             "verified_adequate": _bool_all([r.get("verified_adequate") for r in group]) if block else None,
             "max_theta_ratio": max(ratios) if (block and ratios) else None,
             "widest_failing_width_m": _widest([r.get("widest_failing_width_m") for r in group],
-                                              above=_num(gov.get("verified_width_m"))),
+                                              above=number(gov.get("verified_width_m"))),
             "survives_vertical": (None if not block else _bool_all(
                 [None if r.get("vertical_overturns") is None else not r["vertical_overturns"] for r in group])),
         }))
@@ -132,13 +133,13 @@ def _yes(value, yes="yes", no="no"):
 
 
 def _m(value):
-    v = _num(value)
+    v = number(value)
     return "-" if v is None else f"{v:.3f}"
 
 
 def pulse_text(row) -> str:
     """``sine +0.71g 0.80s``: the governing pulse of a design row."""
-    shape, ap, tp = row.get("governing_shape"), _num(row.get("governing_ap_g")), _num(row.get("governing_tp_s"))
+    shape, ap, tp = row.get("governing_shape"), number(row.get("governing_ap_g")), number(row.get("governing_tp_s"))
     if not shape or ap is None or tp is None:
         return "-"
     return f"{shape} {ap:+.2f}g {tp:.2f}s"
@@ -163,13 +164,13 @@ VERTICAL_HEADER = "with vertical"
 def table_cells(row) -> tuple[str, ...]:
     """The printed cells of one design row (also the batch table of ``report.html``)."""
     name = display(row["record"])
-    d = _num(row.get("direction_deg"))
+    d = number(row.get("direction_deg"))
     if d is not None and (row.get("n_directions") or 1) > 1:
         name += f" @{d:.0f}deg"
     return (name, display(row.get("column") or "-"), _yes(row.get("pulse_like")), pulse_text(row),
-            _m(row.get("eq31_width_m")) + (" m" if _num(row.get("eq31_width_m")) is not None else ""),
-            _m(row.get("verified_width_m")) + (" m" if _num(row.get("verified_width_m")) is not None else ""),
-            _m(row.get("widest_failing_width_m")) + (" m" if _num(row.get("widest_failing_width_m")) is not None else ""),
+            _m(row.get("eq31_width_m")) + (" m" if number(row.get("eq31_width_m")) is not None else ""),
+            _m(row.get("verified_width_m")) + (" m" if number(row.get("verified_width_m")) is not None else ""),
+            _m(row.get("widest_failing_width_m")) + (" m" if number(row.get("widest_failing_width_m")) is not None else ""),
             survives_text(row))
 
 
@@ -187,13 +188,13 @@ def metadata_text(row) -> str | None:
     if row.get("peer_station"):
         parts[0] += f", {row['peer_station']}"
     site = []
-    if _num(row.get("peer_magnitude")) is not None:
-        site.append(f"M{_num(row['peer_magnitude']):.2f}" + (f" {row['peer_mechanism']}" if row.get("peer_mechanism") else ""))
+    if number(row.get("peer_magnitude")) is not None:
+        site.append(f"M{number(row['peer_magnitude']):.2f}" + (f" {row['peer_mechanism']}" if row.get("peer_mechanism") else ""))
     for key, label, unit in (("peer_rrup_km", "Rrup", "km"), ("peer_vs30_m_s", "Vs30", "m/s")):
-        if _num(row.get(key)) is not None:
-            site.append(f"{label} {_num(row[key]):g} {unit}")
-    tp = _num(row.get("peer_tp_s"))
-    ours = _num(row.get("velocity_tp_s"))
+        if number(row.get(key)) is not None:
+            site.append(f"{label} {number(row[key]):g} {unit}")
+    tp = number(row.get("peer_tp_s"))
+    ours = number(row.get("velocity_tp_s"))
     if tp is not None or ours is not None:
         site.append("velocity pulse Tp " + ("-" if tp is None else f"{tp:.2f} s") + " (PEER), "
                     + ("-" if ours is None else f"{ours:.2f} s") + " (here)")
@@ -212,7 +213,7 @@ def table_text(rows, failures=(), summary=()) -> str:
         widths = {}
         for r in summary:
             key = (r.get("pair") or r.get("record"), r.get("column"))
-            w = _num(r.get("vertical_verified_width_m"))
+            w = number(r.get("vertical_verified_width_m"))
             if w is not None:
                 widths[key] = max(w, widths.get(key, w))
         headers = HEADERS + (VERTICAL_HEADER,)

@@ -12,12 +12,12 @@ same bytes.
 from __future__ import annotations
 
 import html
-import math
 import pathlib
 import urllib.parse
 
 from . import report
 from .design_table import metadata_text, pulse_text, survives_text
+from .design_table import number as _num
 
 #: the file in ``--out``
 REPORT_HTML = "report.html"
@@ -73,14 +73,6 @@ def output_files() -> list[str]:
 
 def _e(value) -> str:
     return html.escape(report.display("" if value is None else value), quote=True)
-
-
-def _num(value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else None
 
 
 def _sort_value(value) -> str:

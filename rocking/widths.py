@@ -203,7 +203,7 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion,
                              cap_mass_ratio=gamma)
 
-    def runs(widths):
+    def run_widths(widths):  # not `runs`: that name counts the runs below
         blocks = [Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma) for b in widths]
         if vertical is not None:
             import rocking
@@ -212,12 +212,12 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         return _batch(blocks, excitation, None, model=model)
 
     def evaluate(idx, widths):
-        return _failed(runs(widths), criterion)
+        return _failed(run_widths(widths), criterion)
 
     is_pulse = getattr(excitation, "shape", "record") in SHAPES
     if not is_pulse:
         def evaluate_record(widths):
-            res = runs(widths)
+            res = run_widths(widths)
             return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
 
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
