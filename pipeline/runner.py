@@ -84,20 +84,17 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
     except OSError as exc:
         problems.append(exc)
     if plots:
-        try:
-            if res.get("plot"):
-                outputs.write(report.record_plot_name(rid), res["plot"])
-            else:
-                outputs.remove(report.record_plot_name(rid))
-        except OSError as exc:
-            problems.append(exc)
-        try:  # the barcode of the check above the verified width, where it found failing widths
-            if res.get("widths_plot"):
-                outputs.write(report.record_widths_plot_name(rid), res["widths_plot"])
-            else:
-                outputs.remove(report.record_widths_plot_name(rid))
-        except OSError as exc:
-            problems.append(exc)
+        # the record's figure, and the barcode of the check above the verified width where it
+        # found failing widths; a figure not drawn this time is removed (an earlier run's)
+        for name, data in ((report.record_plot_name(rid), res.get("plot")),
+                           (report.record_widths_plot_name(rid), res.get("widths_plot"))):
+            try:
+                if data:
+                    outputs.write(name, data)
+                else:
+                    outputs.remove(name)
+            except OSError as exc:
+                problems.append(exc)
     res["widths_plot"] = None
     res["plot"] = None  # thousands of records: keep only the rows in memory
     for exc in problems:
