@@ -16,7 +16,7 @@ For every candidate shape (rectangular, one-sine, symmetric and antisymmetric Ri
    weighted by the first estimate (:func:`_estimate_background`); every other shape is refit by
    least squares weighted by the inverse of the second (generalised least squares,
    :func:`_refine_weighted`), each weighted fit kept unless the record departs from the pulse
-   model (Hausman's test, :func:`_difference_covariance`), and the candidates are ranked by the
+   model (Hausman's test, :func:`pulses.weighted.difference_covariance`), and the candidates are ranked by the
    share of the record's energy they explain in the same metric (:func:`_weighted`; the plain
    fit answers where the record does not support the weighting, ``PulseFit.weighting``).
 
@@ -49,8 +49,10 @@ from scipy import fft as sfft
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
 from .cwt import Matcher, _dot, unit_energy
+from .lsq import baseline_projector, levenberg_marquardt, normal_equations
 from .record import G, Record
 from .shapes import SHAPES, Pulse, make_pulse, shape_class
+from .weighted import WeightedWindow
 
 #: shapes fitted by default (every registered shape), in the order they are reported on ties
 DEFAULT_SHAPES = tuple(SHAPES)
@@ -90,23 +92,6 @@ LOADING = 1e-3
 #: pulse needs; on the README's synthetic records 5 s either side did no better, and cost 9 % more)
 GLS_MARGIN = 3.0
 GLS_MARGIN_PERIODS = 1.0
-#: periods scanned by the weighted least squares of a shape with corners before its descent,
-#: within a factor GLS_SCAN_RANGE of the plain least squares' period; shifts within GLS_SHIFT Tp
-GLS_SCAN = 9
-GLS_SCAN_RANGE = 1.1
-GLS_SHIFT = 0.1
-#: the weighted descent stops when the weighted sum of squares falls by less than this share,
-#: or after GLS_MAX_CALLS evaluations.  The sum is about the number of samples in the window
-#: (thousands), so this is a fall of a few hundredths, where one standard deviation of the
-#: estimates moves it by one; 1e-7 gave the same README tables, 2.5 % slower
-GLS_FTOL = 1e-5
-GLS_MAX_CALLS = 12
-#: for a shape with corners (:meth:`pulses.Pulse.cornered`) the descent is restarted from the
-#: best of a lattice of the pulse's two edges about where it stopped, GLS_LATTICE points per
-#: sample, the width within GLS_LATTICE_SPAN points: weighted by the background's spectrum, the
-#: corners pin the pulse to a fraction of a sample, and the objective has a kink at every sample
-GLS_LATTICE = 4
-GLS_LATTICE_SPAN = 4
 #: the weighted estimate is refused when it differs from the plain one by more than noise
 #: explains: Hausman's statistic (chi-square of 3 degrees of freedom under the model) above its
 #: 99.9 % point
@@ -525,7 +510,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         if idx.stop - idx.start < 6:
             break
         tw, xw = t[idx], x[idx]
-        project = _projector(tw, baseline)
+        project = baseline_projector(tw, baseline)
         xp = project(xw)
 
         def residual_and_jacobian(p):
@@ -535,10 +520,10 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
             return xp - p[0] * cols[0], -cols.T
 
         try:
-            p_new, cost = _levenberg_marquardt(_normal_equations(residual_and_jacobian), np.array([ap, tp, t0]),
-                                               scale=np.array([abs(ap) or 1.0, tp, tp]),
-                                               lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
-                                               upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
+            p_new, cost = levenberg_marquardt(normal_equations(residual_and_jacobian), np.array([ap, tp, t0]),
+                                              scale=np.array([abs(ap) or 1.0, tp, tp]),
+                                              lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
+                                              upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
         except np.linalg.LinAlgError:
             break
         ap_new, tp_new, t0_new = (float(v) for v in p_new)
@@ -667,17 +652,14 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
 
     The residual over the pulse and :data:`GLS_MARGIN` s (or :data:`GLS_MARGIN_PERIODS`) of
     record each side is weighted by the inverse of the background's spectrum
-    (:class:`Background`), in the frequency domain; the straight-line baseline is fitted
-    alongside in the same metric.  For a shape with corners,
-    weighting sharpens the minimum, so first the period is scanned (:data:`GLS_SCAN` periods,
-    centre kept) with every whole-sample shift of the pulse at once (one inverse FFT per
-    period), Levenberg-Marquardt starts from the best, and starts again from the best of a
-    lattice of the pulse's edges about where it stopped (:data:`GLS_LATTICE`).  A smooth shape's
-    weighted minimum lies in the plain one's basin (the scan never moved a Ricker on the
-    README's synthetic or shared records): the descent starts from ``start``.  ``start`` is
-    returned when nothing beats it on the weighted objective, or when the two estimates differ by
-    more than noise of the estimated spectrum explains (:func:`_difference_covariance`).  By
-    Gauss-Markov, under that spectrum the weighted estimate scatters less than the plain one,
+    (:class:`Background`), in the frequency domain, the straight-line baseline fitted alongside
+    in the same metric (:meth:`pulses.weighted.WeightedWindow.search`: for a shape with corners
+    a scan of the period and a lattice of the pulse's edges around Levenberg-Marquardt; for a
+    smooth shape, whose weighted minimum lies in the plain one's basin, the descent from
+    ``start``).  ``start`` is returned when nothing beats it on the weighted objective, or when
+    the two estimates differ by more than noise of the estimated spectrum explains
+    (:func:`pulses.weighted.difference_covariance`, Hausman's test).  By Gauss-Markov, under
+    that spectrum the weighted estimate scatters less than the plain one,
     whatever the shape and period; it is used wherever the record follows the model.
     """
     cls = shape_class(shape)
@@ -687,18 +669,15 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     i0 = max(0, int(math.floor((t0 + lo * tp - margin) / dt)))
     i1 = min(x.size, int(math.ceil((t0 + hi * tp + margin) / dt)) + 1)
     idx = slice(i0, i1)
-    gls = _Weighted(cls, x[idx], t[idx], dt, background, baseline, tp)
-    difference = _difference_covariance(
-        sfft.rfft(gls.sampled_with_derivatives(tp, t0), axis=-1) * np.array([[1.0], [ap], [ap]]),
-        gls.B if baseline else None, gls.w, gls.nfft, _gram)
+    gls = WeightedWindow(cls, x[idx], t[idx], dt, background.weights, baseline, tp)
+    difference = gls.difference_covariance(ap, tp, t0)
     if difference is None:
         return start
     start_cost, _ = gls.profiled(tp, t0)
     _, tp0, t00 = match
-    gls.lower = np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0])
-    gls.upper = np.array([np.inf, tp0 * TP_LEASH, t00 + tp0])
     try:
-        p_new, cost = gls.search(tp, t0)
+        p_new, cost = gls.search(tp, t0, lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
+                                 upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
     except np.linalg.LinAlgError:
         return start
     ap_new, tp_new, t0_new = (float(v) for v in p_new)
@@ -713,232 +692,6 @@ def _refine_weighted(x, t, dt, shape, match, start, background, baseline):
     if float(d @ np.linalg.pinv(difference) @ d) > GLS_HAUSMAN:
         return start
     return (ap_new, tp_new, t0_new, idx)
-
-
-def _gram(U, Vw):
-    """``u' S^-1 v`` for the rows of ``U`` and of ``Vw`` (the latter already weighted): the
-    sum of ``Re(U) Re(Vw) + Im(U) Im(Vw)``, on the arrays' float views."""
-    return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
-
-
-class _Weighted:
-    """The weighted least squares of one shape on one window of a record (``xw`` at times ``tw``):
-    the record's and the baseline's weighted spectra, and the objective's pieces for a pulse
-    ``(ap, tp, t0)``.  ``lower``/``upper``: bounds of the descent, set by the caller."""
-
-    def __init__(self, cls, xw, tw, dt, background, baseline, tp):
-        self.cls, self.tw, self.dt, self.baseline = cls, tw, dt, baseline
-        self.nfft = nfft = sfft.next_fast_len(tw.size, real=True)
-        self.w = w = background.weights(nfft)
-        X = sfft.rfft(xw, nfft)
-        self.Xw = Xw = X * w  # every product is with one weighted side
-        # the pulse and its derivatives vanish outside its support: computed there only
-        self.sup_lo, self.sup_hi = cls.support_tau
-        self.xx = float(_gram(X[None], Xw[None])[0, 0])
-        if baseline:
-            self.B = B = sfft.rfft(np.stack((np.ones_like(tw), tw - float(tw.mean()))), nfft, axis=-1)
-            Bw = B * w
-            self.BB_inv = np.linalg.inv(_gram(B, Bw))
-            self.BX = _gram(B, Xw[None])[:, 0]
-            self.xx -= float(self.BX @ self.BB_inv @ self.BX)
-        # the record's and the baseline's weighted spectra, stacked: one product with the columns
-        self.fixed = np.concatenate((Xw[None], Bw)) if baseline else Xw[None]
-        # each candidate pulse's best whole-sample shift from the weighted cross-correlation (one
-        # inverse FFT per candidate, all at once; baseline left out)
-        self.shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
-        self.k_near = np.flatnonzero(np.abs(self.shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
-        # irfft counts the interior bins twice, which the weights already do
-        self.Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
-
-    def support(self, tp_, t0_):
-        tw, dt = self.tw, self.dt
-        a = max(0, int(math.floor((t0_ + self.sup_lo * tp_ - tw[0]) / dt)) - 1)
-        b = min(tw.size, int(math.ceil((t0_ + self.sup_hi * tp_ - tw[0]) / dt)) + 2)
-        return slice(a, max(a, b))
-
-    # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
-    def sampled(self, tp_, t0_):
-        out = np.zeros((1, self.nfft))
-        k = self.support(tp_, t0_)
-        out[0, k] = self.cls.sampled(tp_, t0_, self.tw[k], self.dt)
-        return out
-
-    def sampled_with_derivatives(self, tp_, t0_):
-        out = np.zeros((3, self.nfft))
-        k = self.support(tp_, t0_)
-        out[:, k] = self.cls.sampled_with_derivatives(tp_, t0_, self.tw[k], self.dt)
-        return out
-
-    def products(self, cols):
-        """Weighted ``u'v`` among the columns and with the record, the baseline projected out."""
-        U = sfft.rfft(cols, axis=-1, overwrite_x=True)
-        UU, UF = _gram(U, U * self.w), _gram(U, self.fixed)
-        UX = UF[:, 0]
-        if self.baseline:
-            UB = UF[:, 1:]
-            UU -= UB @ self.BB_inv @ UB.T
-            UX = UX - UB @ self.BB_inv @ self.BX
-        return UU, UX
-
-    def profiled(self, tp_, t0_):
-        UU, UX = self.products(self.sampled(tp_, t0_))
-        return self.xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
-
-    def normal(self, p):
-        a = p[0]
-        UU, UX = self.products(self.sampled_with_derivatives(max(p[1], 1e-9), p[2]))
-        d = np.array([1.0, a, a])
-        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
-        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
-        return cost, UU * np.outer(d, d), -d * ur
-
-    def scan(self, tps, t0s, whitened=None):
-        """The best of the pulses ``(tps, t0s)``, each moved by its best whole-sample shift, by
-        the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``.  Given the record ``whitened`` (in time,
-        ``irfft(Xw)``: its circular cross-correlation with ``u`` at lag ``m`` is ``u'S^-1 x``
-        for ``u`` moved by ``m`` samples), the shifts are within 2 samples, summed over the
-        pulses' support instead of an inverse FFT each."""
-        tw, dt, nfft = self.tw, self.dt, self.nfft
-        # every candidate sampled at once, over the union of their supports
-        a = max(0, int(math.floor((np.min(t0s + self.sup_lo * tps) - tw[0]) / dt)) - 1)
-        b = max(a, min(tw.size, int(math.ceil((np.max(t0s + self.sup_hi * tps) - tw[0]) / dt)) + 2))
-        cols = np.zeros((len(tps), nfft))
-        cols[:, a:b] = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
-        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
-        mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
-        if whitened is None:
-            lags = self.shifts[self.k_near]
-            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, self.k_near] * nfft
-        else:
-            lags = np.arange(-2, 3)
-            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
-        j = np.argmax(np.abs(corr), axis=1)
-        gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
-        i = int(np.argmax(gain))
-        return tps[i], t0s[i] + lags[j[i]] * dt
-
-    def descent(self, tp_, t0_):
-        _, ap_ = self.profiled(tp_, t0_)
-        return _levenberg_marquardt(self.normal, np.array([ap_, tp_, t0_]),
-                                    scale=np.array([abs(ap_) or 1.0, tp_, tp_]),
-                                    ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS, lower=self.lower, upper=self.upper)
-
-    def search(self, tp, t0):
-        """``(p, cost)``: the descent from ``(tp, t0)``; for a shape with corners from the best of a
-        scan of the period, then again from the best of a lattice of the pulse's edges."""
-        cls, dt = self.cls, self.dt
-        if not cls.cornered():
-            return self.descent(tp, t0)
-        # a scan of the period about the start, the pulse's centre kept, then the descent
-        tps = tp * np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN))
-        p_new, cost = self.descent(*self.scan(tps, t0 + cls.centre_tau * (tp - tps)))
-        # the descent stops in the first kink it meets, a sample or two from the optimum:
-        # a lattice of both edges about where it stopped, then the descent from its best
-        lo_, hi_ = cls.support_tau
-        widths, starts = (v.ravel() for v in np.meshgrid(
-            (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
-            p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
-        tps = widths / (hi_ - lo_)
-        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps,
-                                                          sfft.irfft(self.Xw_half, self.nfft) * self.nfft))
-        if cost_lattice < cost:
-            p_new, cost = p_lattice, cost_lattice
-        return p_new, cost
-
-
-def _difference_covariance(U, B, w, nfft, gram):
-    """Covariance of the difference of the plain and weighted estimates of ``(ap, Tp, t0)``
-    (None where it cannot be computed).
-
-    ``U``: ``nfft``-point FFT of the pulse's derivatives with respect to ``ap``, ``Tp``, ``t0``
-    at the plain estimate; ``B``: of the baseline's columns (or None); ``w``: the weights of
-    :meth:`Background.weights`, the inverse of the estimated spectrum ``S``.  Linearised, plain
-    least squares scatter as ``(J'J)^-1 J'SJ (J'J)^-1`` and weighted ones as ``(J'S^-1 J)^-1``;
-    the weighted estimate being the efficient one, their difference has the difference of
-    these covariances, which lets the caller tell noise from a pulse model the record does not
-    follow (Hausman's test).
-    """
-    J = U if B is None else np.concatenate([U, B])
-    plain = np.full(w.size, 2.0 / nfft)  # the same sums unweighted: interior bins count twice
-    plain[0] = 1.0 / nfft
-    if nfft % 2 == 0:
-        plain[-1] = 1.0 / nfft
-    try:
-        weighted = np.linalg.inv(gram(J, J * w))
-        plain_inv = np.linalg.inv(gram(J, J * plain))
-    except np.linalg.LinAlgError:
-        return None
-    plain_cov = plain_inv @ gram(J, J * (plain**2 / w)) @ plain_inv
-    difference = (plain_cov - weighted)[:3, :3]
-    return difference if np.all(np.isfinite(difference)) else None
-
-
-def _projector(tw, baseline: bool):
-    """Removal of the straight-line baseline (least squares on 1 and t - tc, orthogonal) from
-    samples on times ``tw``, if it is fitted."""
-    ramp = tw - float(tw.mean())
-    ramp_norm = _dot(ramp, ramp) or 1.0
-
-    def project(v):
-        if not baseline:
-            return v
-        v = v - v.mean(axis=-1, keepdims=True)
-        if v.ndim == 1:
-            return v - ramp * (_dot(v, ramp) / ramp_norm)
-        return v - np.outer(np.einsum("ij,j->i", v, ramp), ramp / ramp_norm)
-
-    return project
-
-
-def _normal_equations(residual_and_jacobian):
-    """``p -> (||r||^2, J'J, J'r)`` from ``p -> (r, J)``, for :func:`_levenberg_marquardt`."""
-
-    def normal(p):
-        r, J = residual_and_jacobian(p)
-        return _dot(r, r), np.einsum("ij,ik->jk", J, J), np.einsum("ij,i->j", J, r)
-
-    return normal
-
-
-def _levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, max_iter=100,
-                         max_calls=None):
-    """Minimise a sum of squares ``||r(p)||^2`` by Levenberg-Marquardt with Marquardt's scaling.
-
-    ``normal(p)`` returns the sum of squares, ``J'J`` and ``J'r`` (``J = dr/dp``; for weighted
-    least squares the weighted products).  A small dense solver (three unknowns) without the
-    per-call overhead of a general one.  Steps that leave the box ``[lower, upper]`` are refused
-    like steps that increase the sum of squares.  Stops when every step is below ``xtol`` times
-    ``scale`` or the sum of squares falls by less than ``ftol`` relative, or after ``max_calls``
-    evaluations of ``normal``.  Returns ``(p, sum of squares)``.
-    """
-    cost, A, g = normal(p)
-    calls = 1
-    lam = 1e-3
-    for _ in range(max_iter):
-        diag = np.diag(A).copy()
-        diag[diag <= 0] = 1.0
-        while True:
-            step = np.linalg.solve(A + lam * np.diag(diag), -g)
-            trial = p + step
-            if max_calls is not None and calls >= max_calls:
-                return p, cost
-            if np.all(trial >= lower) and np.all(trial <= upper):
-                cost_trial, A_trial, g_trial = normal(trial)
-                calls += 1
-            else:
-                cost_trial = np.inf
-            if cost_trial <= cost:
-                lam = max(lam / 10.0, 1e-12)
-                break
-            lam *= 4.0
-            if lam > 1e12:
-                return p, cost
-        small_step = bool(np.all(np.abs(step) <= xtol * scale))
-        small_gain = cost - cost_trial <= ftol * cost
-        p, cost, A, g = trial, cost_trial, A_trial, g_trial
-        if small_step or small_gain:
-            break
-    return p, cost
 
 
 def _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00):

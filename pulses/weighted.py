@@ -1,0 +1,275 @@
+"""Weighted (generalised) least squares of one pulse shape on a window of a record.
+
+The background motion is taken as stationary noise whose covariance ``S`` is the circulant of a
+power spectrum (:class:`pulses.fit.Background` estimates it from the record): weighting every
+frequency of a residual by the inverse of the power there is generalised least squares, and the
+weighted inner product of two sampled signals is ``u' S^-1 v``.  It is computed in the frequency
+domain, on real FFTs of ``nfft`` points (the window zero-padded), with weights ``w`` per bin
+(:func:`gram`).
+
+:class:`WeightedWindow` holds one window of a record and gives the pieces of the weighted sum of
+squares of a pulse ``(ap, Tp, t0)`` (amplitude in the record's units, period and time in s): the
+sum profiled over the amplitude, the normal equations for Levenberg-Marquardt
+(:func:`pulses.lsq.levenberg_marquardt`), a scan over periods and whole-sample shifts, and the
+search that combines them.  A straight-line baseline is fitted alongside in the same metric.
+:func:`difference_covariance` gives the covariance of the difference of the plain and weighted
+estimates, for Hausman's test of the pulse model (:func:`pulses.fit._refine_weighted`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import fft as sfft
+
+from .lsq import levenberg_marquardt
+
+#: periods scanned by the weighted search of a shape with corners before its descent, within a
+#: factor GLS_SCAN_RANGE of the starting period; shifts within GLS_SHIFT Tp
+GLS_SCAN = 9
+GLS_SCAN_RANGE = 1.1
+GLS_SHIFT = 0.1
+#: the weighted descent stops when the weighted sum of squares falls by less than this share,
+#: or after GLS_MAX_CALLS evaluations.  The sum is about the number of samples in the window
+#: (thousands), so this is a fall of a few hundredths, where one standard deviation of the
+#: estimates moves it by one; 1e-7 gave the same README tables, 2.5 % slower
+GLS_FTOL = 1e-5
+GLS_MAX_CALLS = 12
+#: for a shape with corners (:meth:`pulses.Pulse.cornered`) the descent is restarted from the
+#: best of a lattice of the pulse's two edges about where it stopped, GLS_LATTICE points per
+#: sample, the width within GLS_LATTICE_SPAN points: weighted by the background's spectrum, the
+#: corners pin the pulse to a fraction of a sample, and the objective has a kink at every sample
+GLS_LATTICE = 4
+GLS_LATTICE_SPAN = 4
+
+
+def gram(U, Vw):
+    """Weighted inner products ``u' S^-1 v`` of every row of ``U`` with every row of ``Vw``.
+
+    Parameters
+    ----------
+    U : ndarray of complex, shape (k, nfft // 2 + 1)
+        Real FFTs (``scipy.fft.rfft``, ``nfft`` points) of ``k`` sampled signals.
+    Vw : ndarray of complex, shape (m, nfft // 2 + 1)
+        Real FFTs of ``m`` signals already multiplied by the weights ``w`` of each bin.
+
+    Returns
+    -------
+    ndarray, shape (k, m)
+        ``sum(Re(U) Re(Vw) + Im(U) Im(Vw))`` over the bins (computed on the arrays' float views),
+        which is ``u' S^-1 v`` when ``w`` are the weights of :meth:`pulses.fit.Background.weights`.
+    """
+    return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
+
+
+def difference_covariance(U, B, w, nfft):
+    """Covariance of the difference of the plain and weighted estimates of ``(ap, Tp, t0)``.
+
+    Linearised, plain least squares scatter as ``(J'J)^-1 J'SJ (J'J)^-1`` and weighted ones as
+    ``(J'S^-1 J)^-1``; the weighted estimate being the efficient one, their difference has the
+    difference of these covariances (Hausman), which lets the caller tell noise from a pulse
+    model the record does not follow.
+
+    Parameters
+    ----------
+    U : ndarray of complex, shape (3, nfft // 2 + 1)
+        Real FFTs of the pulse's derivatives with respect to ``ap``, ``Tp`` and ``t0`` at the plain
+        estimate (record units per unit of ``ap``, per s, per s).
+    B : ndarray of complex, shape (2, nfft // 2 + 1), or None
+        Real FFTs of the baseline's columns ``1`` and ``t - tc`` (None without a baseline).
+    w : ndarray, shape (nfft // 2 + 1,)
+        Weights of the bins, the inverse of the noise's spectrum (:func:`gram`).
+    nfft : int
+        Length of the FFTs.
+
+    Returns
+    -------
+    ndarray, shape (3, 3), or None
+        The covariance, in the units of ``(ap, Tp, t0)`` squared per unit of noise power; None
+        where it cannot be computed (singular or not finite).
+    """
+    J = U if B is None else np.concatenate([U, B])
+    plain = np.full(w.size, 2.0 / nfft)  # the same sums unweighted: interior bins count twice
+    plain[0] = 1.0 / nfft
+    if nfft % 2 == 0:
+        plain[-1] = 1.0 / nfft
+    try:
+        weighted = np.linalg.inv(gram(J, J * w))
+        plain_inv = np.linalg.inv(gram(J, J * plain))
+    except np.linalg.LinAlgError:
+        return None
+    plain_cov = plain_inv @ gram(J, J * (plain**2 / w)) @ plain_inv
+    difference = (plain_cov - weighted)[:3, :3]
+    return difference if np.all(np.isfinite(difference)) else None
+
+
+class WeightedWindow:
+    """The weighted least squares of one pulse shape on one window of a record.
+
+    Parameters
+    ----------
+    cls : type
+        The shape's class (:func:`pulses.shape_class`): its ``sampled``,
+        ``sampled_with_derivatives``, ``support_tau``, ``centre_tau`` and ``cornered``.
+    xw : ndarray, shape (n,)
+        The record's samples in the window (any acceleration units; ``ap`` comes out in them).
+    tw : ndarray, shape (n,)
+        Their times, s (uniform, step ``dt``).
+    dt : float
+        Sampling step, s.
+    weights : callable
+        ``nfft -> w``: the weights of the ``nfft // 2 + 1`` bins of a real FFT of ``nfft``
+        points (:meth:`pulses.fit.Background.weights`).
+    baseline : bool
+        Fit a straight-line baseline ``c0 + c1 (t - tc)`` alongside the pulse.
+    tp : float
+        The period the search starts near, s: it sets how far the whole-sample shifts of
+        :meth:`scan` reach (:data:`GLS_SHIFT`).
+
+    Notes
+    -----
+    The window is zero-padded to ``nfft = scipy.fft.next_fast_len(n)`` points and the metric is
+    circular over them.  The record's and the baseline's weighted spectra are computed once;
+    every pulse tried costs one FFT of its samples (and derivatives), built on its support only.
+    """
+
+    def __init__(self, cls, xw, tw, dt, weights, baseline, tp):
+        self.cls, self.tw, self.dt, self.baseline = cls, tw, dt, baseline
+        self.nfft = nfft = sfft.next_fast_len(tw.size, real=True)
+        self.w = w = weights(nfft)
+        X = sfft.rfft(xw, nfft)
+        self.Xw = Xw = X * w  # every product is with one weighted side
+        # the pulse and its derivatives vanish outside its support: computed there only
+        self.sup_lo, self.sup_hi = cls.support_tau
+        self.xx = float(gram(X[None], Xw[None])[0, 0])
+        if baseline:
+            self.B = B = sfft.rfft(np.stack((np.ones_like(tw), tw - float(tw.mean()))), nfft, axis=-1)
+            Bw = B * w
+            self.BB_inv = np.linalg.inv(gram(B, Bw))
+            self.BX = gram(B, Xw[None])[:, 0]
+            self.xx -= float(self.BX @ self.BB_inv @ self.BX)
+        # the record's and the baseline's weighted spectra, stacked: one product with the columns
+        self.fixed = np.concatenate((Xw[None], Bw)) if baseline else Xw[None]
+        # each candidate pulse's best whole-sample shift from the weighted cross-correlation (one
+        # inverse FFT per candidate, all at once; baseline left out)
+        self.shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
+        self.k_near = np.flatnonzero(np.abs(self.shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
+        # irfft counts the interior bins twice, which the weights already do
+        self.Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+
+    def support(self, tp_, t0_):
+        """Slice of the window's samples where the pulse ``(tp_, t0_)`` (s) may be non-zero."""
+        tw, dt = self.tw, self.dt
+        a = max(0, int(math.floor((t0_ + self.sup_lo * tp_ - tw[0]) / dt)) - 1)
+        b = min(tw.size, int(math.ceil((t0_ + self.sup_hi * tp_ - tw[0]) / dt)) + 2)
+        return slice(a, max(a, b))
+
+    # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
+    def sampled(self, tp_, t0_):
+        """The unit pulse ``(tp_, t0_)`` on the window, zero-padded: shape ``(1, nfft)``."""
+        out = np.zeros((1, self.nfft))
+        k = self.support(tp_, t0_)
+        out[0, k] = self.cls.sampled(tp_, t0_, self.tw[k], self.dt)
+        return out
+
+    def sampled_with_derivatives(self, tp_, t0_):
+        """The unit pulse and its derivatives with respect to ``tp`` and ``t0`` (per s),
+        zero-padded: shape ``(3, nfft)``."""
+        out = np.zeros((3, self.nfft))
+        k = self.support(tp_, t0_)
+        out[:, k] = self.cls.sampled_with_derivatives(tp_, t0_, self.tw[k], self.dt)
+        return out
+
+    def products(self, cols):
+        """Weighted ``u'v`` among the columns ``cols`` (shape ``(k, nfft)``; overwritten) and with
+        the record, the baseline projected out: ``(UU, UX)`` of shapes ``(k, k)`` and ``(k,)``."""
+        U = sfft.rfft(cols, axis=-1, overwrite_x=True)
+        UU, UF = gram(U, U * self.w), gram(U, self.fixed)
+        UX = UF[:, 0]
+        if self.baseline:
+            UB = UF[:, 1:]
+            UU -= UB @ self.BB_inv @ UB.T
+            UX = UX - UB @ self.BB_inv @ self.BX
+        return UU, UX
+
+    def profiled(self, tp_, t0_):
+        """``(cost, ap)``: the weighted sum of squares of the record less the pulse ``(tp_, t0_)``
+        of least-squares amplitude ``ap`` (record units), and that amplitude."""
+        UU, UX = self.products(self.sampled(tp_, t0_))
+        return self.xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
+
+    def normal(self, p):
+        """The normal equations at ``p = (ap, tp, t0)`` for :func:`pulses.lsq.levenberg_marquardt`:
+        ``(r'S^-1 r, J'S^-1 J, J'S^-1 r)`` with ``r`` the residual and ``J = dr/dp``."""
+        a = p[0]
+        UU, UX = self.products(self.sampled_with_derivatives(max(p[1], 1e-9), p[2]))
+        d = np.array([1.0, a, a])
+        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
+        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
+        return cost, UU * np.outer(d, d), -d * ur
+
+    def difference_covariance(self, ap, tp_, t0_):
+        """:func:`difference_covariance` at the plain estimate ``(ap, tp_, t0_)`` on this window."""
+        U = sfft.rfft(self.sampled_with_derivatives(tp_, t0_), axis=-1) * np.array([[1.0], [ap], [ap]])
+        return difference_covariance(U, self.B if self.baseline else None, self.w, self.nfft)
+
+    def scan(self, tps, t0s, whitened=None):
+        """The best of the pulses ``(tps, t0s)`` (arrays, s), each moved by its best whole-sample
+        shift, by the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``: its ``(tp, t0)``.
+
+        Given the record ``whitened`` (in time, ``irfft(Xw)``: its circular cross-correlation with
+        ``u`` at lag ``m`` is ``u'S^-1 x`` for ``u`` moved by ``m`` samples), the shifts are within 2
+        samples, summed over the pulses' support instead of an inverse FFT each."""
+        tw, dt, nfft = self.tw, self.dt, self.nfft
+        # every candidate sampled at once, over the union of their supports
+        a = max(0, int(math.floor((np.min(t0s + self.sup_lo * tps) - tw[0]) / dt)) - 1)
+        b = max(a, min(tw.size, int(math.ceil((np.max(t0s + self.sup_hi * tps) - tw[0]) / dt)) + 2))
+        cols = np.zeros((len(tps), nfft))
+        cols[:, a:b] = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
+        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
+        mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
+        if whitened is None:
+            lags = self.shifts[self.k_near]
+            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, self.k_near] * nfft
+        else:
+            lags = np.arange(-2, 3)
+            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        j = np.argmax(np.abs(corr), axis=1)
+        gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
+        i = int(np.argmax(gain))
+        return tps[i], t0s[i] + lags[j[i]] * dt
+
+    def descent(self, tp_, t0_, lower, upper):
+        """``(p, cost)``: Levenberg-Marquardt from ``(tp_, t0_)`` and its profiled amplitude, inside
+        the box ``[lower, upper]`` of ``(ap, tp, t0)`` (:data:`GLS_FTOL`, :data:`GLS_MAX_CALLS`)."""
+        _, ap_ = self.profiled(tp_, t0_)
+        return levenberg_marquardt(self.normal, np.array([ap_, tp_, t0_]),
+                                   scale=np.array([abs(ap_) or 1.0, tp_, tp_]),
+                                   ftol=GLS_FTOL, max_calls=GLS_MAX_CALLS, lower=lower, upper=upper)
+
+    def search(self, tp, t0, lower, upper):
+        """``(p, cost)``: the weighted least squares ``p = (ap, tp, t0)`` from ``(tp, t0)`` (s)
+        inside the box ``[lower, upper]``, and its weighted sum of squares.
+
+        The descent from ``(tp, t0)``; for a shape with corners from the best of a scan of the
+        period (:data:`GLS_SCAN`), then again from the best of a lattice of the pulse's edges
+        (:data:`GLS_LATTICE`), whichever ends lower."""
+        cls, dt = self.cls, self.dt
+        if not cls.cornered():
+            return self.descent(tp, t0, lower, upper)
+        # a scan of the period about the start, the pulse's centre kept, then the descent
+        tps = tp * np.exp(np.linspace(-math.log(GLS_SCAN_RANGE), math.log(GLS_SCAN_RANGE), GLS_SCAN))
+        p_new, cost = self.descent(*self.scan(tps, t0 + cls.centre_tau * (tp - tps)), lower, upper)
+        # the descent stops in the first kink it meets, a sample or two from the optimum:
+        # a lattice of both edges about where it stopped, then the descent from its best
+        lo_, hi_ = cls.support_tau
+        widths, starts = (v.ravel() for v in np.meshgrid(
+            (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
+            p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
+        tps = widths / (hi_ - lo_)
+        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps,
+                                                          sfft.irfft(self.Xw_half, self.nfft) * self.nfft),
+                                               lower, upper)
+        if cost_lattice < cost:
+            p_new, cost = p_lattice, cost_lattice
+        return p_new, cost
