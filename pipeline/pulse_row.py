@@ -3,11 +3,26 @@ record or pair as ``pipeline classify`` reports it, and the subset ``pipeline ru
 """
 from __future__ import annotations
 
+from .report import Columns
+
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
            "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio"]
-#: the subset ``pipeline run`` reports
-RUN_COLUMNS = ["pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "orientation_deg", "azimuth_deg"]
+#: the subset ``pipeline run`` reports, with their units and meanings (its reports' columns)
+RUN_PULSE_COLUMNS = Columns(
+    ("pulse_like", "-", "The record (for a pair: the pair) is pulse-like by Shahi & Baker's (2014) "
+                        "velocity-pulse classification (`pulses.classify_pulse`). When it is not, "
+                        "`warnings` notes that Eq. 31 assumes a pulse."),
+    ("velocity_pulse_indicator", "-", "Shahi & Baker's pulse indicator PI (pulse-like when above 0, "
+                                      "with an early enough arrival)."),
+    ("velocity_tp_s", "s", "Pseudo-period Tp of the extracted velocity pulse."),
+    ("orientation_deg", "deg", "Direction of the strongest velocity pulse, from the first component "
+                               "towards the second (0 for a single component)."),
+    ("azimuth_deg", "deg", "Azimuth of the strongest velocity pulse, clockwise from north (0..180), "
+                           "where the files state the azimuths; else blank."),
+)
+#: their names
+RUN_COLUMNS = list(RUN_PULSE_COLUMNS.names)
 
 def result_row(result, file="", file2="") -> dict:
     """One report row of a :class:`pulses.PulseClassification` (see :data:`COLUMNS`)."""
@@ -41,7 +56,7 @@ def classification_fields(record, other=None, pair_fields=None) -> tuple[dict, s
 
     ``pair_fields`` (already computed for the pair, in the main process) are used as they are.
     """
-    blank = dict.fromkeys(RUN_COLUMNS)
+    blank = RUN_PULSE_COLUMNS.blank()
     if pair_fields and "error" in pair_fields:  # the pair's classification failed: no direction
         return blank, f"velocity-pulse classification of the pair failed: {pair_fields['error']}"
     if pair_fields:

@@ -68,6 +68,12 @@ class Columns:
         """The group with every cell blank (the values do not apply)."""
         return dict.fromkeys(self.names)
 
+    def around(self, after: str, *columns) -> tuple:
+        """This group's columns with ``columns`` (``(name, unit, meaning)``) put after the column
+        ``after``: for a group that reports these columns with some of its own among them."""
+        k = self.names.index(after) + 1
+        return self.columns[:k] + tuple(columns) + self.columns[k:]
+
 
 # -- formatting --------------------------------------------------------------------------------
 def fmt(value) -> str:

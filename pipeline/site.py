@@ -18,7 +18,8 @@ import math
 
 from . import peer_inputs
 from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
-from .pulse_row import NOT_PULSE_WARNING, classification_fields  # noqa: F401 (tests import them here)
+from .peer_inputs import PEER_TP
+from .pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
 from .args import SCALE_RANGE, parse_scale
 from .report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
                      Columns)
@@ -47,19 +48,12 @@ SITE_COLUMNS = Columns(
     ("cap_mass_ratio", "-", "Mass of the cap beam over the columns' total mass (`--cap-mass-ratio`): "
                             "0 for a lone column, above 0 for a rocking frame of such columns "
                             "(docs/theory.md section 8: the frame's p and restitution are used throughout)."),
-    ("pulse_like", "-", "The record (for a pair: the pair) is pulse-like by Shahi & Baker's (2014) "
-                        "velocity-pulse classification (`pulses.classify_pulse`). When it is not, "
-                        "`warnings` notes that Eq. 31 assumes a pulse."),
-    ("velocity_pulse_indicator", "-", "Shahi & Baker's pulse indicator PI (pulse-like when above 0, "
-                                      "with an early enough arrival)."),
-    ("velocity_tp_s", "s", "Pseudo-period Tp of the extracted velocity pulse."),
-    ("peer_tp_s", "s", "PEER's pulse period of the record (`Tp-Pulse Period` of a PEER download's "
+    # the velocity-pulse columns (pipeline.pulse_row), PEER's period beside the package's
+    *RUN_PULSE_COLUMNS.around(
+        "velocity_tp_s",
+        (PEER_TP, "s", "PEER's pulse period of the record (`Tp-Pulse Period` of a PEER download's "
                        "`_SearchResults.csv`), to compare with `velocity_tp_s`; blank when PEER gives "
-                       "none (`-`: not pulse-like in its search) or the record is not from a PEER download."),
-    ("orientation_deg", "deg", "Direction of the strongest velocity pulse, from the first component "
-                               "towards the second (0 for a single component)."),
-    ("azimuth_deg", "deg", "Azimuth of the strongest velocity pulse, clockwise from north (0..180), "
-                           "where the files state the azimuths; else blank."),
+                       "none (`-`: not pulse-like in its search) or the record is not from a PEER download.")),
 )
 
 ENVELOPE_COLUMNS = Columns(
@@ -100,7 +94,7 @@ def site_fields(task, record) -> tuple[dict, str | None]:
               "direction_azimuth_deg": az, "scale": float(task.scale),
               "cap_mass_ratio": float(task.options.cap_mass_ratio)}
     fields.update(cls)
-    fields["peer_tp_s"] = peer_inputs.tp(task)
+    fields[PEER_TP] = peer_inputs.tp(task)
     return SITE_COLUMNS.row(fields), warning
 
 
