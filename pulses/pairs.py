@@ -74,17 +74,7 @@ def check_pair(first: Record, second: Record) -> tuple[Record, Record]:
         :data:`ORTHOGONAL_TOLERANCE_DEG` from orthogonal.
     """
     names = f"{_label(first)} and {_label(second)}"
-    if abs(first.dt - second.dt) > DT_RTOL * max(first.dt, second.dt):
-        raise RecordError(f"{names}: not a pair, time steps differ ({first.dt:g} s and {second.dt:g} s)")
-    if abs(first.t_start - second.t_start) > 0.5 * first.dt:
-        # the components are combined sample by sample: records that start at different times
-        # would be added out of step
-        raise RecordError(f"{names}: not a pair, they start at different times ({first.t_start:g} s "
-                          f"and {second.t_start:g} s); cut them to a common start first")
-    diff = abs(first.npts - second.npts)
-    if diff > MAX_LENGTH_DIFFERENCE:
-        raise RecordError(f"{names}: not a pair, lengths differ by {diff} samples ({first.npts} and "
-                          f"{second.npts}; at most {MAX_LENGTH_DIFFERENCE} are truncated)")
+    n = check_time_axis(first, second, names, "a pair", ("the first", "the second"))
     for r in (first, second):
         if r.metadata.get("vertical"):
             raise RecordError(f"{names}: not a pair of horizontals, {_label(r)} is vertical")
@@ -94,12 +84,54 @@ def check_pair(first: Record, second: Record) -> tuple[Record, Record]:
         if abs(apart - 90.0) > ORTHOGONAL_TOLERANCE_DEG:
             raise RecordError(f"{names}: not orthogonal, azimuths {az1:g} and {az2:g} deg are "
                               f"{apart:g} deg apart (90 +- {ORTHOGONAL_TOLERANCE_DEG:g} accepted)")
-    n = min(first.npts, second.npts)
-    if first.npts != n:
-        first = Record(first.acc[:n], first.dt, first.name, first.t_start, first.metadata)
-    if second.npts != n:
-        second = Record(second.acc[:n], second.dt, second.name, second.t_start, second.metadata)
-    return first, second
+    return truncated(first, n), truncated(second, n)
+
+
+def check_time_axis(first: Record, other: Record, names: str, group: str, kinds: tuple[str, str]) -> int:
+    """Check that ``other`` shares ``first``'s time axis; return the length both are cut to.
+
+    Components are combined sample by sample, so they must share the time step (within
+    :data:`DT_RTOL`) and the start (within half a sample), and lengths more than
+    :data:`MAX_LENGTH_DIFFERENCE` samples apart are refused (the shorter length is returned).
+
+    Parameters
+    ----------
+    first, other : pulses.Record
+        The records (``other`` compared with ``first``).
+    names : str
+        The files, as the message names them.
+    group : str
+        What the records must form, as the message says it: ``"a pair"``, ``"one station's
+        components"``.
+    kinds : (str, str)
+        What ``first`` and ``other`` are, as the message says it: ``("the first", "the second")``,
+        ``("the horizontals", "the vertical")``.
+
+    Raises
+    ------
+    RecordError
+        One line naming the files and the differing time steps (s), starts (s) or lengths (samples).
+    """
+    a, b = kinds
+    if abs(first.dt - other.dt) > DT_RTOL * max(first.dt, other.dt):
+        raise RecordError(f"{names}: not {group}, time steps differ ({first.dt:g} s for {a}, "
+                          f"{other.dt:g} s for {b})")
+    if abs(first.t_start - other.t_start) > 0.5 * first.dt:
+        # records that start at different times would be added out of step
+        raise RecordError(f"{names}: not {group}, they start at different times ({first.t_start:g} s for "
+                          f"{a}, {other.t_start:g} s for {b}); cut them to a common start first")
+    diff = abs(first.npts - other.npts)
+    if diff > MAX_LENGTH_DIFFERENCE:
+        raise RecordError(f"{names}: not {group}, lengths differ by {diff} samples ({first.npts} for {a}, "
+                          f"{other.npts} for {b}; at most {MAX_LENGTH_DIFFERENCE} are truncated)")
+    return min(first.npts, other.npts)
+
+
+def truncated(record: Record, n: int) -> Record:
+    """The first ``n`` samples of ``record`` (the record itself if it has ``n``)."""
+    if record.npts == n:
+        return record
+    return Record(record.acc[:n], record.dt, record.name, record.t_start, record.metadata)
 
 
 def read_pair(path1, path2, **read_options) -> tuple[Record, Record]:

@@ -301,6 +301,10 @@ def test_check_triplet_cuts_to_one_axis_and_refuses_what_is_not_a_vertical(tmp_p
         pulses.check_triplet(h1, h2, rec("S2-UP.AT2", "UP", dt=0.02))
     with pytest.raises(RecordError, match="lengths differ"):
         pulses.check_triplet(h1, h2, rec("S3-UP.AT2", "UP", n=250))
+    late = rec("S4-UP.AT2", "UP")
+    late = pulses.Record(late.acc, late.dt, late.name, 2.0, late.metadata)
+    with pytest.raises(RecordError, match=r"different times \(0 s for the horizontals, 2 s for the vertical\)"):
+        pulses.check_triplet(h1, h2, late)
 
 
 def test_a_zip_that_is_not_a_peer_download_is_a_failure_not_a_crash(tmp_path):
