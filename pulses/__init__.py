@@ -1,10 +1,10 @@
 """Pulse shapes, accelerogram reading and pulse fitting (no dependency on ``rocking``).
 
-Names are loaded from their modules on first use (PEP 562), so that ``import pulses`` costs
-almost nothing and a program pays for scipy, PyWavelets or obspy only when it reads records,
-fits pulses or classifies them.
+Names are loaded from their modules on first use (PEP 562, :mod:`pulses.lazy`), so that
+``import pulses`` costs almost nothing and a program pays for scipy, PyWavelets or obspy only
+when it reads records, fits pulses or classifies them.
 """
-import importlib
+from .lazy import lazy_names
 
 #: public name -> the module of this package that defines it
 _WHERE = {
@@ -29,16 +29,4 @@ _MODULES = ("peer",)
 __all__ = sorted(_WHERE) + list(_MODULES)
 
 
-def __getattr__(name):
-    if name in _MODULES:
-        return importlib.import_module(f".{name}", __name__)
-    where = _WHERE.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{where}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names(__name__, _WHERE, _MODULES)

@@ -1,11 +1,13 @@
 """Housner's rocking block: solvers (exact-where-possible, fast, reference) and design.
 
-Names are loaded from their modules on first use (PEP 562): ``import rocking`` costs almost
-nothing, and the compiled core, scipy and the design modules load when first asked for.
+Names are loaded from their modules on first use (PEP 562, :mod:`pulses.lazy`): ``import
+rocking`` costs almost nothing, and the compiled core, scipy and the design modules load when
+first asked for.
 """
-import importlib
 import sys
 import types
+
+from pulses.lazy import lazy_names
 
 #: public name -> the module of this package that defines it
 _WHERE = {
@@ -27,13 +29,7 @@ _WHERE = {
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name):
-    where = _WHERE.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{where}", __name__), name)
-    globals()[name] = value
-    return value
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)
 
 
 class _Package(types.ModuleType):
@@ -47,6 +43,3 @@ class _Package(types.ModuleType):
 
 sys.modules[__name__].__class__ = _Package
 
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
