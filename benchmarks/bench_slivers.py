@@ -2,8 +2,8 @@
 
     python benchmarks/bench_slivers.py            # ~20 min on 2 busy cores; needs ../shared
     python benchmarks/bench_slivers.py --quick    # the 15 top-level records, one seed
-    python benchmarks/bench_slivers.py --variants "near + follow (default)"   # one layout
-    python benchmarks/bench_slivers.py --variants "near + follow (default)" --ns 800,1500 \
+    python benchmarks/bench_slivers.py --variants "near + stages (default)"   # one layout
+    python benchmarks/bench_slivers.py --variants "near + stages (default)" --ns 800,1500 \
         --seeds 8 --only RSN879_LANDERS_LCN345,RSN159_1,RSN250_1,RSN6_2,RSN77_2
     python benchmarks/bench_slivers.py --figure docs/slivers_barcode.png
 
@@ -43,9 +43,17 @@ RECORDS = pathlib.Path(os.environ.get("ROCKING_RECORDS", ROOT.parent / "shared" 
 HEIGHT = 7.5
 DENSE = 6000
 NS = (50, 100, 200, 400, 800, 1500)
-#: layouts of the check: (share log-spaced near w, share placed by the second stage)
-VARIANTS = {"uniform": (0.0, 0.0), "near": (0.5, 0.0), "all near": (1.0, 0.0),
-            "near + follow (default)": (0.5, 0.5)}
+#: layouts of the check (rocking.search.SearchSettings fields): "uniform" all in B, "near" half of
+#: them log-spaced just above w, "all near", and the default, a third placed so (half near) and
+#: two thirds over five later stages where the widths run so far vary most or failed
+VARIANTS = {"uniform": dict(check_near=0.0, check_follow=0.0),
+            "near": dict(check_near=0.5, check_follow=0.0),
+            "all near": dict(check_near=1.0, check_follow=0.0),
+            "near + stages (default)": {},
+            # the later stages' rule varied one setting at a time (docs/slivers.md)
+            "power 2": dict(check_power=2.0), "power 4": dict(check_power=4.0),
+            "50 bins": dict(check_bins=50), "200 bins": dict(check_bins=200),
+            "10 stages": dict(check_stages=10), "first stage 1/4": dict(check_follow=0.75)}
 NEARS = tuple(VARIANTS)
 SEEDS = (1, 2)
 
@@ -62,7 +70,7 @@ def _verdicts(record, widths):
     return _run(record, widths)[0]
 
 
-def _check(record, v, top, near, follow, n, seed):
+def _check(record, v, top, layout, n, seed):
     """The package's check (``rocking.widths``) with these sizes above the verified width ``v``."""
     import dataclasses
 
@@ -70,7 +78,7 @@ def _check(record, v, top, near, follow, n, seed):
     from rocking import widths as rw
 
     res = dataclasses.replace(v)
-    settings = rocking.search.SearchSettings(check_runs=n, check_near=near, check_follow=follow)
+    settings = rocking.search.SearchSettings(check_runs=n, **layout)
     rw._add_check(res, top, lambda x: _run(record, x), settings, seed)
     return res.failing_share, res.widest_failing_width
 
@@ -107,7 +115,7 @@ def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
         for q in nears:
             for n in ns:
                 for s in seeds:
-                    row["checks"][f"{q}/{n}/{s}"] = _check(record, v, top, *VARIANTS[q], n, s)
+                    row["checks"][f"{q}/{n}/{s}"] = _check(record, v, top, VARIANTS[q], n, s)
         out.append(row)
         dense = (max(row["dense_fail"]) / w - 1) * 100 if row["dense_fail"] else 0.0
         print(f"{row['record']:28s} w {w:.4f} m, search {v.runs} runs {t_search:.1f} s, dense "
@@ -188,7 +196,7 @@ def main(argv=None):
     if "--ns" in argv:             # e.g. --ns 800,1500
         ns = tuple(int(n) for n in argv[argv.index("--ns") + 1].split(","))
     nears = NEARS
-    if "--variants" in argv:       # e.g. --variants "near + follow (default)"
+    if "--variants" in argv:       # e.g. --variants "near + stages (default)"
         nears = tuple(argv[argv.index("--variants") + 1].split(","))
     rows = measure(paths, seeds=seeds, nears=nears, ns=ns)
     dump = pathlib.Path(os.environ.get("BENCH_SLIVERS_JSON", "")) if os.environ.get("BENCH_SLIVERS_JSON") else None

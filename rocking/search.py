@@ -58,12 +58,15 @@ class SearchSettings:
     jittered (one random width in each of equal strata; seeded from the record, so a re-run gives
     the same widths; none on the search's grid).  A first stage: a share ``check_near`` of its
     widths uniform in ``log(B / w - 1)`` from ``check_first`` up (failing slivers cluster just
-    above ``w``), the rest uniform in ``B``.  A second stage, a share ``check_follow`` of the
-    runs, over ``check_bins`` equal bins of the span weighted by ``(mean min(max|theta|/alpha,
-    1))**check_power`` of the first stage's widths in each bin (failing slivers far above ``w``
-    sit where neighbouring widths rock hard: on the real records, the ratio averaged over 0.5 %
-    of width around a dense grid's failures is above the 63rd percentile of the span's, on four
-    of six records above the 89th).  0 runs switch the check off.  The sizes were chosen from
+    above ``w``), the rest uniform in ``B``.  Then ``check_stages`` stages share ``check_follow``
+    of the runs, each spread over ``check_bins`` equal bins of the span in proportion to
+    ``q**check_power``, ``q`` the standard deviation of ``min(max|theta|/alpha, 1)`` over the
+    widths run so far in the bin (over the largest bin's), 1 in a bin where a width failed:
+    failing slivers far above ``w`` are points where the response jumps, and they lie where it
+    is irregular from one width to the next, not where the block rocks hardest (on the shared
+    records the ratio next to a failing width is often that of the smooth surroundings, 0.3-0.6,
+    while the bin's spread is among the span's largest).  0 runs switch the check off.  The
+    sizes were chosen from
     ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
     """
 
@@ -87,13 +90,14 @@ class SearchSettings:
     record_near: float = 0.6
     record_rounds: int = 12
     record_chunk: int = 32
-    check_runs: int = 800
+    check_runs: int = 1500
     check_span: float = 2.0
     check_near: float = 0.5
     check_first: float = 1e-4
-    check_follow: float = 0.5
-    check_bins: int = 50
-    check_power: float = 4.0
+    check_follow: float = 2.0 / 3.0
+    check_stages: int = 5
+    check_bins: int = 100
+    check_power: float = 3.0
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -108,9 +112,10 @@ class SearchSettings:
         if not 0.0 < self.check_first < self.check_span - 1.0:
             raise ValueError("SearchSettings.check_first must be in (0, check_span - 1), got "
                              f"{self.check_first!r}")
-        if not 0.0 <= self.check_follow < 1.0 or self.check_bins < 1:
-            raise ValueError("SearchSettings.check_follow must be in [0, 1) and check_bins at "
-                             f"least 1, got {self.check_follow!r}, {self.check_bins!r}")
+        if not 0.0 <= self.check_follow < 1.0 or self.check_bins < 1 or self.check_stages < 1:
+            raise ValueError("SearchSettings.check_follow must be in [0, 1), check_bins and "
+                             f"check_stages at least 1, got {self.check_follow!r}, "
+                             f"{self.check_bins!r}, {self.check_stages!r}")
         if not self.rtol > 0:
             raise ValueError(f"SearchSettings.rtol must be positive, got {self.rtol!r}")
         if self.record_spacing not in ("geometric", "uniform"):

@@ -280,7 +280,7 @@ def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
     """The widths (m, ascending) of the first stage of the check above a verified ``width``
     (docs/slivers.md).
 
-    ``settings.check_runs`` less the second stage's share (``settings.check_follow``, see
+    ``settings.check_runs`` less the later stages' share (``settings.check_follow``, see
     :func:`follow_widths`) widths in ``(width, hi]``, ``hi = min(settings.check_span width,
     top)`` (``top``: the no-uplift width, above which nothing rocks): a share
     ``settings.check_near`` of them uniform in ``log d``, ``d = B / width - 1`` from
@@ -306,30 +306,38 @@ def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
     return np.sort(np.concatenate([near, spread]))
 
 
-def follow_widths(width, top, widths, ratio, settings=DEFAULT_SETTINGS, seed=0):
-    """The widths (m, ascending) of the second stage of the check: ``settings.check_runs`` times
-    ``settings.check_follow`` of them over ``settings.check_bins`` equal bins of the span, each
-    bin's number in proportion to ``m ** settings.check_power``, ``m`` the mean
-    ``min(max|theta|/alpha, 1)`` of the first stage's ``widths`` in it (``ratio``; 1 in a bin
-    that has none), jittered within the bin (``seed`` as for :func:`check_widths`, a stream of
-    its own)."""
-    n = int(settings.check_runs) - _first_runs(settings)
+def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTINGS, seed=0,
+                  stage=1):
+    """The ``n`` widths (m, ascending) of one later stage of the check (docs/slivers.md).
+
+    They are spread over ``settings.check_bins`` equal bins of the span in proportion to
+    ``q ** settings.check_power``, ``q`` the standard deviation of ``min(max|theta|/alpha, 1)``
+    (``ratio``) over the ``widths`` run so far in the bin, divided by the largest bin's, and 1 in
+    a bin where one of them ``failed``: failing slivers far above the verified width are isolated
+    jumps of the response, found where it is irregular from one width to the next (or next to a
+    failure), not where the block merely rocks hard.  Uniform where no bin varies.  Each bin's
+    widths are jittered within it (``seed`` as for :func:`check_widths`; ``stage`` numbers the
+    stream, one per stage)."""
     hi = min(settings.check_span * width, top)
     if n <= 0 or not hi > width * (1.0 + settings.check_first):
         return np.zeros(0)
     k = int(settings.check_bins)
     edges = np.linspace(width, hi, k + 1)
-    widths, ratio = np.asarray(widths, dtype=float), np.minimum(np.asarray(ratio, dtype=float), 1.0)
+    widths = np.asarray(widths, dtype=float)
+    ratio = np.minimum(np.asarray(ratio, dtype=float), 1.0)
     idx = np.clip(np.searchsorted(edges, widths) - 1, 0, k - 1)
-    total = np.bincount(idx, weights=ratio, minlength=k)
-    count = np.bincount(idx, minlength=k)
-    mean = np.where(count > 0, total / np.maximum(count, 1), 1.0)
-    weight = mean ** settings.check_power
+    count = np.maximum(np.bincount(idx, minlength=k), 1)
+    mean = np.bincount(idx, weights=ratio, minlength=k) / count
+    spread = np.sqrt(np.maximum(np.bincount(idx, weights=ratio * ratio, minlength=k) / count
+                                - mean * mean, 0.0))
+    q = spread / spread.max() if spread.max() > 0 else np.zeros(k)
+    q[np.bincount(idx[np.asarray(failed, dtype=bool)], minlength=k) > 0] = 1.0
+    weight = q ** settings.check_power
     weight = weight / weight.sum() if weight.sum() > 0 else np.full(k, 1.0 / k)
     share = weight * n
     alloc = np.floor(share).astype(int)
     alloc[np.argsort(alloc - share, kind="stable")[:n - alloc.sum()]] += 1   # largest remainders
-    rng = np.random.default_rng([seed, 1])
+    rng = np.random.default_rng([seed, stage])
     x = [edges[j] + (edges[j + 1] - edges[j]) * (np.arange(a) + rng.random(a)) / a
          for j, a in enumerate(alloc) if a > 0]
     return np.sort(np.concatenate(x))
@@ -345,12 +353,19 @@ def _record_seed(record, height, criterion, eta, gamma) -> int:
 def _add_check(res, top, evaluate, settings, seed) -> None:
     """Run the check above ``res.width`` (``evaluate(widths)``: verdicts and max|theta|/alpha,
     one batch per stage) and store its outcome in ``res``."""
-    x1 = check_widths(res.width, top, settings, seed)
-    f1, r1 = evaluate(x1) if x1.size else (np.zeros(0, dtype=bool), np.zeros(0))
-    x2 = follow_widths(res.width, top, x1, r1, settings, seed)
-    f2 = evaluate(x2)[0] if x2.size else np.zeros(0, dtype=bool)
-    x = np.concatenate([x1, x2])
-    f = np.concatenate([np.asarray(f1, dtype=bool), np.asarray(f2, dtype=bool)])
+    x = check_widths(res.width, top, settings, seed)
+    f, r = evaluate(x) if x.size else (np.zeros(0, dtype=bool), np.zeros(0))
+    f, r = np.asarray(f, dtype=bool), np.asarray(r, dtype=float)
+    left = int(settings.check_runs) - _first_runs(settings)
+    stages = int(settings.check_stages)
+    for stage in range(1, stages + 1):
+        n = left // (stages - stage + 1)
+        left -= n
+        y = follow_widths(res.width, top, x, r, f, n, settings, seed, stage)
+        if y.size:
+            fy, ry = evaluate(y)
+            x, f, r = (np.concatenate([x, y]), np.concatenate([f, np.asarray(fy, dtype=bool)]),
+                       np.concatenate([r, np.asarray(ry, dtype=float)]))
     order = np.argsort(x, kind="stable")
     x, f = x[order], f[order]
     res.check_top = float(min(settings.check_span * res.width, top))
@@ -358,8 +373,8 @@ def _add_check(res, top, evaluate, settings, seed) -> None:
     res.failing_share = float(f.mean()) if x.size else 0.0
     res.widest_failing_width = float(x[f].max()) if f.any() else None
     res.check_widths, res.check_failed = x, f
-    res.method += (f"; check above it: {x.size} jittered widths up to {res.check_top:.4g} m, "
-                   f"{int(f.sum())} failed"
+    res.method += (f"; check above it: {x.size} jittered widths up to {res.check_top:.4g} m "
+                   f"in {stages + 1} stages, {int(f.sum())} failed"
                    + (f" (widest {res.widest_failing_width:.4g} m)" if f.any() else ""))
 
 

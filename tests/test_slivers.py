@@ -12,7 +12,7 @@ import rocking
 from pulses import G, make_pulse
 from rocking import Block
 from rocking.search import DEFAULT_SETTINGS, SearchSettings
-from rocking.widths import check_widths, follow_widths
+from rocking.widths import _record_seed, check_widths, follow_widths
 
 from .conftest import shared_record
 
@@ -39,8 +39,8 @@ def _chaotic_record(seed=8, duration=20.0, dt=0.01):
 
 def test_check_widths_layout():
     """First stage jittered: one width per stratum of each part, inside the span, none on the
-    search's grid, the same for the same seed and different for another; the second stage puts
-    its widths where the first stage's widths rocked hardest."""
+    search's grid, the same for the same seed and different for another; the later stages put
+    its widths where the widths run so far vary most from one to the next, or failed."""
     s = DEFAULT_SETTINGS
     w, top = 1.0, 1.7                                  # the span ends at the no-uplift width
     x = check_widths(w, top, s, seed=5)
@@ -64,15 +64,31 @@ def test_check_widths_layout():
     # nothing to check where the verified width is the no-uplift width; 0 runs switch it off
     assert check_widths(1.0, 1.0, s).size == 0
     assert check_widths(1.0, 2.0, s.replace(check_runs=0)).size == 0
-    # second stage: first-stage ratios 1 in the bin (1.35, 1.364] and 0.5 elsewhere: that bin
-    # gets 2**power times the others' share (weights (mean ratio)**power), all n_follow placed
-    ratio = np.where((x > 1.35) & (x <= 1.364), 1.0, 0.5)
-    y = follow_widths(w, top, x, ratio, s, seed=5)
-    assert y.size == n_follow and y[0] > w and y[-1] <= top
-    per_bin = np.histogram(y, bins=np.linspace(w, top, s.check_bins + 1))[0]
-    expect = n_follow * 2.0 ** s.check_power / (2.0 ** s.check_power + s.check_bins - 1)
-    assert abs(per_bin[25] - expect) <= 1.0        # largest remainders: within one width
-    assert np.array_equal(y, follow_widths(w, top, x, ratio, s, seed=5))
+    # later stages: two widths in every bin, ratio 0.5 (no spread) except three bins: spread
+    # 0.3 (0.2 and 0.8), spread 0.15 (0.35 and 0.65), and one failing width (weight 1 whatever
+    # its spread); weights q**power, q the spread over the largest: 1, 0.5**power, 1
+    k = s.check_bins
+    edges = np.linspace(w, top, k + 1)
+    widths = np.repeat(edges[:-1], 2) + np.tile([1 / 3, 2 / 3], k) * (edges[1] - edges[0])
+    ratio, failed = np.full(2 * k, 0.5), np.zeros(2 * k, dtype=bool)
+    j1, j2, j3 = int(0.6 * k), int(0.75 * k), int(0.9 * k)
+    ratio[[2 * j1, 2 * j1 + 1]] = 0.2, 0.8
+    ratio[[2 * j2, 2 * j2 + 1]] = 0.35, 0.65
+    ratio[2 * j3], failed[2 * j3] = 1.7, True          # a failure's ratio is capped at 1
+    n = 200
+    y = follow_widths(w, top, widths, ratio, failed, n, s, seed=5)
+    assert y.size == n and y[0] > w and y[-1] <= top
+    per_bin = np.histogram(y, bins=edges)[0]
+    total = 2.0 + 0.5 ** s.check_power
+    for j, q in ((j1, 1.0), (j2, 0.5), (j3, 1.0)):
+        assert abs(per_bin[j] - n * q ** s.check_power / total) <= 1.0   # largest remainders
+    assert per_bin.sum() == per_bin[[j1, j2, j3]].sum()                 # nothing elsewhere
+    assert np.array_equal(y, follow_widths(w, top, widths, ratio, failed, n, s, seed=5))
+    assert not np.array_equal(y, follow_widths(w, top, widths, ratio, failed, n, s, seed=5, stage=2))
+    # no bin varies and none failed: uniform over the bins
+    even = np.histogram(follow_widths(w, top, widths, np.full(2 * k, 0.5), np.zeros(2 * k, bool),
+                                      2 * k, s, seed=5), bins=edges)[0]
+    assert np.all(even == 2)
     with pytest.raises(ValueError):
         SearchSettings(check_near=1.5)
     with pytest.raises(ValueError):
@@ -103,12 +119,17 @@ def test_check_against_dense_scans_synthetic():
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
                            model="reference", history=False)
     assert ref.overturned
-    # the check's log-spaced widths in d = B/w - 1 in [1e-4, 1e-2] against 1500 log-spaced widths
-    # of the same stretch (an independent deterministic grid): the check's count of failures
-    # there is binomial with the grid's share p; 4 standard deviations plus 2 for the grid's own
-    # sampling error (a 1500-point estimate of p) bound it (a chance of ~1e-4 to fail by luck)
+    # the first stage's log-spaced widths in d = B/w - 1 in [1e-4, 1e-2] (the later stages place
+    # theirs by what it found, so only the first stage is an unbiased sample) against 1500
+    # log-spaced widths of the same stretch (an independent deterministic grid): the check's
+    # count of failures there is binomial with the grid's share p; 4 standard deviations plus 2
+    # for the grid's own sampling error (a 1500-point estimate of p) bound it (a chance of ~1e-4
+    # to fail by luck)
+    first = check_widths(res.width, top, DEFAULT_SETTINGS,
+                         _record_seed(rec, height, "overturn", None, 0.0))
+    assert np.isin(first, res.check_widths).all()
     d = res.check_widths / res.width - 1.0
-    sel = (d >= 1e-4) & (d <= 1e-2)
+    sel = (d >= 1e-4) & (d <= 1e-2) & np.isin(res.check_widths, first)
     m, k = int(sel.sum()), int(res.check_failed[sel].sum())
     grid = res.width * (1.0 + np.geomspace(1e-4, 1e-2, 1500))
     p = _verdicts(height, rec, grid).mean()
