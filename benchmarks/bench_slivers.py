@@ -44,8 +44,9 @@ HEIGHT = 7.5
 DENSE = 6000
 NS = (50, 100, 200, 400, 800, 1500)
 #: layouts of the check (rocking.search.SearchSettings fields): "uniform" all in B, "near" half of
-#: them log-spaced just above w, "all near", and the default, a third placed so (half near) and
-#: two thirds over five later stages where the widths run so far vary most or failed
+#: them log-spaced just above w, "all near", and the default, a fifth placed so (half near) and
+#: four fifths over five later stages where the widths run so far (the search's included) vary
+#: most or failed
 VARIANTS = {"uniform": dict(check_near=0.0, check_follow=0.0),
             "near": dict(check_near=0.5, check_follow=0.0),
             "all near": dict(check_near=1.0, check_follow=0.0),
@@ -53,7 +54,8 @@ VARIANTS = {"uniform": dict(check_near=0.0, check_follow=0.0),
             # the later stages' rule varied one setting at a time (docs/slivers.md)
             "power 2": dict(check_power=2.0), "power 4": dict(check_power=4.0),
             "50 bins": dict(check_bins=50), "200 bins": dict(check_bins=200),
-            "10 stages": dict(check_stages=10), "first stage 1/4": dict(check_follow=0.75)}
+            "10 stages": dict(check_stages=10), "first stage 1/3": dict(check_follow=2.0 / 3.0),
+            "first stage 1/4": dict(check_follow=0.75)}
 NEARS = tuple(VARIANTS)
 SEEDS = (1, 2)
 
@@ -70,7 +72,7 @@ def _verdicts(record, widths):
     return _run(record, widths)[0]
 
 
-def _check(record, v, top, layout, n, seed):
+def _check(record, v, seen, top, layout, n, seed):
     """The package's check (``rocking.widths``) with these sizes above the verified width ``v``."""
     import dataclasses
 
@@ -79,7 +81,7 @@ def _check(record, v, top, layout, n, seed):
 
     res = dataclasses.replace(v)
     settings = rocking.search.SearchSettings(check_runs=n, **layout)
-    rw._add_check(res, top, lambda x: _run(record, x), settings, seed)
+    rw._add_check(res, top, lambda x: _run(record, x), settings, seed, seen)
     return res.failing_share, res.widest_failing_width
 
 
@@ -89,16 +91,19 @@ def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
     import pulses
     import rocking
     from pulses import G
+    from rocking import widths as rw
     out = []
     cache = os.environ.get("BENCH_SLIVERS_DENSE")        # an earlier run's JSON: its dense grids
     cached = {r["record"]: r for r in json.loads(pathlib.Path(cache).read_text())} if cache else {}
     for path in paths:
         record = pulses.read_record(path)
         t = time.perf_counter()
-        v = rocking.required_width(HEIGHT, record, rule="exact",
-                                   settings=rocking.search.SearchSettings(check_runs=0))
+        top = HEIGHT * (record.pga / G)       # as required_width computes it, to the last bit
+        # the search as required_width runs it, keeping its widths (the check's later stages
+        # measure the spread over them too)
+        v, seen = rw._record_search(HEIGHT, top, lambda x: _run(record, x), criterion="overturn",
+                                    eta=None, settings=rocking.search.SearchSettings(check_runs=0))
         t_search = time.perf_counter() - t
-        top = HEIGHT * record.pga / G
         w = v.width
         hi = min(2.0 * w, top)
         old = cached.get(pathlib.Path(path).stem)
@@ -115,7 +120,7 @@ def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
         for q in nears:
             for n in ns:
                 for s in seeds:
-                    row["checks"][f"{q}/{n}/{s}"] = _check(record, v, top, VARIANTS[q], n, s)
+                    row["checks"][f"{q}/{n}/{s}"] = _check(record, v, seen, top, VARIANTS[q], n, s)
         out.append(row)
         dense = (max(row["dense_fail"]) / w - 1) * 100 if row["dense_fail"] else 0.0
         print(f"{row['record']:28s} w {w:.4f} m, search {v.runs} runs {t_search:.1f} s, dense "

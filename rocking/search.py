@@ -61,7 +61,8 @@ class SearchSettings:
     above ``w``), the rest uniform in ``B``.  Then ``check_stages`` stages share ``check_follow``
     of the runs, each spread over ``check_bins`` equal bins of the span in proportion to
     ``q**check_power``, ``q`` the standard deviation of ``min(max|theta|/alpha, 1)`` over the
-    widths run so far in the bin (over the largest bin's), 1 in a bin where a width failed:
+    widths run so far in the bin, the search's own widths above ``w`` included (over the largest
+    bin's), 1 in a bin where a width failed:
     failing slivers far above ``w`` are points where the response jumps, and they lie where it
     is irregular from one width to the next, not where the block rocks hardest (on the shared
     records the ratio next to a failing width is often that of the smooth surroundings, 0.3-0.6,
@@ -94,7 +95,7 @@ class SearchSettings:
     check_span: float = 2.0
     check_near: float = 0.5
     check_first: float = 1e-4
-    check_follow: float = 2.0 / 3.0
+    check_follow: float = 0.8
     check_stages: int = 5
     check_bins: int = 100
     check_power: float = 3.0

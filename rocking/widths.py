@@ -221,14 +221,14 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
             return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
 
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
-        res = _record_width(height, top, evaluate_record, criterion=criterion, eta=eta,
-                            settings=settings)
+        res, seen = _record_search(height, top, evaluate_record, criterion=criterion, eta=eta,
+                                   settings=settings)
         res.cap_mass_ratio = gamma
         if vertical is not None:
             res.method += "; with the vertical record (compiled engine, fast-vertical)"
         if not res.below_scan and settings.check_runs > 0:
             _add_check(res, top, evaluate_record, settings,
-                       _record_seed(excitation, height, criterion, eta, gamma))
+                       _record_seed(excitation, height, criterion, eta, gamma), seen)
         return res
     settings = settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol)
     x = _scan_points(np.array([top]), settings.n_scan, settings.n_tail)
@@ -312,7 +312,8 @@ def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTING
 
     They are spread over ``settings.check_bins`` equal bins of the span in proportion to
     ``q ** settings.check_power``, ``q`` the standard deviation of ``min(max|theta|/alpha, 1)``
-    (``ratio``) over the ``widths`` run so far in the bin, divided by the largest bin's, and 1 in
+    (``ratio``) over the ``widths`` run so far in the bin (those outside the span are left
+    out), divided by the largest bin's, and 1 in
     a bin where one of them ``failed``: failing slivers far above the verified width are isolated
     jumps of the response, found where it is irregular from one width to the next (or next to a
     failure), not where the block merely rocks hard.  Uniform where no bin varies.  Each bin's
@@ -324,14 +325,16 @@ def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTING
     k = int(settings.check_bins)
     edges = np.linspace(width, hi, k + 1)
     widths = np.asarray(widths, dtype=float)
-    ratio = np.minimum(np.asarray(ratio, dtype=float), 1.0)
-    idx = np.clip(np.searchsorted(edges, widths) - 1, 0, k - 1)
+    inside = (widths > width) & (widths <= hi)
+    ratio = np.minimum(np.asarray(ratio, dtype=float), 1.0)[inside]
+    failed = np.asarray(failed, dtype=bool)[inside]
+    idx = np.clip(np.searchsorted(edges, widths[inside]) - 1, 0, k - 1)
     count = np.maximum(np.bincount(idx, minlength=k), 1)
     mean = np.bincount(idx, weights=ratio, minlength=k) / count
     spread = np.sqrt(np.maximum(np.bincount(idx, weights=ratio * ratio, minlength=k) / count
                                 - mean * mean, 0.0))
     q = spread / spread.max() if spread.max() > 0 else np.zeros(k)
-    q[np.bincount(idx[np.asarray(failed, dtype=bool)], minlength=k) > 0] = 1.0
+    q[np.bincount(idx[failed], minlength=k) > 0] = 1.0
     weight = q ** settings.check_power
     weight = weight / weight.sum() if weight.sum() > 0 else np.full(k, 1.0 / k)
     share = weight * n
@@ -350,18 +353,25 @@ def _record_seed(record, height, criterion, eta, gamma) -> int:
     return int.from_bytes(h.digest()[:8], "little")
 
 
-def _add_check(res, top, evaluate, settings, seed) -> None:
+def _add_check(res, top, evaluate, settings, seed, seen=None) -> None:
     """Run the check above ``res.width`` (``evaluate(widths)``: verdicts and max|theta|/alpha,
-    one batch per stage) and store its outcome in ``res``."""
+    one batch per stage) and store its outcome in ``res``.  ``seen``: ``(widths, failed,
+    ratio)`` already run by the search; those above the verified width (all survived) join the
+    later stages' measure of the spread at no cost."""
     x = check_widths(res.width, top, settings, seed)
     f, r = evaluate(x) if x.size else (np.zeros(0, dtype=bool), np.zeros(0))
     f, r = np.asarray(f, dtype=bool), np.asarray(r, dtype=float)
+    if seen is None:
+        seen = (np.zeros(0), np.zeros(0, dtype=bool), np.zeros(0))
+    above = np.asarray(seen[0], dtype=float) > res.width
+    sx, sf, sr = (np.asarray(v)[above] for v in seen)
     left = int(settings.check_runs) - _first_runs(settings)
     stages = int(settings.check_stages)
     for stage in range(1, stages + 1):
         n = left // (stages - stage + 1)
         left -= n
-        y = follow_widths(res.width, top, x, r, f, n, settings, seed, stage)
+        y = follow_widths(res.width, top, np.concatenate([x, sx]), np.concatenate([r, sr]),
+                          np.concatenate([f, sf.astype(bool)]), n, settings, seed, stage)
         if y.size:
             fy, ry = evaluate(y)
             x, f, r = (np.concatenate([x, y]), np.concatenate([f, np.asarray(fy, dtype=bool)]),
@@ -384,7 +394,14 @@ DOWN_HALVINGS = 40
 
 
 def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SETTINGS):
+    """Verified width under a record (:func:`_record_search`'s answer without its widths)."""
+    return _record_search(height, top, evaluate, criterion=criterion, eta=eta, settings=settings)[0]
+
+
+def _record_search(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SETTINGS):
     """Verified width under a record: the smallest width above which every scanned width survives.
+    Returns ``(RequiredWidth, (widths, failed, ratio))``, the second the widths run (ascending)
+    with their verdicts and ``max|theta|/alpha``.
 
     A record's verdict can change hundreds of times with the width (slender columns rock
     chaotically; real records have isolated failing bands well above the main transition), so
@@ -446,7 +463,8 @@ def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SET
     return RequiredWidth(
         width=float(width), height=height, rule="exact", iterations=pts.calls,
         method=_method(xs.size, top, rounds, limited, below_scan, pts, s),
-        criterion=criterion, transitions=transitions, runs=pts.runs, eta=eta, below_scan=below_scan)
+        criterion=criterion, transitions=transitions, runs=pts.runs, eta=eta,
+        below_scan=below_scan), pts.sorted()
 
 
 def _scan_widths(top, s):

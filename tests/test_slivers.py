@@ -133,7 +133,7 @@ def test_check_against_dense_scans_synthetic():
     m, k = int(sel.sum()), int(res.check_failed[sel].sum())
     grid = res.width * (1.0 + np.geomspace(1e-4, 1e-2, 1500))
     p = _verdicts(height, rec, grid).mean()
-    assert m > 100 and 0.0 < p < 1.0
+    assert m > 50 and 0.0 < p < 1.0
     sigma = math.sqrt(m * p * (1 - p)) + math.sqrt(m * m * p * (1 - p) / grid.size)
     assert abs(k - m * p) <= 4.0 * sigma + 2.0, (k, m, p)
 
@@ -188,3 +188,34 @@ def test_pipeline_reports_the_check(tmp_path):
     text = (out / "columns.md").read_text()
     assert "`widest_failing_width_m`" in text and "docs/slivers.md" in text
     assert "plots/widths/<record>.png" in text
+
+
+def test_check_uses_the_search_widths():
+    """The later stages measure the spread over the search's widths above the verified width too
+    (at no cost): a model response with no spread anywhere but in the search's widths of one bin
+    sends the later stages there; without them the stages spread evenly."""
+    from rocking.widths import _add_check
+
+    s = DEFAULT_SETTINGS.replace(check_runs=500)
+    w, top = 1.0, 3.0                                 # the span is (1, 2]: bins of 0.01
+
+    def flat(x):                                      # every width survives, ratio 0.5
+        return np.zeros(np.size(x), dtype=bool), np.full(np.size(x), 0.5)
+
+    k = s.check_bins
+    edges = np.linspace(w, 2.0 * w, k + 1)
+    j = int(0.4 * k)
+    seen_x = np.concatenate([[0.5, 2.5], edges[j] + np.array([0.2, 0.4, 0.6, 0.8]) * (edges[1] - edges[0])])
+    seen = (seen_x, np.zeros(seen_x.size, dtype=bool), np.array([0.9, 0.1, 0.2, 0.8, 0.3, 0.7]))
+    n_later = s.check_runs - (s.check_runs - round(s.check_follow * s.check_runs))
+    first = check_widths(w, top, s, seed=3)
+    for known, expect in ((seen, n_later), (None, n_later / k)):
+        res = rocking.RequiredWidth(w, 7.5, "exact", 0, "test")
+        _add_check(res, top, flat, s, 3, known)
+        later = res.check_widths[~np.isin(res.check_widths, first)]
+        assert later.size == n_later and res.check_runs == s.check_runs
+        in_bin = int(np.sum((later > edges[j]) & (later <= edges[j + 1])))
+        # all later widths in that bin (the widths below w and above the span are left out);
+        # without the search's widths, the even share of one bin (within one: largest remainders)
+        assert abs(in_bin - expect) <= 1.0, (known is None, in_bin, expect)
+    assert res.widest_failing_width is None and res.failing_share == 0.0
