@@ -6,6 +6,7 @@
     python benchmarks/bench_slivers.py --variants "near + stages (default)" --ns 800,1500 \
         --seeds 8 --only RSN879_LANDERS_LCN345,RSN159_1,RSN250_1,RSN6_2,RSN77_2
     python benchmarks/bench_slivers.py --figure docs/slivers_barcode.png
+    python benchmarks/bench_slivers.py --variants "near + stages (default)" --ns 1500 --seeds 8 --height 12
 
 The verified width ``w`` (``rocking.required_width(H, record, rule="exact")``) is followed by a
 check of ``check_runs`` jittered widths above it (docs/slivers.md).  For every real record of
@@ -182,8 +183,11 @@ def figure(path, name="RSN879_LANDERS_LCN345.AT2", n=6000):
 
 
 def main(argv=None):
+    global HEIGHT
     argv = sys.argv[1:] if argv is None else argv
     quick = "--quick" in argv
+    if "--height" in argv:         # e.g. --height 12: another column height (m)
+        HEIGHT = float(argv[argv.index("--height") + 1])
     if not RECORDS.is_dir():
         print(f"no records at {RECORDS} (set $ROCKING_RECORDS)")
         return 1
