@@ -97,5 +97,6 @@ def measure(quick):
     else:
         log("  `pipeline simulate` not available: " + (probe.stderr.strip().splitlines() or ["?"])[-1])
     return dict(length=rows, batch=brows, spectrum=spec, spectrum_1thread=spec1, cold=cold, record=base.name,
-                usual_max=usual_max, threads=threads, n_spectrum=3 if not quick else 1,
+                usual_max=usual_max, threads=threads, parallel_min=lanes.PARALLEL_MIN_RUNS,
+                n_spectrum=3 if not quick else 1,
                 n_cold=3 if quick else 5)

@@ -3,13 +3,9 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import pathlib
-import subprocess
-import sys
-import time
 
-from benchmarks.common import ROOT, log
+from benchmarks.common import log
 
 
 def measure(quick):
@@ -47,12 +43,6 @@ def measure(quick):
                                       "-q", "--jobs", "1"])
         res["cold_jobs1"] = n / cold1
         log(f"  cold (fresh process), --jobs 1: {res['cold_jobs1']:.2f} records/s")
-        env = dict(os.environ, NUMBA_NUM_THREADS="1")
-        t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "pipeline", "run", *recs, *bp.COLUMNS, "--out", str(tmp / "c2t1"),
-                        "--no-plots", "-q", "--jobs", "2"], capture_output=True, env=env, cwd=str(ROOT))
-        res["cold_jobs2_t1"] = n / (time.perf_counter() - t0)
-        log(f"  cold, --jobs 2, NUMBA_NUM_THREADS=1: {res['cold_jobs2_t1']:.2f} records/s")
         # compared between the two fresh processes (they load the same code; the in-process run
         # may hold modules loaded before another engineer's edit of the working tree)
         res["identical"] = all((tmp / "c1" / f).read_bytes() == (tmp / "c2" / f).read_bytes()

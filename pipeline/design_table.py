@@ -137,6 +137,34 @@ def _m(value):
     return "-" if v is None else f"{v:.3f}"
 
 
+def excess_text(value, verified) -> str | None:
+    """``+2.5 %``: how far the width ``value`` lies above the ``verified`` width, relative to it.
+
+    Whole percent from 10 % (``+25 %``), tenths from 1 % (``+2.5 %``), hundredths below
+    (``+0.25 %``, ``+0.02 %``) and ``<+0.01 %`` below 0.01 %, so that a failing width a hair above
+    the verified one never reads as ``+0.0 %``.  None when either is blank or ``value`` is not
+    above ``verified``.
+    """
+    v, ref = number(value), number(verified)
+    if v is None or ref is None or ref <= 0 or v <= ref:
+        return None
+    pct = 100.0 * (v - ref) / ref
+    if pct < 0.01:
+        return "<+0.01 %"
+    return f"+{pct:.{0 if pct >= 10 else 1 if pct >= 1 else 2}f} %"
+
+
+def failing_text(value, verified, unit=" m") -> str | None:
+    """``0.608 m (+2.5 %)``: a failing width with how far it lies above the verified width
+    (:func:`excess_text`; metres only where that is blank); None where ``value`` is blank.
+    ``unit=""`` gives ``0.608 (+2.5 %)`` for a column headed in metres."""
+    v = number(value)
+    if v is None:
+        return None
+    excess = excess_text(v, verified)
+    return f"{v:.3f}{unit}" + (f" ({excess})" if excess else "")
+
+
 def pulse_text(row) -> str:
     """``sine +0.71g 0.80s``: the governing pulse of a design row."""
     shape, ap, tp = row.get("governing_shape"), number(row.get("governing_ap_g")), number(row.get("governing_tp_s"))
@@ -170,7 +198,7 @@ def table_cells(row) -> tuple[str, ...]:
     return (name, display(row.get("column") or "-"), _yes(row.get("pulse_like")), pulse_text(row),
             _m(row.get("eq31_width_m")) + (" m" if number(row.get("eq31_width_m")) is not None else ""),
             _m(row.get("verified_width_m")) + (" m" if number(row.get("verified_width_m")) is not None else ""),
-            _m(row.get("widest_failing_width_m")) + (" m" if number(row.get("widest_failing_width_m")) is not None else ""),
+            failing_text(row.get("widest_failing_width_m"), row.get("verified_width_m")) or "-",
             survives_text(row))
 
 
@@ -201,6 +229,20 @@ def metadata_text(row) -> str | None:
     return display(parts[0] + (": " + ", ".join(site) if site else ""))
 
 
+#: the index of "fails above" in :data:`HEADERS`
+FAILS_COLUMN = HEADERS.index("fails above")
+
+
+def _align_failing(body, col):
+    """``body`` with the cells of column ``col`` (``0.608 m (+2.5 %)`` or ``-``) padded so that
+    their metres line up on the decimal point and their percentages start in one place."""
+    parts = [c[col].partition(" (") for c in body]
+    head = max((len(h) for h, _, _ in parts), default=0)
+    tail = max((len(sep + t) for _, sep, t in parts), default=0)
+    return [c[:col] + (h.rjust(head) + (sep + t).ljust(tail),) + c[col + 1:]
+            for c, (h, sep, t) in zip(body, parts)]
+
+
 def table_text(rows, failures=(), summary=()) -> str:
     """The compact table printed at the end of ``pipeline run``: every design row, then every failed
     record (``failures``: rows of ``failures.csv``) with its reason, then the search report's
@@ -220,6 +262,7 @@ def table_text(rows, failures=(), summary=()) -> str:
         body = [c + (_vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
                                           if (r["record"], r.get("column")) in widths else ""),)
                 for c, r in zip(body, rows)]
+    body = _align_failing(body, FAILS_COLUMN)
     widths = [max([len(h)] + [len(c[i]) for c in body]) for i, h in enumerate(headers)]
     right = {4, 5, 6}  # widths, aligned on the decimal point
 

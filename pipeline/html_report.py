@@ -16,7 +16,7 @@ import pathlib
 import urllib.parse
 
 from . import report
-from .design_table import metadata_text, pulse_text, survives_text
+from .design_table import failing_text, metadata_text, pulse_text, survives_text
 from .design_table import number as _num
 
 #: the file in ``--out``
@@ -137,7 +137,8 @@ def _batch_table(design, anchors) -> list[str]:
             + _cell(r["governing_tp_s"], _fixed(r["governing_tp_s"], 3), numeric=True)
             + _cell(r["eq31_width_m"], _fixed(r["eq31_width_m"]), numeric=True)
             + _cell(r["verified_width_m"], _fixed(r["verified_width_m"]), numeric=True)
-            + _cell(r.get("widest_failing_width_m"), _fixed(r.get("widest_failing_width_m")), numeric=True)
+            + _cell(r.get("widest_failing_width_m"),
+                    failing_text(r.get("widest_failing_width_m"), r["verified_width_m"], unit=""), numeric=True)
             + _cell(r["width_m"], _fixed(r["width_m"]), numeric=True)
             + _cell(surv if r["survives"] is not None else None, surv)
             + (_cell(r.get("survives_vertical"), _yes(r.get("survives_vertical"))) if vertical else "")
@@ -183,7 +184,8 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                 share = _num(r.get("failing_share"))
                 parts.append(f"check above it: {r.get('check_runs')} widths, "
                              + (f"{100 * share:.2g} % overturn, the widest at "
-                                f"{_fixed(r.get('widest_failing_width_m'))} m" if share else "none overturns"))
+                                + (failing_text(r.get("widest_failing_width_m"), r.get("verified_width_m")) or "-")
+                                if share else "none overturns"))
             if r.get("column_kind") == "block":
                 surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
                                       "verified_adequate": r.get("verified_adequate")})

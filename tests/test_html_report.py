@@ -74,6 +74,19 @@ def test_printed_table_and_design_csv(demo):
         assert line.startswith(row["record"])
         assert f"{float(row['verified_width_m']):.3f} m" in line
         assert f"{float(row['eq31_width_m']):.3f} m" in line
+        # the widest failing width with its excess over the verified width, or a dash
+        if row["widest_failing_width_m"]:
+            fail, verified = float(row["widest_failing_width_m"]), float(row["verified_width_m"])
+            m = re.search(re.escape(f"{fail:.3f} m (") + r"(<?)\+([\d.]+) %\)", line)
+            assert m, line
+            pct = 100 * (fail - verified) / verified
+            if m.group(1):
+                assert pct < 0.01
+            else:  # the percentage shown is the excess rounded to its last digit
+                decimals = len(m.group(2).partition(".")[2])
+                assert abs(float(m.group(2)) - pct) <= 0.5 * 10 ** -decimals + 1e-9, (m.group(0), pct)
+        else:
+            assert "%)" not in line
         assert line.rstrip().endswith({"True": "yes" if row["verified_adequate"] == "True" else "yes, safe island",
                                        "False": "NO"}[row["survives"]])
     # the files are the run's own: listed in the manifest (so a re-run may replace them)
@@ -155,6 +168,29 @@ def test_design_rows_of_a_pair():
     assert design_table.survives_text(d) == "NO"
     text = design_table.table_text([d])
     assert "A+B @90deg" in text and "1.900 m" in text
+
+
+def test_report_html_says_how_far_above_the_verified_width_a_column_fails():
+    """The batch table's widest failing width and each record's check line carry its excess over
+    the verified width in percent: far above, a hair above (equal to 3 decimals), none found."""
+    base = dict(column="7.5x1.8", column_kind="block", width_m=1.8, scale=1.0, pulse_like=True,
+                velocity_tp_s=1.2, governing_shape="sine", governing_ap_g=0.5, governing_tp_s=0.8,
+                eq31_width_m=2.0, eq31_width_overturns=False, direction_deg=None, overturns=False,
+                verified_adequate=True, max_theta_ratio=0.3, verified_width_m=0.593, check_runs=40)
+    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05),
+            dict(base, record="tiny", widest_failing_width_m=0.593 * 1.00012, failing_share=0.025),
+            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0)]
+    design = design_table.design_rows(rows)
+    page = html_report.report_html(design, rows, [], ["far", "tiny", "none"], {})
+    cells = {r: re.search(rf'<tr><td data-v="{r}">.*?</tr>', page).group(0) for r in ("far", "tiny", "none")}
+    # the cell shows metres and percent, and sorts by the number in metres
+    assert '<td class="n" data-v="0.608">0.608 (+2.5 %)</td>' in cells["far"]
+    assert re.search(r'<td class="n" data-v="0\.593\d+">0\.593 \(\+0\.01 %\)</td>', cells["tiny"])
+    assert '<td class="n" data-v="">-</td>' in cells["none"] and "%)" not in cells["none"]
+    assert "5 % overturn, the widest at 0.608 m (+2.5 %)" in page
+    assert "2.5 % overturn, the widest at 0.593 m (+0.01 %)" in page
+    assert "check above it: 40 widths, none overturns" in page
+    assert html_report.report_html(design, rows, [], ["far", "tiny", "none"], {}) == page
 
 
 # -- in a real browser -----------------------------------------------------------------------------
