@@ -144,16 +144,22 @@ def refine_gaps(pts, step, resolution, near, max_rounds) -> None:
         pts.add(0.5 * (x[m] + x[m + 1]))
 
 
+def bisect(pts, lo, hi, rtol, fails_low):
+    """Bisect the bracket ``lo < hi`` (its ends of different verdicts; ``fails_low``: the ``lo``
+    end fails) by adding points to ``pts`` until narrower than ``rtol`` relative; the bracket."""
+    while hi - lo > rtol * hi:
+        mid = 0.5 * (lo + hi)
+        if pts.add([mid])[0] == fails_low:
+            lo = mid
+        else:
+            hi = mid
+    return lo, hi
+
+
 def bisect_first(pts, rtol) -> float:
     """Bisect the bracket below the lowest failure (the first point survives) until narrower than
     ``rtol`` relative; return its failing end."""
     x, f, _ = pts.sorted()
     j = np.nonzero(f)[0][0]
     lo, hi = x[j - 1], x[j]                    # x[0] survives, so j >= 1
-    while hi - lo > rtol * hi:
-        mid = 0.5 * (lo + hi)
-        if pts.add([mid])[0]:
-            hi = mid
-        else:
-            lo = mid
-    return float(hi)
+    return float(bisect(pts, lo, hi, rtol, fails_low=False)[1])

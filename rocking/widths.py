@@ -456,7 +456,7 @@ def _record_search(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SE
     br, rounds, limited = _rounds(pts, br, top, s)
     width, below_scan = narrowest, True
     if br is not None:
-        width, below_scan = _bisect(pts, *_top_bracket(pts), s.rtol)[1], False
+        width, below_scan = scan.bisect(pts, *_top_bracket(pts), s.rtol, fails_low=True)[1], False
     x, f, _ = pts.sorted()
     ch = np.nonzero(f[1:] != f[:-1])[0]
     transitions = tuple(float(t) for t in 0.5 * (x[ch] + x[ch + 1]))
@@ -486,7 +486,7 @@ def _rounds(pts, br, top, s):
     rounds = 0
     while br is not None and rounds < s.record_rounds:
         rounds += 1
-        lo, hi = _bisect(pts, *br, max(s.record_zone_first / 4.0, rtol))
+        lo, hi = scan.bisect(pts, *br, max(s.record_zone_first / 4.0, rtol), fails_low=True)
         found = False
         if n_zone > 0:
             z = hi * (1.0 + np.geomspace(s.record_zone_first, s.record_zone_fraction, int(n_zone)))
@@ -530,17 +530,6 @@ def _top_bracket(pts):
         return None
     j = np.nonzero(f)[0][-1]
     return x[j], x[j + 1]                     # x[-1] = top survives, so j + 1 exists
-
-
-def _bisect(pts, lo, hi, tol):
-    """Bisect a bracket whose narrow end fails to ``tol`` relative."""
-    while hi - lo > tol * hi:
-        mid = 0.5 * (lo + hi)
-        if pts.add([mid])[0]:
-            lo = mid
-        else:
-            hi = mid
-    return lo, hi
 
 
 def _near_gaps(pts, w, s):

@@ -4,7 +4,6 @@ exact similarity of a constant vertical, free flight, and the shared PEER record
 from __future__ import annotations
 
 import math
-import pathlib
 
 import numpy as np
 import pytest
@@ -15,22 +14,11 @@ from pulses import G
 from rocking.reference import simulate_reference
 from rocking.reference_vertical import check_axes, simulate_vertical_reference
 
-DOWNLOAD = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "records" / "peer_download"
+from .vertical_cases import BLOCKS, DOWNLOAD, record
+
 #: both integrators run DOP853 at rtol 1e-12 and locate their events to ~1e-15 s: their peak
 #: rotations agree far better than 1e-6 of alpha, the floor asked of the solvers
 TOL_ALPHA = 1e-6
-
-
-def record(seed=0, ap_g=0.35, tp=1.0, dt=0.01, duration=6.0):
-    """A one-sine pulse with a little high-frequency motion: uplift, impacts, free rocking."""
-    t = np.arange(0.0, duration, dt)
-    rng = np.random.default_rng(seed)
-    acc = pulses.make_pulse("sine", ap_g * G, tp, 0.5)(t) + 0.02 * G * np.sin(7 * t + rng.uniform(0, 6))
-    return pulses.Record(acc, dt)
-
-
-BLOCKS = [rocking.Block.from_dimensions(3.0, 0.6), rocking.Block.from_dimensions(3.0, 0.9),
-          rocking.Block.from_dimensions(7.5, 1.8)]
 
 
 @pytest.mark.slow

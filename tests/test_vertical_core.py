@@ -6,7 +6,6 @@ with located events) on real three-component PEER records and on free flight."""
 from __future__ import annotations
 
 import math
-import pathlib
 
 import numpy as np
 import pytest
@@ -18,25 +17,13 @@ from rocking import engine
 from rocking._common import ZENO_TOL
 from rocking.reference_vertical import simulate_vertical_reference
 
-DOWNLOAD = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "records" / "peer_download"
+from .vertical_cases import BLOCKS, DOWNLOAD, IDS, record
+
 #: the floor of issue 28: peak rotations within 1e-6 of alpha.  The compiled Taylor steps are
 #: exact to rounding and the reference runs DOP853 at rtol 1e-12; measured deviations are 1e-17 to
 #: 6e-8 of alpha (the largest where the verdict comes from the energy rule after the record and
 #: the reference integrates the free rocking to its first peak instead)
 TOL_ALPHA = 1e-6
-
-
-def record(seed=0, ap_g=0.35, tp=1.0, dt=0.01, duration=6.0):
-    """A one-sine pulse with a little high-frequency motion: uplift, impacts, free rocking."""
-    t = np.arange(0.0, duration, dt)
-    rng = np.random.default_rng(seed)
-    acc = pulses.make_pulse("sine", ap_g * G, tp, 0.5)(t) + 0.02 * G * np.sin(7 * t + rng.uniform(0, 6))
-    return pulses.Record(acc, dt)
-
-
-BLOCKS = [rocking.Block.from_dimensions(3.0, 0.6), rocking.Block.from_dimensions(3.0, 0.9),
-          rocking.Block.from_dimensions(7.5, 1.8)]
-IDS = ["overturns", "rocks", "stands-tall"]
 
 
 @pytest.mark.parametrize("history", [True, False])

@@ -12,7 +12,8 @@ import pulses
 import rocking
 from pipeline.cli import main
 
-DOWNLOAD = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "records" / "peer_download"
+from .vertical_cases import DOWNLOAD
+
 RUN_ARGS = ["--block", "3x0.3", "--shapes", "sine", "--no-plots", "--quiet"]
 #: RSN 41 (Lytle Creek, Castaic): short (3203 samples), a DWN vertical
 H1, H2, V = "RSN41_LYTLECR_ORR021.AT2", "RSN41_LYTLECR_ORR291.AT2", "RSN41_LYTLECR_ORRDWN.AT2"
