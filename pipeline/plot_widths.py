@@ -9,6 +9,8 @@ import io
 
 import numpy as np
 
+from .design_table import excess_text
+
 #: dots per inch; the figures are 9 in wide: 1350 px
 DPI = 150
 WIDTH_IN = 9.0
@@ -63,7 +65,7 @@ def widths_figure(title, width, widths, failed, widest_failing=None, near=0.05):
     if widest_failing is not None:
         ax1.axvline(widest_failing, color=FAIL, lw=2, ls="--",
                     label=f"widest failing width {widest_failing:.4g} m "
-                          f"(+{100 * (widest_failing / width - 1):.2g} %)")
+                          f"({excess_text(widest_failing, width)})")
     ax1.set_xlabel("column width B (m): red overturns, green survives")
     ax1.set_title(f"{title}: {x.size} widths, {int(f.sum())} overturn, "
                   f"{int(above.sum())} of them above the verified width", fontsize=9)
@@ -101,7 +103,8 @@ def record_widths_png(record_id, verified) -> bytes | None:
         ax.set_xscale("log")
         ax.set_xlim(max(1e-3, 0.5 * (x[0] - v.width) * pct), (v.check_top - v.width) * pct)
         ax.axvline((v.widest_failing_width - v.width) * pct, color=FAIL, lw=2, ls="--",
-                   label=f"widest failing width {v.widest_failing_width:.4g} m")
+                   label=f"widest failing width {v.widest_failing_width:.4g} m "
+                         f"({excess_text(v.widest_failing_width, v.width)})")
         ax.set_title(f"{record_id}, column height {label}: verified width {v.width:.4g} m; the check "
                      f"above it: {x.size} widths, {int(f.sum())} overturn (share "
                      f"{v.failing_share:.3g})", fontsize=9)
