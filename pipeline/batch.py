@@ -76,7 +76,7 @@ def _process_record(task: Task) -> dict:
             raise KeyboardInterrupt from exc
         out["failure"] = failure(task, "internal", exc)
         return out
-    if task.options.plots:
+    if task.options.plots and task.plot:
         from .plots import run_figure_png
 
         try:
@@ -438,7 +438,10 @@ def _process(task: Task):
     for c in candidates:  # candidates are ranked: keep the best of each shape
         by_shape.setdefault(c.shape, c)
     base = _record_fields(task, record, fit, best, fitting)
-    site_fields, warning = _stage("classify", site.site_fields, task, record)
+    # a lone record is classified once, for its row and its figure (a pair's classification comes
+    # with the task; the figure of a pair's direction classifies the component it draws)
+    velocity = None if task.pair_fields else _stage("classify", _classify, record)
+    site_fields, warning = _stage("classify", site.site_fields, task, record, velocity)
     if warning:
         base["warnings"] = "; ".join(w for w in (base["warnings"], warning) if w)
     base.update(site_fields)
@@ -446,6 +449,11 @@ def _process(task: Task):
     if vertical_note:
         base["warnings"] = "; ".join(w for w in (base["warnings"], vertical_note) if w)
     shown_vertical = None if up is None else (up.metadata.get("source") or task.vertical)
+    draw = opts.plots and task.plot
+    # the check above the verified width where pipeline.passes asks for it (docs/slivers.md)
+    from rocking.search import DEFAULT_SETTINGS
+
+    settings = DEFAULT_SETTINGS if task.check else DEFAULT_SETTINGS.replace(check_runs=0)
 
     gamma = opts.cap_mass_ratio
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
@@ -483,21 +491,21 @@ def _process(task: Task):
         designed = _stage("design", design)
         res = None
         if block is not None:
-            res = _stage("verify", _sim, block, record, opts.plots)
-            if opts.plots:
+            res = _stage("verify", _sim, block, record, draw)
+            if draw:
                 curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
         block31 = rocking.Block.from_dimensions(H, w31, cap_mass_ratio=gamma)
-        res31 = _stage("verify", _sim, block31, record, opts.plots)
-        if opts.plots:
+        res31 = _stage("verify", _sim, block31, record, draw)
+        if draw:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
 
         # -- verified width: smallest width surviving the full record (islands respected) ---------
         if H not in verified_cache:
             verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact",
-                                       cap_mass_ratio=gamma)
-        if opts.plots:  # the column at its verified width, for the figure
+                                       cap_mass_ratio=gamma, settings=settings)
+        if draw:  # the column at its verified width, for the figure
             wv = float(verified_cache[H].width)
             block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
             curves.append((f"verified width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
@@ -514,7 +522,17 @@ def _process(task: Task):
         row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, H, gamma))
         rows.append(row)
 
-    return rows, (record, fit, fitting, histories), verified_cache
+    return rows, (record, fit, fitting, histories, velocity), verified_cache
+
+
+def _classify(record):
+    """The record's velocity-pulse classification, or None where it fails (its row then says why)."""
+    import pulses
+
+    try:
+        return pulses.classify_pulse(record)
+    except Exception:  # an unusual record: classified again for the row's warning, drawn without
+        return None
 
 
 def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:

@@ -13,6 +13,10 @@ DEFAULT_OUT = "pipeline-output"
 MAX_JOBS = 256
 
 
+#: what ``--plots`` may be given: figures of each pair's governing direction, or of every one
+PLOT_SCOPES = ("governing", "all")
+
+
 def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
     """Options shared by ``run`` and ``demo``."""
     parser.add_argument("--out", metavar="DIR", default=default_out,
@@ -25,8 +29,13 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
                         help="distribute records over a dask.distributed cluster: a scheduler "
                              "address (tcp://host:8786) or 'local' for a local cluster of --jobs "
                              "workers; needs the [dask] extra")
-    parser.add_argument("--plots", action=argparse.BooleanOptionalAction, default=True,
-                        help="write plots/<record>.png and plots/summary.png (default: yes)")
+    parser.add_argument("--plots", nargs="?", const="governing", default="governing",
+                        choices=PLOT_SCOPES,
+                        help="write plots/<record>.png and plots/summary.png: for a pair designed in "
+                             "several directions, the figures of its governing direction (default, "
+                             "`governing`) or of every direction (`all`)")
+    parser.add_argument("--no-plots", dest="plots", action="store_const", const="none",
+                        help="write no figures")
     parser.add_argument("--quiet", "-q", action="store_true",
                         help="no progress bar and no messages (the exit status tells)")
 
@@ -63,6 +72,10 @@ def add_parser(subparsers) -> None:
     p.add_argument("--log", metavar="FILE",
                    help="append one JSON line per record to FILE (record, status, seconds, model, "
                         "worker), to watch a long batch")
+    p.add_argument("--thorough", action="store_true",
+                   help="for pairs: the check above the verified width (and with --plots, the "
+                        "figures) in every direction; by default only where it can change the "
+                        "pair's design width (the same answer, docs/slivers.md)")
     add_record_options(p)
     site.add_options(p)
     peer_inputs.add_options(p)
@@ -97,7 +110,8 @@ def build_columns(blocks, heights):
 def options_from(args, **overrides):
     from .tasks import Options
 
-    kw = dict(plots=bool(args.plots))
+    kw = dict(plots=args.plots != "none", plots_all=args.plots == "all",
+              thorough=bool(getattr(args, "thorough", False)))
     kw.update(overrides)
     return Options(**kw)
 

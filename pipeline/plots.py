@@ -159,16 +159,18 @@ def record_figure_png(record_id, record, fit, fitting, histories, velocity=None)
         return _png(record_figure(record_id, record, fit, fitting, histories, velocity=velocity))
 
 
-def run_figure_png(record_id, record, fit, fitting, histories) -> bytes:
+def run_figure_png(record_id, record, fit, fitting, histories, velocity=None) -> bytes:
     """The figure of ``pipeline run`` for one record: :func:`record_figure_png` with the record's
-    velocity pulse (classified here, on the record as designed: for a pair, the component in the
+    velocity pulse: ``velocity``, the classification given (a lone record's, made once for its
+    rows), else classified here on the record as designed (for a pair, the component in the
     row's direction); without it where the record cannot be classified."""
     import pulses
 
-    try:
-        velocity = pulses.classify_pulse(record)
-    except Exception:  # an unusual record: its rows say why; the figure is drawn without the panel
-        velocity = None
+    if velocity is None:
+        try:
+            velocity = pulses.classify_pulse(record)
+        except Exception:  # an unusual record: its rows say why; drawn without the panel
+            velocity = None
     return record_figure_png(record_id, record, fit, fitting, histories, velocity=velocity)
 
 

@@ -51,16 +51,20 @@ def classify_fields(record, other=None) -> dict:
 NOT_PULSE_WARNING = "Eq. 31 assumes a pulse; the verified width does not"
 
 
-def classification_fields(record, other=None, pair_fields=None) -> tuple[dict, str | None]:
+def classification_fields(record, other=None, pair_fields=None, result=None) -> tuple[dict, str | None]:
     """The velocity-pulse columns of a row, and a warning (or None).
 
-    ``pair_fields`` (already computed for the pair, in the main process) are used as they are.
+    ``pair_fields`` (already computed for the pair, in the main process) are used as they are;
+    so is ``result``, the record's :class:`pulses.PulseClassification` where already made.
     """
     blank = RUN_PULSE_COLUMNS.blank()
     if pair_fields and "error" in pair_fields:  # the pair's classification failed: no direction
         return blank, f"velocity-pulse classification of the pair failed: {pair_fields['error']}"
     if pair_fields:
         fields = dict(pair_fields)
+    elif result is not None:
+        row = result_row(result)
+        fields = {k: row[k] for k in RUN_COLUMNS}
     else:
         try:
             fields = classify_fields(record, other)

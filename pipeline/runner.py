@@ -13,7 +13,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import design_table, html_report, interrupts, joblog, outfiles, outlock, report, resume, site
+from . import design_table, html_report, interrupts, joblog, outfiles, outlock, passes, report, resume, site
 from .args import ArgumentError, output_folder
 from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
@@ -148,9 +148,12 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch
-    texts, keys, todo = _reusable(tasks, journal, force, options.plots)
+    tasks = passes.first_pass(tasks, options)
+    plan = passes.Plan(options)
+    texts, keys, todo = _reusable(tasks, journal, force, options, plan)
     failures: list[dict | None] = [None] * len(tasks)
     n_reused = len(tasks) - len(todo)
+    n_todo = len(todo)
     try:
         log = joblog.JobLog(log)
     except OSError as exc:
@@ -170,26 +173,24 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
             print(msg, file=sys.stderr)
 
     header = report.csv_text(FIELDS, [])
-    stream = execute(todo, jobs=jobs, dask=dask) if todo else _serial([])
+    stream = _serial([])
     try:
-        for res in stream:
-            i = res["index"]
-            task = tasks[i]
-            figure = res.get("plot")
-            _write_record(outputs, task, res, options.plots, say)
-            texts[i] = report.csv_text(FIELDS, res["rows"])[len(header):]
-            failures[i] = res["failure"]
-            if res["failure"] or not res["rows"] or keys[i] is None:
-                journal.drop(task.record_id)
-            else:
-                journal.add(task.record_id, keys[i], (header + texts[i]).encode("utf-8"),
-                            figure if options.plots else None)
-            if res["failure"]:
-                f = res["failure"]
-                say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
-            log.record(res, task.record_id)
+        while True:  # pipeline.passes: a pair's directions, then its governing one checked, ...
+            if todo:
+                stream = execute(todo, jobs=jobs, dask=dask)
+                for res in stream:
+                    _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
+                    log.record(res, tasks[res["index"]].record_id)
+                    if bar is not None:
+                        bar.update(1)
+                stream.close()
+            todo = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
+            if not todo:
+                break
+            n_todo += len(todo)
             if bar is not None:
-                bar.update(1)
+                bar.total += len(todo)
+                bar.refresh()
     finally:
         with interrupts.deferred():
             stream.close()  # an interrupted pool is stopped here, at once
@@ -215,7 +216,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
             msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
                    f"records or pairs processed in every direction ({summary.n_ok} of "
                    f"{summary.n_records} tasks)")
-        msg += f" ({n_reused} reused from an earlier run, {len(todo)} computed)"
+        msg += f" ({n_reused} reused from an earlier run, {n_todo} computed)"
         if n_failed:
             msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
         print(design_table.table_text(design, failures, rows), end="")
@@ -223,21 +224,88 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     return summary
 
 
-def _reusable(tasks, journal, force: bool, plots: bool):
+def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say) -> None:
+    """One computed task's result: its report and figures written, its rows kept as text, the
+    journal and the plan of passes told."""
+    i = res["index"]
+    task = tasks[i]
+    figure = res.get("plot")
+    _write_record(outputs, task, res, options.plots and task.plot, say)
+    texts[i] = report.csv_text(FIELDS, res["rows"])[len(header):]
+    failures[i] = res["failure"]
+    plan.note(task, res["rows"])
+    if res["failure"] or not res["rows"] or keys[i] is None:
+        journal.drop(task.record_id)
+    else:
+        journal.add(task.record_id, keys[i], (header + texts[i]).encode("utf-8"),
+                    figure if options.plots and task.plot else None)
+    if res["failure"]:
+        f = res["failure"]
+        say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
+
+
+def _variants(task, options):
+    """The forms of ``task`` whose kept report may stand for it: itself, and for a pair's
+    direction computed in passes, its checked forms (a later pass of an earlier run)."""
+    if not passes.staged(task, options):
+        return [task]
+    return [task] + [dataclasses.replace(task, check=True, plot=p) for p in (False, True) if p or not task.plot]
+
+
+def _reuse(t, journal, force, options, version):
+    """``(task form, key, rows text)`` of ``t``'s kept report, or ``(t, key, "")``."""
+    key = resume.task_key(t, version)
+    if not force:
+        for v in _variants(t, options):
+            k = key if v is t else resume.task_key(v, version)
+            kept = journal.reusable(v, k, options.plots and v.plot)
+            if kept is not None:
+                return v, k, kept
+    return t, key, ""
+
+
+def _reusable(tasks, journal, force: bool, options, plan):
     """``(texts, keys, todo)``: each task's rows as its kept report holds them ("" where it must be
-    computed), its resume key, and the tasks to compute (their journal entries dropped)."""
+    computed), its resume key, and the tasks to compute (their journal entries dropped).
+    ``tasks`` is updated with the form of each task that was kept."""
     texts: list[str] = [""] * len(tasks)
     version = resume.package_version()
-    keys = [resume.task_key(t, version) for t in tasks]
+    keys: list = [None] * len(tasks)
     todo = []
-    for t, key in zip(tasks, keys):
-        kept = None if force else journal.reusable(t, key, plots)
-        if kept is None:
+    for t in list(tasks):
+        v, keys[t.index], texts[t.index] = _reuse(t, journal, force, options, version)
+        if texts[t.index]:
+            tasks[t.index] = v
+            plan.note(v, resume.rows_from_text(texts[t.index]))
+        else:
             journal.drop(t.record_id)
             todo.append(t)
-        else:
-            texts[t.index] = kept
     return texts, keys, todo
+
+
+def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
+    """The tasks of the next pass (pipeline.passes) that must be computed; those an earlier run
+    kept are taken as they are."""
+    version = resume.package_version()
+    todo = []
+    while True:
+        wanted = plan.next_pass(tasks)
+        if not wanted:
+            return todo
+        found = False
+        for t in wanted:
+            key = resume.task_key(t, version)
+            kept = None if force else journal.reusable(t, key, options.plots and t.plot)
+            tasks[t.index], keys[t.index] = t, key
+            if kept is None:
+                journal.drop(t.record_id)
+                todo.append(t)
+            else:
+                texts[t.index] = kept
+                plan.note(t, resume.rows_from_text(kept))
+                found = True
+        if todo or not found:
+            return todo
 
 
 def _progress_bar(n_todo: int, quiet: bool, progress: bool | None):

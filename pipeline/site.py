@@ -82,9 +82,11 @@ def pair_of(task) -> str:
     return task.pair or task.record_id
 
 
-def site_fields(task, record) -> tuple[dict, str | None]:
-    """The :data:`SITE_COLUMNS` group of one task's rows, and the warning to add (or None)."""
-    cls, warning = classification_fields(record, pair_fields=dict(task.pair_fields) or None)
+def site_fields(task, record, classification=None) -> tuple[dict, str | None]:
+    """The :data:`SITE_COLUMNS` group of one task's rows, and the warning to add (or None);
+    ``classification``: the record's :class:`pulses.PulseClassification` where already made."""
+    cls, warning = classification_fields(record, pair_fields=dict(task.pair_fields) or None,
+                                         result=classification)
     az = None
     if task.path2 is not None:
         az = record.metadata.get("azimuth")

@@ -41,12 +41,18 @@ class Options:
     format: str | None = None
     trace: str | None = None
     plots: bool = True
+    #: ``--plots all``: a figure for every direction of a pair (default: its governing direction
+    #: only, pipeline.passes)
+    plots_all: bool = False
     #: a rocking frame's cap beam mass over the columns' (0: lone columns); see pipeline.site
     cap_mass_ratio: float = 0.0
     fragility: bool = False
     up_to: float = 10.0
     #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
     vertical: str = "auto"
+    #: ``--thorough``: every direction of a pair gets the check above its verified width and
+    #: (with plots) its figures, as a lone record does (pipeline.passes)
+    thorough: bool = False
 
 
 @dataclass(frozen=True)
@@ -67,6 +73,11 @@ class Task:
     peer: object = None
     #: the vertical component's file of a pair (pipeline.vertical: --triplet, --pairs auto)
     vertical: str | None = None
+    #: run the check above the verified width (docs/slivers.md); pipeline.passes decides per
+    #: direction of a pair
+    check: bool = True
+    #: draw this task's figures (where ``options.plots``); pipeline.passes decides per direction
+    plot: bool = True
 
 
 # -- record ids ------------------------------------------------------------------------------------
