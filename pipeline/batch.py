@@ -66,6 +66,9 @@ def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
            "failure": None, "plot": None, "widths_plot": None}
     try:
+        if task.only_check:
+            out["rows"] = _check_rows(task)
+            return out
         rows, fit_parts, verified = _process(task)
         out["rows"] = rows
     except StageError as err:
@@ -413,6 +416,44 @@ def _check_fields(ver) -> dict:
         "failing_share": ver.failing_share, "widest_failing_width_m": ver.widest_failing_width,
         "check_runs": ver.check_runs,
     })
+
+
+def _check_rows(task: Task) -> list[dict]:
+    """The check's columns of each of the task's columns (``{"column": label, ...}``): the search
+    and the check above its verified width, as :func:`_process` runs them."""
+    import rocking
+
+    record, _, _ = _stage("read", vertical.read_task, task)
+    rows = []
+    for col in task.columns:
+        ver = _stage("verify", rocking.required_width, col.height, record, rule="exact",
+                     cap_mass_ratio=task.options.cap_mass_ratio)
+        rows.append({"column": col.label, "verified_width_m": float(ver.width), **_check_fields(ver)})
+    return rows
+
+
+def patch_check(rows_text: str, check_rows) -> str:
+    """``rows_text`` (a task's rows as its report holds them, without the header) with the check's
+    columns of each column set from ``check_rows`` (:func:`_check_rows`), written as
+    :func:`pipeline.report.csv_text` writes them."""
+    import csv
+    import io
+
+    from .report import fmt
+
+    by_label = {r["column"]: r for r in check_rows}
+    at = {name: FIELDS.index(name) for name in CHECK_COLUMNS.names}
+    col, ver = FIELDS.index("column"), FIELDS.index("verified_width_m")
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    for cells in csv.reader(io.StringIO(rows_text)):
+        new = by_label[cells[col]]
+        if cells[ver] != fmt(new["verified_width_m"]):  # the same search: never expected
+            raise RuntimeError(f"{cells[col]}: the check's search found another verified width")
+        for name, k in at.items():
+            cells[k] = fmt(new[name])
+        writer.writerow(cells)
+    return buf.getvalue()
 
 
 #: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)

@@ -78,6 +78,9 @@ class Task:
     check: bool = True
     #: draw this task's figures (where ``options.plots``); pipeline.passes decides per direction
     plot: bool = True
+    #: compute only the check's columns (:data:`pipeline.batch.CHECK_COLUMNS`) of a direction whose
+    #: other columns an earlier pass gave (pipeline.passes)
+    only_check: bool = False
 
 
 # -- record ids ------------------------------------------------------------------------------------

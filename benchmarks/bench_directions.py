@@ -1,0 +1,138 @@
+"""CPU per pair and direction of ``pipeline run --directions 36``, side by side with another version.
+
+    PYTHONPATH=. python -m benchmarks.bench_directions --baseline ../wt-base [--pairs 4] [--jobs 1]
+
+``--baseline`` is a checkout of the version to compare with (say ``git worktree add ../wt-base
+6acf3f2``) with its own virtual environment in ``.venv`` (built as the README says); this checkout's
+is the Python running the benchmark.  For each real pair of ``../shared/records/raw`` (Rinaldi,
+RSN77, RSN181, RSN879, RSN1084, RSN159, RSN150, RSN250 are pulse-like, RSN6 and the El Centro #4
+examples' RSN179 pair too by S&B14; the first ``--pairs`` of them), one after the other in this one
+run, ``pipeline run --pair A B --directions 36 --block 7.5x1.8 --jobs J`` (38 directions) by:
+
+- the baseline (its defaults: every direction checked and drawn);
+- this version, default options (the check and the figures where they decide, pipeline/passes.py);
+- this version with ``--thorough`` (every direction checked and drawn).
+
+Each run is a fresh process tree in a fresh ``--out``; its CPU is user + sys of the process and
+every worker (``getrusage`` of the tree, measured by a wrapper that also reports the main process's
+own share).  Reported per pair: CPU seconds per direction, PNG bytes, and the answers compared:
+the pair's design width (the widest verified width or failing width the checks found, over its
+directions) of the default and of ``--thorough`` against the baseline's, and whether every
+direction's verified width, verdicts and check columns of ``--thorough`` equal the baseline's.
+Then the projection for 10,000 pairs on 64 cores.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+SHARED = pathlib.Path(__file__).resolve().parents[2] / "shared" / "records" / "raw"
+_H = "haselREC_NGA-West2-Reduced/"
+PAIRS = [("Rinaldi228.AT2", "Rinaldi318.AT2"), ("RSN77_SFERN_PUL164.AT2", _H + "RSN77_2.AT2"),
+         ("RSN159", None), ("RSN181_IMPVALL.H_H-E06230.AT2", "RSN181_IMPVALL.H_H-E06140.AT2"),
+         ("RSN1084_NORTHR_SCS052.AT2", "RSN1084_NORTHR_SCS142.AT2"), ("RSN6_IMPVALL.I_I-ELC180.AT2", _H + "RSN6_2.AT2"),
+         ("RSN150", None), ("RSN250", None), ("RSN879_LANDERS_LCN260.AT2", "RSN879_LANDERS_LCN345.AT2"),
+         ("shahi_baker_examples/example1.AT2", "shahi_baker_examples/example2.AT2")]
+ARGS = ["--directions", "36", "--block", "7.5x1.8", "--quiet"]
+#: runs ``pipeline`` in this process and prints the CPU of the main process and of its workers
+WRAPPER = ("import json, resource, sys\n"
+           "from pipeline.cli import main\n"
+           "code = main(sys.argv[1:])\n"
+           "s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+           "print(json.dumps({'code': code, 'main': s.ru_utime + s.ru_stime, "
+           "'workers': c.ru_utime + c.ru_stime}))\n")
+#: the check's columns and the verdicts compared row by row
+COMPARED = ["verified_width_m", "overturns", "eq31_width_m", "eq31_width_overturns", "failing_share",
+            "widest_failing_width_m", "check_runs", "pulse_shape", "pulse_ap_g", "pulse_tp_s"]
+
+
+def pair_paths(spec):
+    a, b = spec
+    if b is None:  # haselREC's RSN<n>_1 / _2
+        a, b = f"{_H}{a}_1.AT2", f"{_H}{a}_2.AT2"
+    return str(SHARED / a), str(SHARED / b)
+
+
+def run_one(python, pair, out, jobs, extra=()) -> dict:
+    """One ``pipeline run`` as a fresh process tree: its CPU (main process, workers)."""
+    argv = [python, "-c", WRAPPER, "run", "--pair", *pair, *ARGS, "--jobs", str(jobs), "--out", str(out), *extra]
+    res = subprocess.run(argv, capture_output=True, text=True, check=False)
+    line = [ln for ln in res.stdout.splitlines() if ln.startswith("{")]
+    if not line:
+        raise RuntimeError(f"{' '.join(argv)} failed: {res.stderr[-2000:]}")
+    got = json.loads(line[-1])
+    got["cpu"] = got["main"] + got["workers"]
+    got["png_bytes"] = sum(p.stat().st_size for p in pathlib.Path(out).rglob("*.png"))
+    got["rows"] = list(csv.DictReader(open(pathlib.Path(out) / "summary.csv", encoding="utf-8")))
+    return got
+
+
+def design_width(rows) -> float:
+    """The pair's design width: the widest verified or failing width over its directions (m)."""
+    return max(max(float(r["verified_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
+
+
+def same_rows(a, b) -> bool:
+    """Every direction's :data:`COMPARED` columns equal (as written)."""
+    key = lambda r: (r["direction_deg"], r["column"])
+    ra, rb = {key(r): r for r in a}, {key(r): r for r in b}
+    return ra.keys() == rb.keys() and all(ra[k][c] == rb[k][c] for k in ra for c in COMPARED)
+
+
+def measure(baseline, n_pairs, jobs) -> list[dict]:
+    base_python = str(pathlib.Path(baseline) / ".venv" / "bin" / "python")
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, spec in enumerate(PAIRS[:n_pairs]):
+            pair = pair_paths(spec)
+            runs = {name: run_one(py, pair, pathlib.Path(tmp) / f"{k}-{name}", jobs, extra)
+                    for name, py, extra in (("baseline", base_python, ()), ("default", sys.executable, ()),
+                                            ("thorough", sys.executable, ("--thorough",)))}
+            n = len(runs["baseline"]["rows"])
+            entry = {"pair": pathlib.Path(pair[0]).stem, "directions": n}
+            for name, r in runs.items():
+                entry[name] = {"cpu_per_direction": r["cpu"] / n, "main_share": r["main"] / r["cpu"],
+                               "png_mb": r["png_bytes"] / 1e6, "design_width": design_width(r["rows"]),
+                               "exit": r["code"]}
+            entry["thorough_rows_equal_baseline"] = same_rows(runs["thorough"]["rows"], runs["baseline"]["rows"])
+            entry["default_design_equals_thorough"] = (entry["default"]["design_width"]
+                                                       == entry["thorough"]["design_width"])
+            print(json.dumps(entry), flush=True)
+            out.append(entry)
+    return out
+
+
+def summary(entries) -> dict:
+    import numpy as np
+
+    def mean(name, what):
+        return float(np.mean([e[name][what] for e in entries]))
+
+    res = {name: {"cpu_per_direction": mean(name, "cpu_per_direction"), "png_mb_per_pair": mean(name, "png_mb"),
+                  "main_share": mean(name, "main_share"),
+                  # 10,000 pairs of 38 directions on 64 cores, at this machine's speed per core
+                  "hours_10000_pairs_64_cores": mean(name, "cpu_per_direction") * 38 * 10_000 / 64 / 3600}
+           for name in ("baseline", "default", "thorough")}
+    res["speed_up_default"] = res["baseline"]["cpu_per_direction"] / res["default"]["cpu_per_direction"]
+    res["design_widths_equal"] = all(e["default_design_equals_thorough"] for e in entries)
+    res["thorough_equal_baseline"] = all(e["thorough_rows_equal_baseline"] for e in entries)
+    return res
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--baseline", required=True, help="checkout of the version compared with (its .venv)")
+    ap.add_argument("--pairs", type=int, default=4, help=f"pairs measured (at most {len(PAIRS)}; default 4)")
+    ap.add_argument("--jobs", type=int, default=1, help="--jobs of every run (default 1)")
+    args = ap.parse_args(argv)
+    entries = measure(args.baseline, args.pairs, args.jobs)
+    print(json.dumps(summary(entries), indent=1))
+
+
+if __name__ == "__main__":
+    main()
