@@ -61,7 +61,8 @@ def pair_paths(spec):
 def run_one(python, pair, out, jobs, extra=()) -> dict:
     """One ``pipeline run`` as a fresh process tree: its CPU (main process, workers)."""
     argv = [python, "-c", WRAPPER, "run", "--pair", *pair, *ARGS, "--jobs", str(jobs), "--out", str(out), *extra]
-    res = subprocess.run(argv, capture_output=True, text=True, check=False)
+    # run from the output's folder: from a checkout, ``-c`` would import that checkout's package
+    res = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=pathlib.Path(out).parent)
     line = [ln for ln in res.stdout.splitlines() if ln.startswith("{")]
     if not line:
         raise RuntimeError(f"{' '.join(argv)} failed: {res.stderr[-2000:]}")

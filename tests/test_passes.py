@@ -1,0 +1,129 @@
+"""A pair's directions in passes (pipeline/passes.py): the check above the verified width and the
+figures only where they decide, the same design width as ``--thorough``.
+
+The synthetic pairs are those of tests/test_site.py (8 s, one-sine pulses in noise); the real
+pairs (slow) are read from ``../shared`` and skipped without it."""
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+from pipeline import passes
+from pipeline.batch import CHECK_COLUMNS
+from pipeline.cli import main as cli_main
+from rocking.search import DEFAULT_SETTINGS
+
+from .test_site import H, B, _pair
+
+CHECK = list(CHECK_COLUMNS.names)
+
+
+def _rows(out):
+    with open(out / "summary.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _design(rows) -> float:
+    """The pair's design width: the widest verified or failing width over its directions."""
+    return max(max(float(r["verified_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
+
+
+def _top(row) -> float:
+    """The widest width the check of this row's direction would look at (rocking.widths)."""
+    w = float(row["verified_width_m"])
+    return min(DEFAULT_SETTINGS.check_span * w, float(row["height_m"]) * float(row["pga_g"]))
+
+
+def _run(out, pair, *extra):
+    return cli_main(["run", "--pair", *map(str, pair), "--out", str(out), "--quiet", *map(str, extra)])
+
+
+def _same_answer(default, thorough):
+    """The default's rows against ``--thorough``'s: the same design width; every checked direction
+    identical; every unchecked one identical but for the check's columns, and its check could
+    not have reached the design width."""
+    design = _design(thorough)
+    assert _design(default) == design
+    by_dir = {r["direction_deg"]: r for r in thorough}
+    n_checked = 0
+    for r in default:
+        ref = by_dir[r["direction_deg"]]
+        if r["check_runs"] not in ("", "0"):
+            n_checked += 1
+            assert r == ref
+        else:
+            assert {k: v for k, v in r.items() if k not in CHECK} == {k: v for k, v in ref.items() if k not in CHECK}
+            assert r["failing_share"] == "" and r["widest_failing_width_m"] == ""
+            assert _top(r) <= design * (1.0 + passes.MARGIN)
+    return n_checked
+
+
+def _d(index, checked, plotted, w, top, widest=None):
+    return passes._Direction(index, checked, plotted, {"7.5x1.8": (w, top, widest)})
+
+
+def test_the_check_goes_to_the_governing_direction_then_where_it_could_reach_the_design_width():
+    group = {0: _d(0, False, False, 1.0, 2.0), 1: _d(1, False, False, 1.2, 2.4), 2: _d(2, False, False, 0.5, 1.0),
+             3: _d(3, False, False, 1.2, 2.4)}
+    # first the governing direction (the widest; the first of equal widths), with its figure
+    assert passes._wanted(group, plots=True) == {1: True}
+    assert passes._wanted(group, plots=False) == {1: False}
+    # it found a failing width at 1.5 m: the design width; a check reaching up to 1.0 m cannot
+    # change it, one reaching 2.0 m or 2.4 m can
+    group[1] = _d(1, True, True, 1.2, 2.4, 1.5)
+    assert passes._wanted(group, plots=True) == {0: False, 3: False}
+    group[0], group[3] = _d(0, True, False, 1.0, 2.0), _d(3, True, False, 1.2, 2.4, 2.1)
+    assert passes._wanted(group, plots=True) == {}
+    # a direction whose check could reach 2.1 m only if the design width were lower
+    group[4] = _d(4, False, False, 1.05, 2.1 * (1.0 - 1e-3))
+    assert passes._wanted(group, plots=True) == {}
+
+
+@pytest.fixture(scope="module")
+def pair(tmp_path_factory):
+    return _pair(tmp_path_factory.mktemp("passes"), "STP", 0.45, 0.3, 1)
+
+
+def test_default_gives_the_thorough_design_width_figures_where_they_inform(pair, tmp_path):
+    args = ("--block", f"{H}x{B}", "--directions", "6")
+    assert _run(tmp_path / "thorough", pair, *args, "--thorough", "--no-plots") == 0
+    assert _run(tmp_path / "default", pair, *args) == 0
+    default, thorough = _rows(tmp_path / "default"), _rows(tmp_path / "thorough")
+    assert len(default) == len(thorough) >= 6
+    assert 1 <= _same_answer(default, thorough) <= len(default)
+    # one record figure and at most one barcode: the governing direction's (pairs.csv)
+    with open(tmp_path / "default" / "pairs.csv", newline="") as fh:
+        (gov,) = list(csv.DictReader(fh))
+    figures = sorted(p.name for p in (tmp_path / "default" / "plots").glob("*deg.png"))
+    assert figures == [f"{gov['record']}.png"]
+    assert len(list((tmp_path / "default" / "plots").glob("widths/*.png"))) <= 1
+    # a second run computes nothing and changes no file
+    before = {p: p.read_bytes() for p in (tmp_path / "default").rglob("*") if p.is_file()}
+    assert _run(tmp_path / "default", pair, *args) == 0
+    after = {p: p.read_bytes() for p in (tmp_path / "default").rglob("*") if p.is_file()}
+    assert before == after
+
+
+def test_plots_all_draws_every_direction_and_no_plots_none(pair, tmp_path):
+    args = ("--block", f"{H}x{B}", "--directions", "2")
+    assert _run(tmp_path / "all", pair, *args, "--plots", "all") == 0
+    n = len(_rows(tmp_path / "all"))
+    assert len(list((tmp_path / "all" / "plots").glob("*deg.png"))) == n
+    assert _run(tmp_path / "none", pair, *args, "--no-plots") == 0
+    assert not (tmp_path / "none" / "plots").exists() or not list((tmp_path / "none" / "plots").rglob("*.png"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("names", [("Rinaldi228.AT2", "Rinaldi318.AT2"),
+                                   ("haselREC_NGA-West2-Reduced/RSN159_1.AT2",
+                                    "haselREC_NGA-West2-Reduced/RSN159_2.AT2")])
+def test_real_pairs_default_design_width_is_the_thorough_one(shared_records, names, tmp_path):
+    pair = [shared_records / n for n in names]
+    for p in pair:
+        if not p.is_file():
+            pytest.skip(f"real record not available: {p}")
+    args = ("--block", "7.5x1.8", "--directions", "12", "--no-plots")
+    assert _run(tmp_path / "thorough", pair, *args, "--thorough") == 0
+    assert _run(tmp_path / "default", pair, *args) == 0
+    assert _same_answer(_rows(tmp_path / "default"), _rows(tmp_path / "thorough")) >= 1
