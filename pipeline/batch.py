@@ -403,11 +403,13 @@ CHECK_COLUMNS = Columns(
                            "jittered widths (seeded from the record, off the search's grid) from the "
                            "verified width up to twice it or the no-uplift width (height x PGA / g), "
                            "whichever is smaller, half of them log-spaced just above it: this is the "
-                           "share of them that overturn (0: none did; blank: no check)."),
+                           "share of them that overturn (0: none did; blank: no check, as in a direction of a pair whose "
+                           "check could not reach the pair's design width, docs/site.md)."),
     ("widest_failing_width_m", "m", "The widest width the check found to overturn (a failing sliver "
                                     "above the verified width; blank where none was found, which "
                                     "does not prove there is none)."),
-    ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width."),
+    ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width (0: "
+                        "not checked)."),
 )
 
 
