@@ -26,7 +26,7 @@ def test_record_figure_draws_the_record_its_pulses_and_rotations(tmp_path):
     of each column with the alpha lines, the verdicts in the legends, one time axis."""
     path = write_good(tmp_path, 4)
     task, = make_tasks([str(path)], [Column(7.5, 1.8), Column(6.0, 1.2)], Options())
-    record, fit, fitting, histories = _process(task)[1]
+    record, fit, fitting, histories, _velocity = _process(task)[1]
     assert fitting and len(histories) == 2
     fig = plots.record_figure(task.record_id, record, fit, fitting, histories)
     top, *panels = fig.axes
@@ -86,7 +86,7 @@ def test_record_figure_labels_inside_and_apart(tmp_path):
     the others, also with wide tick labels (a weak record: ticks like -0.010) and one column."""
     path = write_good(tmp_path, 4)
     task, = make_tasks([str(path)], [Column(7.5, 1.8), Column(6.0, 1.2)], Options())
-    record, fit, fitting, histories = _process(task)[1]
+    record, fit, fitting, histories, _velocity = _process(task)[1]
     figures = [plots.record_figure(task.record_id, record, fit, fitting, histories),
                plots.record_figure(task.record_id, record.scaled(0.02), fit, [], histories[:1])]
     assert [t.get_text() for t in figures[1].axes[0].get_yticklabels()][1].startswith("\N{MINUS SIGN}0.0")
@@ -158,7 +158,7 @@ def test_record_figure_velocity_pulse_and_verified_width(tmp_path):
 
     path = write_good(tmp_path, 4)
     task, = make_tasks([str(path)], [Column(7.5, 1.8)], Options())
-    rows, (record, fit, fitting, histories), _verified = _process(task)
+    rows, (record, fit, fitting, histories, _velocity), _verified = _process(task)
     (label, curves), = histories
     assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "verified width"]
     _, block_v, res_v = curves[2]
