@@ -187,11 +187,11 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
 
     tasks = make_tasks([*map(str, others), str(target)], [Column(7.5, 1.8), Column(6.0, 1.2)], Options())
     parts = [_process(t)[1] for t in tasks]
-    rec, fit, fitting, hist = parts[-1]
+    rec, fit, fitting, hist, _velocity = parts[-1]
     few = (rec, fit, fitting[:1], [(label, curves[1:]) for label, curves in hist])
     fresh = plots.run_figure_png(tasks[-1].record_id, *parts[-1])  # as the run draws it
     fresh_few = plots.record_figure_png(tasks[-1].record_id, *few)
-    for t, (r, f, fi, h) in zip(tasks, parts):
+    for t, (r, f, fi, h, _v) in zip(tasks, parts):
         plots.record_figure_png(t.record_id, r, f, (fi + fi)[:4], h)
     assert plots.record_figure_png(tasks[-1].record_id, *few) == fresh_few != fresh
     assert plots.run_figure_png(tasks[-1].record_id, *parts[-1]) == fresh == png
