@@ -497,6 +497,7 @@ def _process(task: Task):
     from rocking.search import DEFAULT_SETTINGS
 
     settings = DEFAULT_SETTINGS if task.check else DEFAULT_SETTINGS.replace(check_runs=0)
+    above = dict(zip(task.columns, task.check_above))
 
     gamma = opts.cap_mass_ratio
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
@@ -547,7 +548,8 @@ def _process(task: Task):
         # -- verified width: smallest width surviving the full record (islands respected) ---------
         if H not in verified_cache:
             verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact",
-                                       cap_mass_ratio=gamma, settings=settings)
+                                       cap_mass_ratio=gamma,
+                                       settings=settings.replace(check_above=above.get(col, 0.0)))
         if draw:  # the column at its verified width, for the figure
             wv = float(verified_cache[H].width)
             block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)

@@ -7,11 +7,17 @@ find a failing width above the pair's design width, and it looks only up to ``ch
 check_span w, H PGA / g)`` (``rocking.search.SearchSettings``; the no-uplift width under the
 direction's component).  So ``pipeline run`` computes a pair in passes:
 
-1. every direction: the search only (no check), no figure (unless ``--plots all``);
-2. the governing direction (widest verified width, the first such in angle order, as in
-   ``pairs.csv``): the search and the check, and its figures;
-3. then, while any is left, every unchecked direction whose ``check_top`` lies above the pair's
-   design width found so far (the widest verified or failing width of the checked directions).
+1. a few *scout* directions (the recorded components, the pulse's and its normal, every
+   :data:`SCOUT_EVERY` th direction in angle order): the search only (no check), no figure
+   (unless ``--plots all``);
+2. the other directions, each with its check where its ``check_top`` lies above the widest
+   width the scouts found (a lower bound of the pair's design width), in the same task as its
+   search;
+3. the governing direction (widest verified width, the first such in angle order, as in
+   ``pairs.csv``) with its check where not done, and its figures;
+4. then, while any is left, every unchecked direction whose ``check_top`` lies above the pair's
+   design width found so far (the widest verified or failing width of the checked directions):
+   the search and the check again (its later stages use the search's widths), not the fit.
 
 A direction left unchecked cannot find a failing width above the pair's final design width, so
 the pair's design width is the one ``--thorough`` (every direction checked, as a lone record)
@@ -23,6 +29,8 @@ from __future__ import annotations
 
 import dataclasses
 
+from .report import fmt
+
 #: a check whose top lies within this share of the design width is run all the same (the rows'
 #: numbers are read back from text, with their rounding)
 MARGIN = 1e-6
@@ -33,15 +41,25 @@ def staged(task, options) -> bool:
     return task.direction is not None and not options.thorough
 
 
-def first_pass(tasks, options) -> list:
-    """The tasks of the first pass: a pair's directions without check and figure (with ``--plots
-    all``, with their figures), every other task checked and drawn."""
-    out = []
+#: every this many directions of a pair (in angle order) one is a scout of the first pass
+SCOUT_EVERY = 4
+#: the directions chosen for what they are are scouts too
+SCOUT_KINDS = ("component-1", "component-2", "pulse", "pulse-normal")
+
+
+def first_pass(tasks, options) -> tuple[list, set]:
+    """The tasks in their first-pass form: a pair's directions without check and figure (with
+    ``--plots all``, with their figures), every other task checked and drawn; and the indices of
+    the directions held back for the second pass (not scouts)."""
+    out, held, seen = [], set(), {}
     for t in tasks:
         if staged(t, options):
             t = dataclasses.replace(t, check=False, plot=bool(options.plots_all))
+            k = seen[t.pair] = seen.get(t.pair, -1) + 1
+            if k % SCOUT_EVERY and t.direction_kind not in SCOUT_KINDS:
+                held.add(t.index)
         out.append(t)
-    return out
+    return out, held
 
 
 @dataclasses.dataclass
@@ -56,12 +74,14 @@ class _Direction:
 class Plan:
     """What each pair's directions have given so far, and which to compute next."""
 
-    def __init__(self, options):
+    def __init__(self, options, held=()):
         from rocking.search import DEFAULT_SETTINGS
 
         self.options = options
         self.span = float(DEFAULT_SETTINGS.check_span)
         self.pairs: dict[str, dict[int, _Direction]] = {}
+        #: the directions held back from the first pass (indices)
+        self.held = set(held)
 
     def note(self, task, rows) -> None:
         """Record what ``task`` (as computed, with its switches) gave: its rows (empty: failed)."""
@@ -75,20 +95,40 @@ class Plan:
             return
         cols = {}
         for r in rows:
-            w = float(r["verified_width_m"])
-            top = min(self.span * w, float(r["height_m"]) * float(r["pga_g"]))
-            widest = r.get("widest_failing_width_m")
-            cols[r["column"]] = (w, top, None if widest in (None, "") else float(widest))
+            # as the report holds them (6 digits): a resumed run decides as the first did
+            w, H, pga, widest = (None if r.get(k) in (None, "") else float(fmt(float(r[k])))
+                                 for k in ("verified_width_m", "height_m", "pga_g", "widest_failing_width_m"))
+            cols[r["column"]] = (w, min(self.span * w, H * pga), widest)
         group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols)
 
     def next_pass(self, tasks) -> list:
         """The tasks to compute next (their switches set), from ``tasks`` (the run's tasks, by
         index, as last computed); empty when every pair is settled."""
+        if self.held:
+            return self._second_pass(tasks)
         out = []
         for group in self.pairs.values():
             want = _wanted(group, bool(self.options.plots))
-            out += [dataclasses.replace(tasks[i], check=True, plot=plot or tasks[i].plot)
+            out += [dataclasses.replace(tasks[i], check=True, check_above=(), plot=plot or tasks[i].plot)
                     for i, plot in sorted(want.items())]
+        return out
+
+    def _second_pass(self, tasks) -> list:
+        """The held directions, each checked where its check could reach above the widest width
+        its pair's scouts found."""
+        from .site import pair_of
+
+        out = []
+        for i in sorted(self.held):
+            t = tasks[i]
+            group = self.pairs.get(pair_of(t), {})
+            lower = {}  # the scouts' widest verified width (not their checks': the same on a resumed run)
+            for d in group.values():
+                for label, (w, _, _) in d.columns.items():
+                    lower[label] = max(lower.get(label, 0.0), w)
+            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) for c in t.columns)
+            out.append(dataclasses.replace(t, check=True, check_above=above))
+        self.held = set()
         return out
 
 

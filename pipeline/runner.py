@@ -148,12 +148,11 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch
-    tasks = passes.first_pass(tasks, options)
-    plan = passes.Plan(options)
-    texts, keys, todo = _reusable(tasks, journal, force, options, plan)
+    tasks, held = passes.first_pass(tasks, options)
+    plan = passes.Plan(options, held)
+    texts, keys, todo = _reusable(tasks, journal, force, options, plan, held)
     failures: list[dict | None] = [None] * len(tasks)
-    n_reused = len(tasks) - len(todo)
-    n_todo = len(todo)
+    computed = set()  # the tasks computed (in any pass); the others were reused
     try:
         log = joblog.JobLog(log)
     except OSError as exc:
@@ -162,7 +161,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
         if texts[t.index]:
             log.record(None, t.record_id, reused=True)
 
-    bar = _progress_bar(len(todo), quiet, progress)
+    bar = _progress_bar(len(todo) + len(held), quiet, progress)
 
     def say(msg):
         if quiet:
@@ -179,6 +178,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
             if todo:
                 stream = execute(todo, jobs=jobs, dask=dask)
                 for res in stream:
+                    computed.add(res["index"])
                     _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
                     log.record(res, tasks[res["index"]].record_id)
                     if bar is not None:
@@ -187,7 +187,6 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
             todo = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
             if not todo:
                 break
-            n_todo += len(todo)
             if bar is not None:
                 bar.total += len(todo)
                 bar.refresh()
@@ -208,6 +207,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
+    n_reused = len(tasks) - len(computed)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
@@ -216,7 +216,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
             msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
                    f"records or pairs processed in every direction ({summary.n_ok} of "
                    f"{summary.n_records} tasks)")
-        msg += f" ({n_reused} reused from an earlier run, {n_todo} computed)"
+        msg += f" ({n_reused} reused from an earlier run, {len(computed)} computed)"
         if n_failed:
             msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
         print(design_table.table_text(design, failures, rows), end="")
@@ -267,15 +267,18 @@ def _reuse(t, journal, force, options, version):
     return t, key, ""
 
 
-def _reusable(tasks, journal, force: bool, options, plan):
+def _reusable(tasks, journal, force: bool, options, plan, held=()):
     """``(texts, keys, todo)``: each task's rows as its kept report holds them ("" where it must be
     computed), its resume key, and the tasks to compute (their journal entries dropped).
-    ``tasks`` is updated with the form of each task that was kept."""
+    ``tasks`` is updated with the form of each task that was kept; the ``held`` ones (indices)
+    are left to a later pass."""
     texts: list[str] = [""] * len(tasks)
     version = resume.package_version()
     keys: list = [None] * len(tasks)
     todo = []
     for t in list(tasks):
+        if t.index in held:
+            continue
         v, keys[t.index], texts[t.index] = _reuse(t, journal, force, options, version)
         if texts[t.index]:
             tasks[t.index] = v
@@ -302,8 +305,8 @@ def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
             keys[t.index] = key
             if kept is None:
                 journal.drop(t.record_id)
-                # a direction not drawn: only the check's columns are computed again
-                if not (t.plot and options.plots):
+                # a direction computed before and not drawn: only the check's columns again
+                if texts[t.index] and not (t.plot and options.plots):
                     t = dataclasses.replace(t, only_check=True)
                 tasks[t.index] = t
                 todo.append(t)

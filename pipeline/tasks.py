@@ -76,6 +76,9 @@ class Task:
     #: run the check above the verified width (docs/slivers.md); pipeline.passes decides per
     #: direction of a pair
     check: bool = True
+    #: with ``check``: run it for a column only where its top lies above this width (m, one per
+    #: column; empty: everywhere), ``rocking.search.SearchSettings.check_above``
+    check_above: tuple = ()
     #: draw this task's figures (where ``options.plots``); pipeline.passes decides per direction
     plot: bool = True
     #: compute only the check's columns (:data:`pipeline.batch.CHECK_COLUMNS`) of a direction whose

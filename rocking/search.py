@@ -66,7 +66,9 @@ class SearchSettings:
     failing slivers far above ``w`` are points where the response jumps, and they lie where it
     is irregular from one width to the next, not where the block rocks hardest (on the shared
     records the ratio next to a failing width is often that of the smooth surroundings, 0.3-0.6,
-    while the bin's spread is among the span's largest).  0 runs switch the check off.  The
+    while the bin's spread is among the span's largest).  0 runs switch the check off; so does
+    a top of the span at most ``check_above`` (m; a pair's design width found in other
+    directions, pipeline/passes.py: such a check could not find a failing width above it).  The
     sizes were chosen from
     ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
     """
@@ -99,6 +101,7 @@ class SearchSettings:
     check_stages: int = 5
     check_bins: int = 100
     check_power: float = 3.0
+    check_above: float = 0.0
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):

@@ -226,7 +226,8 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         res.cap_mass_ratio = gamma
         if vertical is not None:
             res.method += "; with the vertical record (compiled engine, fast-vertical)"
-        if not res.below_scan and settings.check_runs > 0:
+        if (not res.below_scan and settings.check_runs > 0
+                and min(settings.check_span * res.width, top) > settings.check_above):
             _add_check(res, top, evaluate_record, settings,
                        _record_seed(excitation, height, criterion, eta, gamma), seen)
         return res
