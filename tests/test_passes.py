@@ -80,6 +80,29 @@ def test_the_check_goes_to_the_governing_direction_then_where_it_could_reach_the
     assert passes._wanted(group, plots=True) == {}
 
 
+def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
+    from pipeline.tasks import Column, Options, Task
+
+    options = Options()
+    cols = (Column(7.5, 1.8),)
+    kinds = ["component-1", "even", "even", "pulse", "even", "even", "component-2", "even", "pulse-normal"]
+    tasks = [Task(i, f"P_{i}", "a", cols, options, path2="b", direction=10.0 * i, direction_kind=k, pair="P")
+             for i, k in enumerate(kinds)] + [Task(9, "lone", "c", cols, options)]
+    first, held = passes.first_pass(tasks, options)
+    # every 4th direction and those chosen for what they are go first, unchecked and undrawn
+    assert held == {1, 2, 5, 7}
+    assert all(not first[i].check and not first[i].plot for i in range(9)) and first[9] == tasks[9]
+    plan = passes.Plan(options, held)
+    for i in sorted(set(range(9)) - held):
+        plan.note(first[i], [{"column": "7.5x1.8", "verified_width_m": 0.5 + 0.1 * i, "height_m": 7.5,
+                              "pga_g": 0.5, "widest_failing_width_m": None}])
+    second = plan.next_pass(first)
+    assert [t.index for t in second] == [1, 2, 5, 7]
+    # each checked where its check could reach above 1.3 m, the scouts' widest verified width
+    assert all(t.check and t.check_above == pytest.approx((1.3,), rel=1e-5) for t in second)
+    assert plan.held == set()
+
+
 @pytest.fixture(scope="module")
 def pair(tmp_path_factory):
     return _pair(tmp_path_factory.mktemp("passes"), "STP", 0.45, 0.3, 1)
@@ -127,3 +150,21 @@ def test_real_pairs_default_design_width_is_the_thorough_one(shared_records, nam
     assert _run(tmp_path / "thorough", pair, *args, "--thorough") == 0
     assert _run(tmp_path / "default", pair, *args) == 0
     assert _same_answer(_rows(tmp_path / "default"), _rows(tmp_path / "thorough")) >= 1
+
+
+def test_check_above_switches_the_check_off_only_where_its_top_is_not_above_it():
+    import importlib.resources
+
+    import pulses
+    import rocking
+
+    record = pulses.read_record(str(importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    full = rocking.required_width(7.5, record, rule="exact")
+    assert full.check_runs > 0 and full.check_top > full.width
+    off = rocking.required_width(7.5, record, rule="exact",
+                                 settings=DEFAULT_SETTINGS.replace(check_above=full.check_top))
+    assert (off.width, off.check_runs, off.failing_share) == (full.width, 0, None)
+    on = rocking.required_width(7.5, record, rule="exact",
+                                settings=DEFAULT_SETTINGS.replace(check_above=full.check_top * (1.0 - 1e-9)))
+    assert (on.width, on.check_runs, on.failing_share, on.widest_failing_width) == \
+        (full.width, full.check_runs, full.failing_share, full.widest_failing_width)
