@@ -146,11 +146,13 @@ def test_check_against_dense_scan_real_record():
     height = 7.5
     rec = pulses.read_record(shared_record("RSN879_LANDERS_LCN345.AT2"))
     res = rocking.required_width(height, rec, rule="exact")
-    assert res.width == pytest.approx(0.593261, rel=1e-5)      # the verified width of today's search
-    x = np.linspace(res.width, min(2.0 * res.width, height * rec.pga / G), 4001)[1:]
+    w = res.search_width
+    assert w == pytest.approx(0.593261, rel=1e-5)      # the search's first transition
+    x = np.linspace(w, min(2.0 * w, height * rec.pga / G), 4001)[1:]
     f = _verdicts(height, rec, x)
-    assert f.any() and x[f].max() > 1.01 * res.width
-    assert res.widest_failing_width is not None and res.widest_failing_width >= 1.01 * res.width
+    assert f.any() and x[f].max() > 1.01 * w
+    assert res.widest_failing_width is not None and res.widest_failing_width >= 1.01 * w
+    assert res.width > res.widest_failing_width          # the design width lies above it
     assert 0.0 < res.failing_share < 0.2
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
                            model="reference", history=False)
@@ -174,7 +176,7 @@ def test_pipeline_reports_the_check(tmp_path):
     # failing widths (0.878 m verified, failing widths up to ~0.885 m)
     ver = rocking.required_width(7.5, pulses.read_record(path), rule="exact")
     width = math.ceil(ver.width * 1000) / 1000
-    assert ver.width <= width < ver.widest_failing_width
+    assert ver.search_width <= width < ver.widest_failing_width < ver.width
     assert main(["run", str(path), "--block", f"7.5x{width}", "--out", str(out), "-q"]) == 0
     row = next(csv.DictReader(open(out / "chaotic.csv")))
     assert float(row["verified_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
