@@ -73,7 +73,10 @@ class SearchSettings:
     The design width: where the check finds a failing width above the search's answer, the
     bracket above the widest failing width (up to the next width run, which survived) is bisected
     to ``design_rtol`` relative, and its surviving end is the design width
-    (:attr:`rocking.widths.RequiredWidth.width`).
+    (:attr:`rocking.widths.RequiredWidth.width`).  The check runs in ``check_rounds`` rounds sharing
+    ``check_runs``, each above the design width the rounds before it left (its span starts
+    there).  ``check_seed``: the check's seed (None: made
+    from the record's samples and the column, so a re-run gives the same widths).
     """
 
     n_scan: int = 64
@@ -105,6 +108,8 @@ class SearchSettings:
     check_bins: int = 100
     check_power: float = 3.0
     design_rtol: float = 1e-6
+    check_seed: int | None = None
+    check_rounds: int = 2
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -123,6 +128,8 @@ class SearchSettings:
             raise ValueError("SearchSettings.check_follow must be in [0, 1), check_bins and "
                              f"check_stages at least 1, got {self.check_follow!r}, "
                              f"{self.check_bins!r}, {self.check_stages!r}")
+        if self.check_rounds < 1:
+            raise ValueError(f"SearchSettings.check_rounds must be at least 1, got {self.check_rounds!r}")
         if not 0.0 < self.design_rtol < 1.0:
             raise ValueError(f"SearchSettings.design_rtol must be in (0, 1), got {self.design_rtol!r}")
         if not self.rtol > 0:

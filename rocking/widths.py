@@ -283,9 +283,10 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         if limit is not None:
             res.method += f"; a width fails where max|theta|/alpha > {limit:g}"
         if not res.below_scan and settings.check_runs > 0:
-            _add_check(res, top, evaluate_record, settings,
-                       _record_seed(excitation, height, criterion, eta, gamma, limit), seen)
-            _raise_to_failures(res, evaluate_record, seen, settings)
+            seed = settings.check_seed
+            if seed is None:
+                seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
+            _check_rounds(res, top, evaluate_record, settings, seed, seen)
         return res
     res = _pulse_width(height, top, lambda idx, widths: _failed(run_widths(widths), criterion, limit),
                        settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol))
@@ -419,11 +420,46 @@ def _record_seed(record, height, criterion, eta, gamma, limit=None) -> int:
     return int.from_bytes(h.digest()[:8], "little")
 
 
-def _add_check(res, top, evaluate, settings, seed, seen=None) -> None:
-    """Run the check above ``res.width`` (``evaluate(widths)``: verdicts and max|theta|/alpha,
-    one batch per stage) and store its outcome in ``res``.  ``seen``: ``(widths, failed,
-    ratio)`` already run by the search; those above the verified width (all survived) join the
-    later stages' measure of the spread at no cost."""
+def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
+    """The check above the search's answer in ``settings.check_rounds`` rounds sharing
+    ``settings.check_runs``: each checks above the design width so far (its span starts there)
+    and raises it above the widest failing width found (:func:`_raise_to_failures`); the later
+    rounds measure the spread over every width run before them.  Stores the outcome in ``res``."""
+    rounds = int(settings.check_rounds)
+    left = int(settings.check_runs)
+    xs, fs, rs = (np.asarray(v) for v in seen)
+    cx, cf = np.zeros(0), np.zeros(0, dtype=bool)
+    base_method, notes = res.method, []
+    for k in range(rounds):
+        n = left // (rounds - k)
+        left -= n
+        x, f, r = _add_check(res, top, evaluate, settings.replace(check_runs=n), seed + k,
+                             (xs, fs, rs))
+        notes.append(f"{x.size} widths from {res.width:.6g} m up to "
+                     f"{min(settings.check_span * res.width, top):.6g} m, {int(f.sum())} failed")
+        cx, cf = np.concatenate([cx, x]), np.concatenate([cf, f])
+        xs, fs, rs = np.concatenate([xs, x]), np.concatenate([fs, f]), np.concatenate([rs, r])
+        res.check_widths, res.check_failed = cx, cf
+        _raise_to_failures(res, evaluate, (xs, fs), settings)
+    order = np.argsort(cx, kind="stable")
+    res.check_widths, res.check_failed = cx[order], cf[order]
+    res.check_runs = int(cx.size)
+    res.check_top = float(min(settings.check_span * res.width, top))
+    res.failing_share = float(cf.mean()) if cx.size else 0.0
+    known = np.concatenate([xs[fs.astype(bool)], [res.widest_failing_width or 0.0]])
+    above = known[known > res.search_width]
+    res.widest_failing_width = float(above.max()) if above.size else None
+    res.method = base_method + (f"; check above it in {rounds} round(s): " + "; ".join(notes)
+                                + (f"; design width {res.width:.6g} m, just above the widest "
+                                   f"failing width {res.widest_failing_width:.6g} m"
+                                   if res.widest_failing_width else ""))
+
+
+def _add_check(res, top, evaluate, settings, seed, seen=None):
+    """One round of the check above ``res.width`` (``evaluate(widths)``: verdicts and
+    max|theta|/alpha, one batch per stage): ``(widths, failed, ratio)`` in the order run.
+    ``seen``: ``(widths, failed, ratio)`` already run; those above ``res.width`` join the later
+    stages' measure of the spread at no cost."""
     x = check_widths(res.width, top, settings, seed)
     f, r = evaluate(x) if x.size else (np.zeros(0, dtype=bool), np.zeros(0))
     f, r = np.asarray(f, dtype=bool), np.asarray(r, dtype=float)
@@ -442,40 +478,25 @@ def _add_check(res, top, evaluate, settings, seed, seen=None) -> None:
             fy, ry = evaluate(y)
             x, f, r = (np.concatenate([x, y]), np.concatenate([f, np.asarray(fy, dtype=bool)]),
                        np.concatenate([r, np.asarray(ry, dtype=float)]))
-    order = np.argsort(x, kind="stable")
-    x, f = x[order], f[order]
-    res.check_top = float(min(settings.check_span * res.width, top))
-    res.check_runs = int(x.size)
-    res.failing_share = float(f.mean()) if x.size else 0.0
-    res.widest_failing_width = float(x[f].max()) if f.any() else None
-    res.check_widths, res.check_failed = x, f
-    res.method += (f"; check above it: {x.size} jittered widths up to {res.check_top:.4g} m "
-                   f"in {stages + 1} stages, {int(f.sum())} failed"
-                   + (f" (widest {res.widest_failing_width:.4g} m)" if f.any() else ""))
+    return x, f, r
 
 
 def _raise_to_failures(res, evaluate, seen, settings) -> None:
-    """Make ``res.width`` the design width: where a width run by the search or the check failed
-    above the search's answer, bisect the bracket from the widest failing width up to the next
-    width run (which survived) to ``settings.design_rtol`` relative, and take its surviving end.
-    Widths found failing by the bisection move the bracket up, so the design width is above every
-    width found to fail."""
-    x = np.concatenate([np.asarray(seen[0], dtype=float), res.check_widths])
-    f = np.concatenate([np.asarray(seen[1], dtype=bool), res.check_failed])
+    """Raise ``res.width`` above every width found to fail: where one of ``seen`` (``(widths,
+    failed)``, every width run) failed above it, bisect the bracket from the widest failing width
+    up to the next width run (which survived) to ``settings.design_rtol`` relative and take its
+    surviving end; widths found failing by the bisection move the bracket up."""
+    x, f = np.asarray(seen[0], dtype=float), np.asarray(seen[1], dtype=bool)
     if not (f & (x > res.width)).any():
         return
     lo = float(x[f].max())
     hi = float(np.min(x[x > lo]))           # run, and survived (lo is the widest failure)
-    runs = 0
     while hi - lo > settings.design_rtol * hi:
         mid = 0.5 * (lo + hi)
         failed = bool(np.asarray(evaluate(np.array([mid]))[0])[0])
-        runs += 1
+        res.refine_runs += 1
         lo, hi = (mid, hi) if failed else (lo, mid)
-    res.widest_failing_width = lo
-    res.width, res.refine_runs = hi, runs
-    res.method += (f"; design width {hi:.6g} m: just above the widest failing width {lo:.6g} m "
-                   f"(bisected to {settings.design_rtol:g} relative, {runs} runs)")
+    res.width, res.widest_failing_width = hi, lo
 
 
 #: how far below the scan's narrowest width (in halvings) the verified width looks for a failure

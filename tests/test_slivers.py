@@ -213,11 +213,11 @@ def test_check_uses_the_search_widths():
     first = check_widths(w, top, s, seed=3)
     for known, expect in ((seen, n_later), (None, n_later / k)):
         res = rocking.RequiredWidth(w, 7.5, "exact", 0, "test")
-        _add_check(res, top, flat, s, 3, known)
-        later = res.check_widths[~np.isin(res.check_widths, first)]
-        assert later.size == n_later and res.check_runs == s.check_runs
+        x, f, _ = _add_check(res, top, flat, s, 3, known)
+        later = x[~np.isin(x, first)]
+        assert later.size == n_later and x.size == s.check_runs
         in_bin = int(np.sum((later > edges[j]) & (later <= edges[j + 1])))
         # all later widths in that bin (the widths below w and above the span are left out);
         # without the search's widths, the even share of one bin (within one: largest remainders)
         assert abs(in_bin - expect) <= 1.0, (known is None, in_bin, expect)
-    assert res.widest_failing_width is None and res.failing_share == 0.0
+    assert not f.any()
