@@ -333,7 +333,7 @@ def table_text(rows, failures=(), summary=()) -> str:
     lines += [line(c) for c in body]
     for f in failures:
         lines.append(f"{display(f['record'])}  failed ({f['stage']}): {' '.join(display(f['reason']).split())}")
-    lines += [""] + verdict_lines(rows)
+    lines += [""] + verdict_lines(rows) + [t for t in (fine_print(rows),) if t]
     seen = {}
     for r in summary:
         text = metadata_text(r)
@@ -379,15 +379,20 @@ def verdict_lines(rows) -> list[str]:
         over = _count(group, "eq31_width_overturns")
         out.append(f"Eq. 31 is below the design width on {below} of {n} record(s); its design "
                    f"overturns under {over}.")
-    runs = [number(r.get("check_runs")) for r in rows if number(r.get("check_runs"))]
-    if runs:
-        out.append(f"Design width: at least every width the search and the check above it found to "
-                   f"fail, refined just above the widest; the check ran {min(runs):.0f}"
-                   + (f"-{max(runs):.0f}" if max(runs) > min(runs) else "")
-                   + " widths per record from the search width up to twice it (or the no-uplift "
-                   "width); thinner failing slivers may remain (docs/slivers.md). Search width: the "
-                   "search's first transition, with how far the design width lies above it.")
     return out
+
+
+def fine_print(rows) -> str | None:
+    """What was tested above the design width (None where no check ran)."""
+    runs = [number(r.get("check_runs")) for r in rows if number(r.get("check_runs"))]
+    if not runs:
+        return None
+    return ("Design width: at least every width the search and the check above it found to "
+            f"fail, refined just above the widest; the check ran {min(runs):.0f}"
+            + (f"-{max(runs):.0f}" if max(runs) > min(runs) else "")
+            + " widths per record from the search width up to twice it (or the no-uplift "
+            "width); thinner failing slivers may remain (docs/slivers.md). Search width: the "
+            "search's first transition, with how far the design width lies above it.")
 
 
 def columns_markdown() -> str:

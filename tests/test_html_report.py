@@ -165,32 +165,46 @@ def test_design_rows_of_a_pair():
     assert d["record"] == "A+B" and d["direction_deg"] == 90.0 and d["verified_width_m"] == 1.9
     assert d["n_directions"] == 3 and d["n_directions_failed"] == 1
     assert d["survives"] is False and d["verified_adequate"] is False and d["max_theta_ratio"] == 5.0
-    assert design_table.survives_text(d) == "NO"
+    assert design_table.survives_text(d) == "NO" and d["verdict"] == "NO"
     text = design_table.table_text([d])
     assert "A+B @90deg" in text and "1.900 m" in text
 
 
-def test_report_html_says_how_far_above_the_verified_width_a_column_fails():
-    """The batch table's widest failing width and each record's check line carry its excess over
-    the verified width in percent: far above, a hair above (equal to 3 decimals), none found."""
+def test_report_html_says_how_far_above_the_search_width_a_column_fails():
+    """The batch table's design width, search width and widest failing width, each record's check
+    line (what was tested above the width), the verdict lines at the top, a safe island flagged
+    like a failure and an overturned row saying so."""
     base = dict(column="7.5x1.8", column_kind="block", width_m=1.8, scale=1.0, pulse_like=True,
                 velocity_tp_s=1.2, governing_shape="sine", governing_ap_g=0.5, governing_tp_s=0.8,
                 eq31_width_m=2.0, eq31_width_overturns=False, direction_deg=None, overturns=False,
-                verified_adequate=True, max_theta_ratio=0.3, verified_width_m=0.593, check_runs=40)
-    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05),
-            dict(base, record="tiny", widest_failing_width_m=0.593 * 1.00012, failing_share=0.025),
-            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0)]
+                verified_adequate=True, max_theta_ratio=0.3, search_width_m=0.593, check_runs=40)
+    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05, verified_width_m=0.6081),
+            dict(base, record="tiny", widest_failing_width_m=0.593 * 1.00012, failing_share=0.025,
+                 verified_width_m=0.593 * 1.00013),
+            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0, verified_width_m=0.593),
+            dict(base, record="island", widest_failing_width_m=None, failing_share=0.0, verified_width_m=2.1,
+                 search_width_m=2.1, verified_adequate=False, eq31_width_m=1.5),
+            dict(base, record="over", widest_failing_width_m=None, failing_share=0.0, verified_width_m=2.2,
+                 search_width_m=2.2, verified_adequate=False, overturns=True, max_theta_ratio=5.36)]
+    ids = [r["record"] for r in rows]
     design = design_table.design_rows(rows)
-    page = html_report.report_html(design, rows, [], ["far", "tiny", "none"], {})
-    cells = {r: re.search(rf'<tr><td data-v="{r}">.*?</tr>', page).group(0) for r in ("far", "tiny", "none")}
-    # the cell shows metres and percent, and sorts by the number in metres
+    page = html_report.report_html(design, rows, [], ids, {})
+    cells = {r: re.search(rf'<tr[^>]*><td data-v="{r}">.*?</tr>', page).group(0) for r in ids}
+    # the widest failing cell shows metres and percent over the search width, sorts by metres
     assert '<td class="n" data-v="0.608">0.608 (+2.5 %)</td>' in cells["far"]
     assert re.search(r'<td class="n" data-v="0\.593\d+">0\.593 \(\+0\.01 %\)</td>', cells["tiny"])
     assert '<td class="n" data-v="">-</td>' in cells["none"] and "%)" not in cells["none"]
-    assert "5 % overturn, the widest at 0.608 m (+2.5 %)" in page
-    assert "2.5 % overturn, the widest at 0.593 m (+0.01 %)" in page
-    assert "check above it: 40 widths, none overturns" in page
-    assert html_report.report_html(design, rows, [], ["far", "tiny", "none"], {}) == page
+    assert "5 % fail, the widest at 0.608 m (+2.5 %) (the design width lies just above it)" in page
+    assert "check above the search width: 40 widths up to twice it (or the no-uplift width), none fails" in page
+    # Eq. 31 below the design width, the safe island flagged, the overturned row
+    assert "1.500 BELOW" in cells["island"] and 'class="island"' in cells["island"]
+    assert ">NO: safe island<" in cells["island"]
+    assert ">overturned</td>" in cells["over"] and ">5.36<" not in cells["over"]   # sorts by the ratio
+    # the verdict lines come first, before the table
+    top = page.index('<p class="verdict">')
+    assert top < page.index('<table') and "the design width covering all 5 record(s) is 2.200 m" in page
+    assert "Eq. 31 is below the design width on 2 of 5 record(s); its design overturns under 0." in page
+    assert html_report.report_html(design, rows, [], ids, {}) == page
 
 
 # -- in a real browser -----------------------------------------------------------------------------
