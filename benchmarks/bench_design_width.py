@@ -85,9 +85,13 @@ def measure(paths, heights, settings=None):
             widest = float(x[f].max()) if f.any() else None
             ratio = rocking.simulate(rocking.Block.from_dimensions(H, half.width), record,
                                      history=False).max_rotation_ratio
+            fx = x[f]
             row = dict(record=path.stem, height=H, w=w, W=W, widest_dense=widest,
                        far_old=bool(widest and widest > 1.01 * w),
                        far_new=bool(widest and widest > 1.01 * W),
+                       # within the span the check covers: (w, 2 w] today, (W, 2 W] now
+                       far_old_2=bool(np.any((fx > 1.01 * w) & (fx <= 2.0 * w))),
+                       far_new_2=bool(np.any((fx > 1.01 * W) & (fx <= 2.0 * W))),
                        runs=over.total_runs, runs_today=over.runs + over.check_runs,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
                        t_over=t_over, t_half=t_half)
@@ -114,6 +118,10 @@ def table(rows):
         f"{n} cases (records x heights); dense grid {DENSE} linear widths in (w, min({SPAN:g} w, top)].",
         f"- failing widths more than 1 % above the search's answer w (today's width): {old} cases; "
         f"more than 1 % above the design width W: {new} cases",
+        f"- within the check's span: failing widths in (1.01 w, 2 w]: "
+        f"{sum(r['far_old_2'] for r in rows)} cases; in (1.01 W, 2 W]: "
+        f"{sum(r['far_new_2'] for r in rows)} cases ("
+        + ", ".join(f"{r['record']} {r['height']:g} m" for r in rows if r["far_new_2"]) + ")",
         f"- W above w on {raised} cases (median +{np.median(up[up > 0]) if raised else 0:.2f} %, "
         f"max +{up.max():.2f} %)",
         f"- limit {LEVEL}: max|theta|/alpha at W_R above {LEVEL} on {len(bad_half)} cases "
