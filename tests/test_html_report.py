@@ -56,30 +56,37 @@ def test_printed_table_and_design_csv(demo):
     assert len(ids) == 5
     rows = list(csv.DictReader(io.StringIO((out / "design.csv").read_text())))
     summary = list(csv.DictReader(io.StringIO((out / "summary.csv").read_text())))
-    assert len(next(iter(rows)).keys()) <= 20
+    assert len(next(iter(rows)).keys()) <= 26
     assert [r["record"] for r in rows] == ids  # one column: a row per record, input order
     # every value comes from summary.csv unchanged (a single component: its only direction)
     for d, s in zip(rows, summary):
         for key in ("pulse_like", "governing_shape", "governing_ap_g", "governing_tp_s", "eq31_width_m",
-                    "verified_width_m", "width_m", "verified_adequate", "max_theta_ratio"):
+                    "verified_width_m", "width_m", "verified_adequate", "max_theta_ratio",
+                    "search_width_m", "check_runs"):
             assert d[key] == s[key], key
         assert d["survives"] == str(s["overturns"] == "False")
-    # the printed table: a header, a rule and one line per record and column, before the last line
+        # the design width is above every failing width found, and at least the search's
+        assert float(d["verified_width_m"]) >= float(d["search_width_m"])
+        if d["widest_failing_width_m"]:   # above it by at most design_rtol 1e-6: equal to 6 digits
+            assert float(d["verified_width_m"]) >= float(d["widest_failing_width_m"])
+        assert d["eq31_below_design"] == str(float(d["eq31_width_m"]) < float(d["verified_width_m"]))
+    # the printed table: a header, a rule and one line per record and column, then the verdict
+    # lines, before the last line
     lines = proc.stdout.splitlines()
     assert lines[-1].startswith("pipeline run: 5 of 5 records processed")
     head = lines.index(next(l for l in lines if l.startswith("record ")))
-    body = lines[head + 2:-1]
-    assert len(body) == len(rows)
+    body = lines[head + 2:head + 2 + len(rows)]
+    assert lines[head + 2 + len(rows)] == ""
     for line, row in zip(body, rows):
         assert line.startswith(row["record"])
         assert f"{float(row['verified_width_m']):.3f} m" in line
         assert f"{float(row['eq31_width_m']):.3f} m" in line
-        # the widest failing width with its excess over the verified width, or a dash
-        if row["widest_failing_width_m"]:
-            fail, verified = float(row["widest_failing_width_m"]), float(row["verified_width_m"])
-            m = re.search(re.escape(f"{fail:.3f} m (") + r"(<?)\+([\d.]+) %\)", line)
+        # the search width with the design width's excess over it, or no percentage
+        design, search = float(row["verified_width_m"]), float(row["search_width_m"])
+        if design > search:
+            m = re.search(re.escape(f"{search:.3f} m (") + r"(<?)\+([\d.]+) %\)", line)
             assert m, line
-            pct = 100 * (fail - verified) / verified
+            pct = 100 * (design - search) / search
             if m.group(1):
                 assert pct < 0.01
             else:  # the percentage shown is the excess rounded to its last digit
@@ -87,8 +94,15 @@ def test_printed_table_and_design_csv(demo):
                 assert abs(float(m.group(2)) - pct) <= 0.5 * 10 ** -decimals + 1e-9, (m.group(0), pct)
         else:
             assert "%)" not in line
-        assert line.rstrip().endswith({"True": "yes" if row["verified_adequate"] == "True" else "yes, safe island",
+        assert line.rstrip().endswith({"True": "yes" if row["verified_adequate"] == "True" else "NO: safe island",
                                        "False": "NO"}[row["survives"]])
+    widest = max(rows, key=lambda r: float(r["verified_width_m"]))
+    assert (f"the design width covering all 5 record(s) is {float(widest['verified_width_m']):.3f} m "
+            f"(set by {widest['record']})") in proc.stdout
+    below = sum(r["eq31_below_design"] == "True" for r in rows)
+    over = sum(r["eq31_width_overturns"] == "True" for r in rows)
+    assert f"Eq. 31 is below the design width on {below} of 5 record(s); its design overturns under {over}." in proc.stdout
+    assert "the check ran 1500 widths per record" in proc.stdout
     # the files are the run's own: listed in the manifest (so a re-run may replace them)
     manifest = (out / "pipeline-manifest.txt").read_text()
     assert "  design.csv\n" in manifest and "  report.html\n" in manifest
@@ -225,7 +239,7 @@ _PROBE = """<script>
       return {src: i.getAttribute("src"), ok: i.complete && i.naturalWidth > 0, width: i.naturalWidth};
     });
     var heads = table.tHead.rows[0].cells, col = -1;
-    for (var k = 0; k < heads.length; k++) { if (heads[k].textContent.indexOf("verified width") === 0) { col = k; } }
+    for (var k = 0; k < heads.length; k++) { if (heads[k].textContent.indexOf("design width") === 0) { col = k; } }
     heads[col].click();
     var sorted = Array.prototype.map.call(table.tBodies[0].rows, function (r) { return parseFloat(r.cells[col].getAttribute("data-v")); });
     heads[col].click();
