@@ -66,9 +66,6 @@ def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
            "failure": None, "plot": None, "widths_plot": None}
     try:
-        if task.only_check:
-            out["rows"] = _check_rows(task)
-            return out
         rows, fit_parts, verified = _process(task)
         out["rows"] = rows
     except StageError as err:
@@ -376,15 +373,27 @@ def _eq31_design_fields(height, w31, res31) -> dict:
 
 
 VERIFIED_COLUMNS = Columns(
-    ("verified_width_m", "m", "Verified width: the smallest width for which a column of this height "
-                              "survives the full record, at that width and every larger one (a search "
-                              "that finds every transition, so it is not fooled by safe islands; "
-                              "`rocking.required_width`, rule exact). Independent of the pulse fit."),
-    ("verified_tan_alpha", "-", "tan(alpha) of the verified width, verified_width_m / height_m."),
-    ("verified_adequate", "-", "The column as it stands is at least as wide as the verified width "
+    ("verified_width_m", "m", "Design width: the smallest width for which a column of this height "
+                              "survives the full record (max|theta|/alpha <= `design_limit` with "
+                              "`--limit`), at that width and at every larger one the search and the "
+                              "check above it examined: at least every width they found to fail, "
+                              "refined just above the widest (`rocking.required_width`, rule exact, "
+                              "`.width`); with a vertical component, the wider of the horizontal "
+                              "motion's and the one with the vertical (`design_governed_by`). "
+                              "Independent of the pulse fit."),
+    ("verified_tan_alpha", "-", "tan(alpha) of the design width, verified_width_m / height_m."),
+    ("verified_adequate", "-", "The column as it stands is at least as wide as the design width "
                                "(blank for `--height`). A column that survives (`overturns` False) "
                                "but is not verified-adequate stands on a safe island: some slightly "
                                "wider column of the same height overturns under the same record."),
+    ("search_width_m", "m", "Diagnostic: the search's first transition (the smallest width above "
+                            "which every width the search examined survives; `search_width`), "
+                            "before the check above it; the design width is at least this."),
+    ("design_governed_by", "-", "Which motion sets the design width: `horizontal` (the horizontal "
+                                "motion alone) or `with vertical` (the horizontal motion with the "
+                                "record's vertical); blank without a vertical."),
+    ("design_limit", "-", "The performance level of the design (`--limit` R: max|theta|/alpha <= R); "
+                          "blank: overturning, the paper's question."),
 )
 
 
@@ -392,6 +401,8 @@ def _verified_fields(col: Column, ver) -> dict:
     return VERIFIED_COLUMNS.row({
         "verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / col.height,
         "verified_adequate": None if col.width is None else col.width >= float(ver.width),
+        "search_width_m": None if ver.search_width is None else float(ver.search_width),
+        "design_governed_by": ver.governed_by, "design_limit": ver.limit,
     })
 
 
@@ -418,44 +429,6 @@ def _check_fields(ver) -> dict:
         "failing_share": ver.failing_share, "widest_failing_width_m": ver.widest_failing_width,
         "check_runs": ver.check_runs,
     })
-
-
-def _check_rows(task: Task) -> list[dict]:
-    """The check's columns of each of the task's columns (``{"column": label, ...}``): the search
-    and the check above its verified width, as :func:`_process` runs them."""
-    import rocking
-
-    record, _, _ = _stage("read", vertical.read_task, task)
-    rows = []
-    for col in task.columns:
-        ver = _stage("verify", rocking.required_width, col.height, record, rule="exact",
-                     cap_mass_ratio=task.options.cap_mass_ratio)
-        rows.append({"column": col.label, "verified_width_m": float(ver.width), **_check_fields(ver)})
-    return rows
-
-
-def patch_check(rows_text: str, check_rows) -> str:
-    """``rows_text`` (a task's rows as its report holds them, without the header) with the check's
-    columns of each column set from ``check_rows`` (:func:`_check_rows`), written as
-    :func:`pipeline.report.csv_text` writes them."""
-    import csv
-    import io
-
-    from .report import fmt
-
-    by_label = {r["column"]: r for r in check_rows}
-    at = {name: FIELDS.index(name) for name in CHECK_COLUMNS.names}
-    col, ver = FIELDS.index("column"), FIELDS.index("verified_width_m")
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    for cells in csv.reader(io.StringIO(rows_text)):
-        new = by_label[cells[col]]
-        if cells[ver] != fmt(new["verified_width_m"]):  # the same search: never expected
-            raise RuntimeError(f"{cells[col]}: the check's search found another verified width")
-        for name, k in at.items():
-            cells[k] = fmt(new[name])
-        writer.writerow(cells)
-    return buf.getvalue()
 
 
 #: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
@@ -493,11 +466,7 @@ def _process(task: Task):
         base["warnings"] = "; ".join(w for w in (base["warnings"], vertical_note) if w)
     shown_vertical = None if up is None else (up.metadata.get("source") or task.vertical)
     draw = opts.plots and task.plot
-    # the check above the verified width where pipeline.passes asks for it (docs/slivers.md)
-    from rocking.search import DEFAULT_SETTINGS
-
-    settings = DEFAULT_SETTINGS if task.check else DEFAULT_SETTINGS.replace(check_runs=0)
-    above = dict(zip(task.columns, task.check_above))
+    settings = _check_settings(task)
 
     gamma = opts.cap_mass_ratio
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
@@ -545,15 +514,17 @@ def _process(task: Task):
         if draw:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
 
-        # -- verified width: smallest width surviving the full record (islands respected) ---------
+        # -- design width: smallest width surviving the full record (islands respected), above
+        #    every width found to fail, with the vertical where there is one ----------------------
         if H not in verified_cache:
-            verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact",
-                                       cap_mass_ratio=gamma,
-                                       settings=settings.replace(check_above=above.get(col, 0.0)))
-        if draw:  # the column at its verified width, for the figure
+            alone = _stage("verify", rocking.required_width, H, record, rule="exact",
+                           cap_mass_ratio=gamma, limit=opts.limit,
+                           settings=settings[col])
+            verified_cache[H] = _stage("verify", vertical.design, record, up, H, alone, gamma, opts.limit)
+        if draw:  # the column at its design width, for the figure
             wv = float(verified_cache[H].width)
             block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
-            curves.append((f"verified width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
+            curves.append((f"design width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
             histories.append((col.label, curves))
 
         row = dict(base)
@@ -564,10 +535,20 @@ def _process(task: Task):
         row.update(_verified_fields(col, verified_cache[H]))
         row.update(_check_fields(verified_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, H, gamma))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, verified_cache[H]))
         rows.append(row)
 
     return rows, (record, fit, fitting, histories, velocity), verified_cache
+
+
+def _check_settings(task: Task) -> dict:
+    """The search's settings for each column: the check above the design width where
+    pipeline.passes asks for it (docs/slivers.md)."""
+    from rocking.search import DEFAULT_SETTINGS
+
+    base = DEFAULT_SETTINGS if task.check else DEFAULT_SETTINGS.replace(check_runs=0)
+    above = dict(zip(task.columns, task.check_above))
+    return {col: base.replace(check_above=above.get(col, 0.0)) for col in task.columns}
 
 
 def _classify(record):

@@ -1,11 +1,13 @@
 """Which directions of a pair get the check above the verified width and the figures.
 
 A pair designed in many directions is governed by its widest direction: the pair's design width is
-the widest of its directions' verified widths and of the failing widths their checks find
+the widest of its directions' design widths, each above every failing width its check found
 (docs/slivers.md).  The check of a direction (1500 runs) changes that answer only where it can
-find a failing width above the pair's design width, and it looks only up to ``check_top = min(
-check_span w, H PGA / g)`` (``rocking.search.SearchSettings``; the no-uplift width under the
-direction's component).  So ``pipeline run`` computes a pair in passes:
+find a failing width above the pair's design width, and it looks only up to ``check_top =
+min(check_span ** check_rounds w, H PGA / g)`` (``rocking.search.SearchSettings``: each round's
+span is at most ``check_span`` times the width the round before left; ``w`` the search's width,
+``H PGA / g`` the no-uplift width under the direction's component).  So ``pipeline run`` computes a
+pair in passes:
 
 1. a few *scout* directions (the recorded components, the pulse's and its normal, every
    :data:`SCOUT_EVERY` th direction in angle order): the search only (no check), no figure
@@ -16,8 +18,9 @@ direction's component).  So ``pipeline run`` computes a pair in passes:
 3. the governing direction (widest verified width, the first such in angle order, as in
    ``pairs.csv``) with its check where not done, and its figures;
 4. then, while any is left, every unchecked direction whose ``check_top`` lies above the pair's
-   design width found so far (the widest verified or failing width of the checked directions):
-   the search and the check again (its later stages use the search's widths), not the fit.
+   design width found so far (the widest design width of the checked directions): the whole
+   direction again (the check's later stages use the search's widths, and the check may raise
+   the direction's design width, which other columns use).
 
 A direction left unchecked cannot find a failing width above the pair's final design width, so
 the pair's design width is the one ``--thorough`` (every direction checked, as a lone record)
@@ -78,7 +81,7 @@ class Plan:
         from rocking.search import DEFAULT_SETTINGS
 
         self.options = options
-        self.span = float(DEFAULT_SETTINGS.check_span)
+        self.span = float(DEFAULT_SETTINGS.check_span) ** int(DEFAULT_SETTINGS.check_rounds)
         self.pairs: dict[str, dict[int, _Direction]] = {}
         #: the directions held back from the first pass (indices)
         self.held = set(held)

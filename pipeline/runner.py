@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from . import design_table, html_report, interrupts, joblog, outfiles, outlock, passes, report, resume, site
 from .args import ArgumentError, output_folder
-from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure, patch_check
+from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV  # noqa: F401 (tests set it through the runner)
 from .tasks import Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
@@ -230,9 +230,6 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
     i = res["index"]
     task = tasks[i]
     figure = res.get("plot")
-    if task.only_check and res["rows"]:  # the check's columns on the rows an earlier pass gave
-        res["rows"] = resume.rows_from_text(patch_check(texts[i], res["rows"]))
-        task = tasks[i] = dataclasses.replace(task, only_check=False)
     _write_record(outputs, task, res, options.plots and task.plot, say)
     texts[i] = report.csv_text(FIELDS, res["rows"])[len(header):]
     failures[i] = res["failure"]
@@ -305,9 +302,6 @@ def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
             keys[t.index] = key
             if kept is None:
                 journal.drop(t.record_id)
-                # a direction computed before and not drawn: only the check's columns again
-                if texts[t.index] and not (t.plot and options.plots):
-                    t = dataclasses.replace(t, only_check=True)
                 tasks[t.index] = t
                 todo.append(t)
             else:

@@ -48,6 +48,8 @@ class Options:
     cap_mass_ratio: float = 0.0
     fragility: bool = False
     up_to: float = 10.0
+    #: the performance level (``--limit`` R: max|theta|/alpha <= R); None: overturning
+    limit: float | None = None
     #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
     vertical: str = "auto"
     #: ``--thorough``: every direction of a pair gets the check above its verified width and
@@ -81,9 +83,6 @@ class Task:
     check_above: tuple = ()
     #: draw this task's figures (where ``options.plots``); pipeline.passes decides per direction
     plot: bool = True
-    #: compute only the check's columns (:data:`pipeline.batch.CHECK_COLUMNS`) of a direction whose
-    #: other columns an earlier pass gave (pipeline.passes)
-    only_check: bool = False
 
 
 # -- record ids ------------------------------------------------------------------------------------

@@ -17,6 +17,9 @@ from rocking.search import DEFAULT_SETTINGS
 from .test_site import H, B, _pair
 
 CHECK = list(CHECK_COLUMNS.names)
+#: what the check decides besides its own columns: the direction's design width (the search's
+#: width where it found no failing width above it)
+DESIGN = CHECK + ["verified_width_m", "verified_tan_alpha", "verified_adequate"]
 
 
 def _rows(out):
@@ -32,7 +35,8 @@ def _design(rows) -> float:
 def _top(row) -> float:
     """The widest width the check of this row's direction would look at (rocking.widths)."""
     w = float(row["verified_width_m"])
-    return min(DEFAULT_SETTINGS.check_span * w, float(row["height_m"]) * float(row["pga_g"]))
+    return min(DEFAULT_SETTINGS.check_span ** DEFAULT_SETTINGS.check_rounds * w,
+               float(row["height_m"]) * float(row["pga_g"]))
 
 
 def _run(out, pair, *extra):
@@ -53,8 +57,9 @@ def _same_answer(default, thorough):
             n_checked += 1
             assert r == ref
         else:
-            assert {k: v for k, v in r.items() if k not in CHECK} == {k: v for k, v in ref.items() if k not in CHECK}
+            assert {k: v for k, v in r.items() if k not in DESIGN} == {k: v for k, v in ref.items() if k not in DESIGN}
             assert r["failing_share"] == "" and r["widest_failing_width_m"] == ""
+            assert r["verified_width_m"] == r["search_width_m"] == ref["search_width_m"]
             assert _top(r) <= design * (1.0 + passes.MARGIN)
     return n_checked
 
@@ -160,11 +165,13 @@ def test_check_above_switches_the_check_off_only_where_its_top_is_not_above_it()
 
     record = pulses.read_record(str(importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
     full = rocking.required_width(7.5, record, rule="exact")
-    assert full.check_runs > 0 and full.check_top > full.width
-    off = rocking.required_width(7.5, record, rule="exact",
-                                 settings=DEFAULT_SETTINGS.replace(check_above=full.check_top))
-    assert (off.width, off.check_runs, off.failing_share) == (full.width, 0, None)
-    on = rocking.required_width(7.5, record, rule="exact",
-                                settings=DEFAULT_SETTINGS.replace(check_above=full.check_top * (1.0 - 1e-9)))
+    s = DEFAULT_SETTINGS
+    # the widest width the check's rounds could reach: each round's span is at most check_span
+    # times the width the one before left, and nothing rocks above the no-uplift width
+    reach = min(s.check_span ** s.check_rounds * full.search_width, 7.5 * record.pga / pulses.G)
+    assert full.check_runs > 0 and reach > full.search_width
+    off = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=reach))
+    assert (off.width, off.check_runs, off.failing_share) == (full.search_width, 0, None)
+    on = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=reach * (1.0 - 1e-9)))
     assert (on.width, on.check_runs, on.failing_share, on.widest_failing_width) == \
         (full.width, full.check_runs, full.failing_share, full.widest_failing_width)
