@@ -99,7 +99,8 @@ def measure(baseline, n_pairs, jobs) -> list[dict]:
             for name, r in runs.items():
                 entry[name] = {"cpu_per_direction": r["cpu"] / n, "main_share": r["main"] / r["cpu"],
                                "png_mb": r["png_bytes"] / 1e6, "design_width": design_width(r["rows"]),
-                               "exit": r["code"]}
+                               "exit": r["code"],
+                               "checked": sum(row["check_runs"] not in ("", "0") for row in r["rows"])}
             entry["thorough_rows_equal_baseline"] = same_rows(runs["thorough"]["rows"], runs["baseline"]["rows"])
             entry["default_design_equals_thorough"] = (entry["default"]["design_width"]
                                                        == entry["thorough"]["design_width"])
