@@ -7,7 +7,8 @@ find a failing width above the pair's design width, and it looks only up to ``ch
 min(check_span ** check_rounds w, H PGA / g)`` (``rocking.search.SearchSettings``: each round's
 span is at most ``check_span`` times the width the round before left; ``w`` the search's width,
 ``H PGA / g`` the no-uplift width under the direction's component).  So ``pipeline run`` computes a
-pair in passes:
+pair in passes (a check's top below also allows for the bracket above a failing width it may raise the
+design width to, :func:`_bracket_step`):
 
 1. a few *scout* directions (the recorded components, the pulse's and its normal, every
    :data:`SCOUT_EVERY` th direction in angle order): the search only (no check), no figure
@@ -37,6 +38,15 @@ from .report import fmt
 #: a check whose top lies within this share of the design width is run all the same (the rows'
 #: numbers are read back from text, with their rounding)
 MARGIN = 1e-6
+
+
+def _bracket_step() -> float:
+    """How far above a check's top the design width it sets may lie: a failing width is raised to
+    the end of its bracket, the next width run above it, at worst the search's next scanned width
+    (geometric, ``record_scan`` widths from ``record_low`` of the no-uplift width up to it)."""
+    from rocking.search import DEFAULT_SETTINGS as s
+
+    return (1.0 / s.record_low) ** (1.0 / (s.record_scan - 1))
 
 
 def staged(task, options) -> bool:
@@ -82,6 +92,7 @@ class Plan:
 
         self.options = options
         self.span = float(DEFAULT_SETTINGS.check_span) ** int(DEFAULT_SETTINGS.check_rounds)
+        self.step = _bracket_step()
         self.pairs: dict[str, dict[int, _Direction]] = {}
         #: the directions held back from the first pass (indices)
         self.held = set(held)
@@ -101,7 +112,8 @@ class Plan:
             # as the report holds them (6 digits): a resumed run decides as the first did
             w, H, pga, widest = (None if r.get(k) in (None, "") else float(fmt(float(r[k])))
                                  for k in ("verified_width_m", "height_m", "pga_g", "widest_failing_width_m"))
-            cols[r["column"]] = (w, min(self.span * w, H * pga), widest)
+            # the widest design width its check could set (above the reach of its rounds)
+            cols[r["column"]] = (w, self.step * min(self.span * w, H * pga), widest)
         group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols)
 
     def next_pass(self, tasks) -> list:
@@ -129,7 +141,7 @@ class Plan:
             for d in group.values():
                 for label, (w, _, _) in d.columns.items():
                     lower[label] = max(lower.get(label, 0.0), w)
-            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) for c in t.columns)
+            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) / self.step for c in t.columns)
             out.append(dataclasses.replace(t, check=True, check_above=above))
         self.held = set()
         return out

@@ -35,8 +35,8 @@ def _design(rows) -> float:
 def _top(row) -> float:
     """The widest width the check of this row's direction would look at (rocking.widths)."""
     w = float(row["verified_width_m"])
-    return min(DEFAULT_SETTINGS.check_span ** DEFAULT_SETTINGS.check_rounds * w,
-               float(row["height_m"]) * float(row["pga_g"]))
+    return passes._bracket_step() * min(DEFAULT_SETTINGS.check_span ** DEFAULT_SETTINGS.check_rounds * w,
+                                        float(row["height_m"]) * float(row["pga_g"]))
 
 
 def _run(out, pair, *extra):
@@ -104,7 +104,8 @@ def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
     second = plan.next_pass(first)
     assert [t.index for t in second] == [1, 2, 5, 7]
     # each checked where its check could reach above 1.3 m, the scouts' widest verified width
-    assert all(t.check and t.check_above == pytest.approx((1.3,), rel=1e-5) for t in second)
+    step = passes._bracket_step()
+    assert all(t.check and t.check_above == pytest.approx((1.3 / step,), rel=1e-5) for t in second)
     assert plan.held == set()
 
 
