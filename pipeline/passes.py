@@ -123,9 +123,13 @@ class Plan:
             return self._second_pass(tasks)
         out = []
         for group in self.pairs.values():
-            want = _wanted(group, bool(self.options.plots))
-            out += [dataclasses.replace(tasks[i], check=True, check_above=(), plot=plot or tasks[i].plot)
-                    for i, plot in sorted(want.items())]
+            want, design = _wanted(group, bool(self.options.plots))
+            for i, plot in sorted(want.items()):
+                # the governing direction's check whole; the others' rounds where they could reach
+                # above the pair's design width so far
+                above = () if plot else tuple(design.get(c.label, 0.0) * (1.0 - MARGIN) / self.step
+                                              for c in tasks[i].columns)
+                out.append(dataclasses.replace(tasks[i], check=True, check_above=above, plot=plot or tasks[i].plot))
         return out
 
     def _second_pass(self, tasks) -> list:
@@ -147,9 +151,10 @@ class Plan:
         return out
 
 
-def _wanted(group, plots: bool) -> dict:
-    """``{index: draw}`` of the directions of one pair to compute (checked) next."""
-    want = {}
+def _wanted(group, plots: bool) -> tuple[dict, dict]:
+    """``{index: draw}`` of the directions of one pair to compute (checked) next, and the pair's
+    design width so far by column label (where its governing direction is checked)."""
+    want, designs = {}, {}
     labels = {c for d in group.values() for c in d.columns}
     for label in labels:
         dirs = [d for d in sorted(group.values(), key=lambda d: d.index) if label in d.columns]
@@ -157,8 +162,8 @@ def _wanted(group, plots: bool) -> dict:
         if not gov.checked or (plots and not gov.plotted):
             want[gov.index] = plots
             continue
-        design = max(max(w, f or 0.0) for d in dirs if d.checked for w, _, f in [d.columns[label]])
+        design = designs[label] = max(max(w, f or 0.0) for d in dirs if d.checked for w, _, f in [d.columns[label]])
         for d in dirs:
             if not d.checked and d.columns[label][1] > design * (1.0 - MARGIN):
                 want.setdefault(d.index, False)
-    return want
+    return want, designs

@@ -70,7 +70,8 @@ class SearchSettings:
     ``check_above`` (m; a pair's design width found in other directions, pipeline/passes.py) at
     or above ``min(check_span ** check_rounds w, no-uplift width)``, the widest width the
     rounds could reach (each round's span is at most ``check_span`` times the width the round
-    before left): such a check could not find a failing width above it.  The
+    before left): such a check could not find a failing width above it; and so are the rounds
+    left after one where that holds from the width it left.  The
     sizes were chosen from
     ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
 

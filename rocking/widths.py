@@ -432,6 +432,8 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
     cx, cf = np.zeros(0), np.zeros(0, dtype=bool)
     base_method, notes = res.method, []
     for k in range(rounds):
+        if k and min(settings.check_span ** (rounds - k) * res.width, top) <= settings.check_above:
+            break  # the rounds left could not reach above check_above (SearchSettings)
         n = left // (rounds - k)
         left -= n
         x, f, r = _add_check(res, top, evaluate, settings.replace(check_runs=n), seed + k,

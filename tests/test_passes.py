@@ -72,17 +72,17 @@ def test_the_check_goes_to_the_governing_direction_then_where_it_could_reach_the
     group = {0: _d(0, False, False, 1.0, 2.0), 1: _d(1, False, False, 1.2, 2.4), 2: _d(2, False, False, 0.5, 1.0),
              3: _d(3, False, False, 1.2, 2.4)}
     # first the governing direction (the widest; the first of equal widths), with its figure
-    assert passes._wanted(group, plots=True) == {1: True}
-    assert passes._wanted(group, plots=False) == {1: False}
+    assert passes._wanted(group, plots=True)[0] == {1: True}
+    assert passes._wanted(group, plots=False)[0] == {1: False}
     # it found a failing width at 1.5 m: the design width; a check reaching up to 1.0 m cannot
     # change it, one reaching 2.0 m or 2.4 m can
     group[1] = _d(1, True, True, 1.2, 2.4, 1.5)
-    assert passes._wanted(group, plots=True) == {0: False, 3: False}
+    assert passes._wanted(group, plots=True) == ({0: False, 3: False}, {"7.5x1.8": 1.5})
     group[0], group[3] = _d(0, True, False, 1.0, 2.0), _d(3, True, False, 1.2, 2.4, 2.1)
-    assert passes._wanted(group, plots=True) == {}
+    assert passes._wanted(group, plots=True)[0] == {}
     # a direction whose check could reach 2.1 m only if the design width were lower
     group[4] = _d(4, False, False, 1.05, 2.1 * (1.0 - 1e-3))
-    assert passes._wanted(group, plots=True) == {}
+    assert passes._wanted(group, plots=True)[0] == {}
 
 
 def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
@@ -173,6 +173,29 @@ def test_check_above_switches_the_check_off_only_where_its_top_is_not_above_it()
     assert full.check_runs > 0 and reach > full.search_width
     off = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=reach))
     assert (off.width, off.check_runs, off.failing_share) == (full.search_width, 0, None)
-    on = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=reach * (1.0 - 1e-9)))
+    # below what the last round from the search's width reaches: every round runs
+    last = min(s.check_span * full.search_width, 7.5 * record.pga / pulses.G)
+    on = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=last * (1.0 - 1e-9)))
     assert (on.width, on.check_runs, on.failing_share, on.widest_failing_width) == \
         (full.width, full.check_runs, full.failing_share, full.widest_failing_width)
+
+
+def test_the_check_stops_after_a_round_when_the_rounds_left_could_not_reach_check_above():
+    import importlib.resources
+
+    import pulses
+    import rocking
+
+    record = pulses.read_record(str(importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    s = DEFAULT_SETTINGS
+    full = rocking.required_width(7.5, record, rule="exact")
+    top = 7.5 * record.pga / pulses.G
+    # above what a second round from the search's width could reach, below what two could: the
+    # first round runs (its share of the runs) and, where it raised nothing that far, no second
+    above = min(s.check_span * full.search_width, top) * (1.0 + 1e-9)
+    one = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=above))
+    assert one.search_width == full.search_width
+    if one.width == one.search_width:  # the first round found no failing width
+        assert one.check_runs == s.check_runs // s.check_rounds
+    else:
+        assert one.check_runs in (s.check_runs // s.check_rounds, full.check_runs)
