@@ -28,6 +28,9 @@ class RunSummary:
     n_failed: int
     out: pathlib.Path
     n_reused: int = 0
+    #: the run's tables as row dicts (``design``, ``summary``, ``failures``, ``suite``): the rows the
+    #: CSV reports were written from (pipeline.api.DesignRun makes DataFrames of them)
+    tables: dict | None = dataclasses.field(default=None, repr=False)
 
     @property
     def exit_code(self) -> int:
@@ -207,7 +210,9 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
+                         {"design": design, "summary": rows, "failures": failures,
+                          "suite": site.suite_rows(rows) if rows else []})
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
         if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
