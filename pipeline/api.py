@@ -74,7 +74,7 @@ def _column(block):
     if isinstance(block, Block):
         if block.height is None or block.width is None:
             raise ValueError("blocks: a rocking.Block with its full height and width (made by "
-                             "Block.from_dimensions), not only R and alpha")
+                             "Block.from_dimensions), not only p and alpha")
         return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"))
     raise TypeError(f"blocks: expected {_COLUMN_FORMS}; got {type(block).__name__} {block!r:.60}")
 
@@ -223,10 +223,21 @@ class DesignRun:
                       "out": None if self.out is None else str(self.out)})
 
 
+#: columns of names: the reports' rows read back from their text type a height's label ("12") or a
+#: record named "1063" as a number; the tables give them as the text the reports hold
+_NAMES = ("record", "column", "pair", "file")
+
+
 def _frame(rows, columns):
     import pandas as pd
 
-    return pd.DataFrame([[r.get(c) for c in columns] for r in rows], columns=list(columns))
+    from .report import fmt
+
+    def cell(row, c):
+        v = row.get(c)
+        return fmt(v) if c in _NAMES and v is not None and not isinstance(v, str) else v
+
+    return pd.DataFrame([[cell(r, c) for c in columns] for r in rows], columns=list(columns))
 
 
 def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 0, vertical: str = "auto",
