@@ -22,6 +22,7 @@ _WHERE = {
     "read_pair": "pairs", "rotate_pair": "pairs",
     "PeerDownload": "peer",
     "check_triplet": "triplets",
+    "to_frame": "export",
 }
 #: submodules that are part of the public namespace
 _MODULES = ("peer",)

@@ -494,8 +494,28 @@ class PulseClassification:
         """Sample times, s."""
         return self.t_start + self.dt * np.arange(self.pulse.size)
 
+    def to_frame(self):
+        """One row per candidate (:class:`pandas.DataFrame`), strongest first, ``chosen`` marking
+        the one whose values the classification reports (``tp`` in s, ``pgv`` in m/s)."""
+        import pandas as pd
+
+        from .export import fields_dict
+
+        rows = [{"name": self.name, "candidate": i, "chosen": i == self.chosen,
+                 **fields_dict(c)} for i, c in enumerate(self.candidates)]
+        return pd.DataFrame(rows)
+
     def as_dict(self) -> dict:
-        """The scalar fields (plain Python types)."""
+        """The scalar fields (plain Python types).
+
+        Examples
+        --------
+        >>> import numpy as np, pulses
+        >>> t = np.arange(0.0, 20.0, 0.01)
+        >>> rec = pulses.Record(pulses.make_pulse("sine", 4.0, 1.5, 5.0)(t), 0.01)
+        >>> pulses.classify_pulse(rec).as_dict()["is_pulse"]
+        True
+        """
         return {"name": self.name, "is_pulse": bool(self.is_pulse), "indicator": float(self.indicator),
                 "tp": float(self.tp), "pgv": float(self.pgv), "pgv_ratio": float(self.pgv_ratio),
                 "energy_ratio": float(self.energy_ratio), "late": bool(self.late),

@@ -94,6 +94,13 @@ class CriticalScale:
         """PGA of the critically scaled record, m/s^2 (None when nothing overturned)."""
         return None if self.scale is None else self.scale * self.pga
 
+    def as_dict(self) -> dict:
+        """The fields (scale factors, PGA in m/s^2, islands as pairs) and ``critical_pga``: plain,
+        JSON-safe."""
+        from pulses.export import fields_dict
+
+        return fields_dict(self, properties=("overturns", "critical_pga"))
+
 
 def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
                    resolution=RESOLUTION, near=NEAR, rtol=RTOL, model="fast") -> CriticalScale:
@@ -264,6 +271,14 @@ class Fragility:
             z = np.log(x / self.median) / self.beta
         out = ndtr(z)
         return float(out) if out.ndim == 0 else out
+
+    def as_dict(self) -> dict:
+        """``median``, ``beta``, ``measure``, ``n`` and the fitted values (``None`` for censored
+        records): plain, JSON-safe."""
+        from pulses.export import plain
+
+        return plain({"median": self.median, "beta": self.beta, "measure": self.measure, "n": self.n,
+                      "values": self.values, "censored_at": self.censored_at})
 
     def empirical(self):
         """``(x, share)``: the sorted critical intensities and the share of records overturned at

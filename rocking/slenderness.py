@@ -57,6 +57,20 @@ class MinSlenderness:
         """``atan(tan_alpha)``, rad."""
         return math.atan(self.tan_alpha)
 
+    def as_dict(self) -> dict:
+        """The fields (not the excitation) and ``alpha``: plain, JSON-safe numbers.
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> m = rocking.min_slenderness(pulses.make_pulse("sine", 3.0, 1.0), p=1.5)
+        >>> sorted(m.as_dict())[:3]
+        ['alpha', 'criterion', 'eq31']
+        """
+        from pulses.export import fields_dict
+
+        return fields_dict(self, skip=("excitation",), properties=("alpha",))
+
     @property
     def safe_islands(self) -> list:
         """``(low, high)`` ranges of ``tan(alpha)`` below :attr:`tan_alpha` where the block survives."""
@@ -222,6 +236,20 @@ class CriticalAmplitudes(list):
     def safe_islands(self) -> list:
         """``(low, high)`` amplitude ranges (m/s^2) of survival above the smallest failing one."""
         return [(self[i][1], self[i + 1][0]) for i in range(len(self) - 1)]
+
+    def as_dict(self) -> dict:
+        """The intervals, islands and settings: plain, JSON-safe numbers (m/s^2, s)."""
+        from pulses.export import plain
+
+        return plain({"shape": self.shape, "tp": self.tp, "up_to": self.up_to, "criterion": self.criterion,
+                      "runs": self.runs, "minimum": self.minimum, "intervals": list(self),
+                      "safe_islands": self.safe_islands, "p": self.block.p, "alpha": self.block.alpha})
+
+    def to_frame(self):
+        """One row per failing interval: ``low_m_s2``, ``high_m_s2``."""
+        import pandas as pd
+
+        return pd.DataFrame(list(self), columns=["low_m_s2", "high_m_s2"])
 
 
 def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n_scan=400,

@@ -50,6 +50,12 @@ class OverturningSpectrum:
         seen = np.cumsum(self.overturned, axis=1) > 0
         return seen & ~self.overturned
 
+    def as_dict(self) -> dict:
+        """The grid and its verdicts as nested lists (``[i][j]`` as the arrays): plain, JSON-safe."""
+        from pulses.export import fields_dict
+
+        return fields_dict(self)
+
     def to_frame(self):
         """Long-format :class:`pandas.DataFrame`, one row per grid point."""
         import pandas as pd

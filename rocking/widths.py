@@ -62,6 +62,31 @@ class RequiredWidth:
     def tan_alpha(self) -> float:
         return self.width / self.height
 
+    def as_dict(self) -> dict:
+        """Every field but the check's arrays, with ``tan_alpha`` and ``p``: plain, JSON-safe
+        numbers (widths and heights in m, ``p`` in rad/s).
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> w = rocking.required_width(7.5, pulses.make_pulse("sine", 3.0, 1.0), rule="eq31")
+        >>> d = w.as_dict()
+        >>> d["rule"], round(d["width"], 3) == round(w.width, 3)
+        ('eq31', True)
+        """
+        from pulses.export import fields_dict
+
+        return fields_dict(self, properties=("tan_alpha", "p"))
+
+    def to_frame(self):
+        """The check above the verified width, one row per width checked (``width_m``,
+        ``failed``); empty where there was no check."""
+        import pandas as pd
+
+        widths = np.asarray(self.check_widths if self.check_widths is not None else [], dtype=float)
+        failed = np.asarray(self.check_failed if self.check_failed is not None else [], dtype=bool)
+        return pd.DataFrame({"width_m": widths, "failed": failed})
+
     @property
     def block(self) -> Block:
         return Block.from_dimensions(self.height, self.width, self.eta,
