@@ -22,7 +22,7 @@ _WHERE = {
     "read_pair": "pairs", "rotate_pair": "pairs",
     "PeerDownload": "peer",
     "check_triplet": "triplets",
-    "to_frame": "export",
+    "to_frame": "export", "from_stream": "traces",
 }
 #: submodules that are part of the public namespace
 _MODULES = ("peer",)

@@ -1,6 +1,10 @@
 """The one exception the readers raise for a record that cannot be used."""
 
 
+class UnitsWarning(UserWarning):
+    """Samples whose peak no accelerogram has in the units given (:class:`pulses.Record`)."""
+
+
 class RecordError(ValueError):
     """A record file that cannot be read as an accelerogram.
 
