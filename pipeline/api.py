@@ -170,6 +170,15 @@ class DesignRun:
         Tasks run (a pair's directions count one each) and tasks that failed.
     out : pathlib.Path or None
         The folder the reports were written to (None: nothing was written).
+
+    Examples
+    --------
+    >>> import pipeline
+    >>> from pipeline.cmd_demo import bundled_records
+    >>> with bundled_records() as paths:
+    ...     run = pipeline.design(paths[3:4], heights=7.5, shapes="sine")
+    >>> run.exit_code, list(run.design["governing_shape"]), run.out is None
+    (0, ['sine'], True)
     """
 
     design_rows: list = field(default_factory=list)

@@ -126,7 +126,8 @@ class Pulse:
 
     @classmethod
     def sampled(cls, tp: float, t0: float, t, dt: float) -> np.ndarray:
-        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support.
+        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support (the fitter's
+        shape; a pulse in m/s^2 on a record's axis is ``pulse(record.time)``, see :meth:`sample`).
 
         Point samples; a shape whose point samples do not locate it finer than ``dt`` (the
         rectangle) overrides this with cell averages over ``[t - dt/2, t + dt/2]``.
@@ -205,7 +206,24 @@ class Pulse:
         return type(self)(self.ap * factor, self.tp, self.t0)
 
     def sample(self, dt: float, name: str | None = None):
-        """Sample the pulse at step ``dt`` (s) over its support, as a :class:`pulses.Record`."""
+        """The pulse alone as a new :class:`pulses.Record`, sampled at step ``dt`` (s) over its own
+        support: it starts at ``t_start = support[0]`` and lasts as long as the pulse.
+
+        Not the pulse on a record's time axis: for that, evaluate it at the record's sample times,
+        ``pulse(record.time)`` (m/s^2, one value per sample).  Nor :meth:`sampled`, the fitter's
+        unit-amplitude shape.
+
+        Examples
+        --------
+        >>> import numpy as np, pulses
+        >>> pulse = pulses.OneSine(3.0, 1.0, t0=2.0)
+        >>> alone = pulse.sample(0.01)
+        >>> alone.t_start, alone.npts
+        (2.0, 101)
+        >>> on_axis = pulse(np.arange(0.0, 5.0, 0.01))   # a 5 s record's axis: 500 values
+        >>> on_axis.size, round(float(on_axis[225]), 6)   # 2.25 s: the crest, ap
+        (500, 3.0)
+        """
         from .record import Record
 
         start, end = self.support

@@ -57,6 +57,15 @@ class GoverningPulse:
         Full height of the column, m.
     widths : list of (float, pulses.Candidate)
         Every fitting candidate's Eq. 31 width (m), best fit first.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses, rocking
+    >>> t = np.arange(0.0, 6.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.0, 1.0)(t), 0.01)
+    >>> gov = rocking.governing_pulse(pulses.fit_pulse(rec, shapes=["sine"]), 7.5)
+    >>> gov.candidate.shape, gov.height
+    ('sine', 7.5)
     """
 
     candidate: object

@@ -86,3 +86,16 @@ def test_a_list_of_results_is_one_frame():
     assert list(df["height"]) == [5.0, 7.5, 10.0] and list(df["width"]) == [r.width for r in results]
     with pytest.raises(TypeError, match="as_dict"):
         pulses.to_frame([1.0])
+
+
+@pytest.mark.parametrize("module", ["pulses.export", "pulses.traces", "pulses.record", "pulses.shapes",
+                                    "pulses.velocity", "rocking.governing", "rocking.widths", "rocking._common",
+                                    "rocking.slenderness", "pipeline.api"])
+def test_the_examples_of_the_docstrings_run(module):
+    """The Examples sections of the export, obspy, governing-pulse and batch docstrings (the API
+    pages show them)."""
+    import doctest
+    import importlib
+
+    result = doctest.testmod(importlib.import_module(module), optionflags=doctest.ELLIPSIS)
+    assert result.failed == 0 and result.attempted > 0, module
