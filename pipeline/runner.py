@@ -18,7 +18,7 @@ from .args import ArgumentError, output_folder
 from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV  # noqa: F401 (tests set it through the runner)
-from .tasks import Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
+from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
 
 
 @dataclass
@@ -127,6 +127,9 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         :func:`pipeline.interrupts.handling` is active): workers stopped, reports already written
         complete, no temporary file left.
     """
+    if tasks is None and not all(isinstance(c, Column) for c in columns):  # not an error per record
+        raise TypeError("columns: expected pipeline.tasks.Column objects; from Python, "
+                        "pipeline.design(records, blocks='7.5x1.8', heights=12.0) takes blocks and heights")
     out = output_folder(out)  # checked before the Path: pathlib makes "" the current folder
     if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)

@@ -151,3 +151,13 @@ def test_a_loop_with_the_governing_pulse_gives_pipeline_runs_eq31_widths():
     table = run.design[["governing_shape", "governing_ap_g", "governing_tp_s", "eq31_width_m"]]
     assert [[r[0]] + [report.fmt(x) for x in r[1:]] for r in table.itertuples(index=False)] == rows
     assert best != [r[0] for r in rows]
+
+
+def test_the_runner_refuses_columns_that_are_not_columns(tmp_path):
+    """The issue's first finding: runner.run(paths, ["9"], out) wrote a header-only design.csv and
+    an internal AttributeError per record; now a TypeError pointing to pipeline.design."""
+    from pipeline.runner import run
+
+    with pytest.raises(TypeError, match=r"pipeline.design\(records, blocks="):
+        run([tmp_path / "a.sac"], ["9"], tmp_path / "out")
+    assert not (tmp_path / "out").exists()
