@@ -83,6 +83,10 @@ def test_out_none_writes_nothing_and_out_writes_the_reports(tmp_path, monkeypatc
         run2 = pipeline.design(paths[1:2], blocks="7.5x1.8", shapes="sine", out=tmp_path / "o", plots=False)
     assert (tmp_path / "o" / "design.csv").is_file() and run2.out == tmp_path / "o"
     assert run.design.equals(run2.design)
+    import json
+
+    d = json.loads(json.dumps(run.as_dict(), allow_nan=False))  # plain data, no NaN
+    assert d["design"][0]["verified_width_m"] == run.design_rows[0]["verified_width_m"] and d["out"] is None
 
 
 def test_a_missing_or_unreadable_file_is_a_failures_row(tmp_path):
