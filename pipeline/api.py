@@ -49,11 +49,14 @@ def _records(records) -> list[str]:
     return out
 
 
-def _many(value, what):
-    """A single item or an iterable of them, as a list (a string is one item)."""
+def _many(value, *, pair_is_one: bool = False):
+    """A single item or an iterable of them, as a list: a string is one item, and with
+    ``pair_is_one`` so is a tuple of two numbers (a block's ``(height, width)``)."""
     if value is None:
         return []
-    if isinstance(value, (str, tuple)) or not hasattr(value, "__iter__"):
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        return [value]
+    if pair_is_one and isinstance(value, tuple) and len(value) == 2 and all(map(_is_number, value)):
         return [value]
     return list(value)
 
@@ -91,8 +94,8 @@ def _height(h):
 
 def columns_from(blocks, heights) -> tuple:
     """The columns of a run, in order, each once: ``blocks`` (as they stand) then ``heights``."""
-    columns = [_column(b) for b in _many(blocks, "blocks")]
-    columns += [_height(h) for h in _many(heights, "heights")]
+    columns = [_column(b) for b in _many(blocks, pair_is_one=True)]
+    columns += [_height(h) for h in _many(heights)]
     if not columns:
         raise ValueError("give at least one column: blocks= (e.g. '7.5x1.8', a rocking.Block) or "
                          "heights= (m)")
@@ -138,9 +141,9 @@ def _shapes(shapes):
 
     if shapes is None:
         return None
-    if not all(isinstance(s, str) for s in _many(shapes, "shapes")):
+    if not all(isinstance(s, str) for s in _many(shapes)):
         raise TypeError("shapes: expected a shape name or a list of them (pulses.SHAPES, or 'all')")
-    return parse_shapes(_many(shapes, "shapes"))
+    return parse_shapes(_many(shapes))
 
 
 def _number_option(value, what, *, default=None):

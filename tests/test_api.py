@@ -75,6 +75,18 @@ def test_a_peer_download_gives_pipeline_runs_design_csv(tmp_path):
     assert len(run.design) >= 3 and run.design["n_directions"].min() >= 4  # pairs in every direction
 
 
+def test_the_forms_of_a_column():
+    from pipeline.api import columns_from
+    from pipeline.tasks import Column
+
+    block = rocking.Block.from_dimensions(7.5, 1.8)
+    want = (Column(7.5, 1.8),)
+    for blocks in ("7.5x1.8", (7.5, 1.8), [(7.5, 1.8)], block, [block, "7.5x1.8"], ("7.5x1.8",)):
+        assert columns_from(blocks, None) == want, blocks
+    assert columns_from(("7.5x1.8", (6, 1.2)), (12, 4.5)) == (want[0], Column(6.0, 1.2), Column(12.0), Column(4.5))
+    assert columns_from(None, 12) == columns_from(None, [12.0]) == (Column(12.0),)
+
+
 def test_out_none_writes_nothing_and_out_writes_the_reports(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with bundled_records() as paths:
