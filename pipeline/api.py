@@ -276,7 +276,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     vertical : {"auto", "none"}
         Use a pair's known vertical component (``--vertical``).
     limit : float, optional
-        ``--limit`` (where the installed version has it).
+        A performance level R, ``0 < R <= 1`` (``--limit``): design widths for max|theta|/alpha
+        <= R instead of for not overturning.
     jobs : int
         Worker processes (0: one per CPU); the tables do not depend on it.
     out : path, optional
@@ -361,9 +362,9 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
               cap_mass_ratio=_number_option(more["cap_mass_ratio"], "cap_mass_ratio"),
               fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"), **opts)
     if limit is not None:
-        if "limit" not in {f.name for f in dataclasses.fields(Options)}:
-            raise ValueError("limit= is not available in this version of the package")
         kw["limit"] = _number_option(limit, "limit")
+        if not 0.0 < kw["limit"] <= 1.0:
+            raise ValueError(f"limit (max|theta|/alpha) must lie in (0, 1], got {limit!r}")
     return Plan(
         records=_records(records), columns=columns_from(blocks, heights), options=Options(**kw),
         record_opts=opts, pairs=mode, pair=explicit, triplets=triplets, directions=str(directions),

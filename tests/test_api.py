@@ -60,6 +60,13 @@ def test_the_demo_records_give_pipeline_runs_design_csv(tmp_path):
     assert set(run.suite["column"]) == {"7.5x1.8", "12"}
 
 
+def test_a_performance_level_flows_through(tmp_path):
+    with bundled_records() as paths:
+        run = _same_as_cli(tmp_path, paths[2:4], ["--height", "7.5", "--limit", "0.5", *CHEAP],
+                           heights=7.5, limit=0.5, shapes="sine")
+    assert list(run.design["design_limit"]) == [0.5, 0.5]
+
+
 @pytest.mark.slow
 def test_the_demo_with_every_shape_and_two_jobs(tmp_path):
     with bundled_records() as paths:
@@ -130,6 +137,8 @@ def test_a_missing_or_unreadable_file_is_a_failures_row(tmp_path):
     (dict(blocks="7.5x-1.8"), ValueError, "width"),
     (dict(), ValueError, "give at least one column"),
     (dict(blocks="7.5x1.8", colour="red"), TypeError, "accepted besides"),
+    (dict(blocks="7.5x1.8", limit="0.5"), TypeError, "expected a number"),
+    (dict(blocks="7.5x1.8", limit=1.5), ValueError, "(0, 1]"),
     (dict(blocks=rocking.Block(p=2.0, alpha=0.2)), ValueError, "Block.from_dimensions"),
 ])
 def test_wrong_inputs_name_the_accepted_forms(kw, error, words, tmp_path, monkeypatch):
