@@ -79,10 +79,9 @@ class GoverningPulse:
 
         Examples
         --------
-        >>> import pulses, rocking
-        >>> import numpy as np
-    >>> t = np.arange(0.0, 6.0, 0.01)
-    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.0, 1.0)(t), 0.01)
+        >>> import numpy as np, pulses, rocking
+        >>> t = np.arange(0.0, 6.0, 0.01)
+        >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.0, 1.0)(t), 0.01)
         >>> gov = rocking.governing_pulse(pulses.fit_pulse(rec, shapes=["sine"]), 7.5)
         >>> sorted(gov.as_dict())[:3]
         ['ap_g', 'ap_m_s2', 'eq31_width_m']
