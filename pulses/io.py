@@ -100,6 +100,18 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
     -----
     The formats are those registered in :mod:`pulses.formats` (one module each); this function
     only dispatches to them and applies the checks every record gets.
+
+    Examples
+    --------
+    >>> import importlib.resources, pulses
+    >>> path = importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"   # a bundled record
+    >>> rec = pulses.read_record(str(path))
+    >>> rec.dt, round(rec.pga / pulses.G, 3)
+    (0.01, 0.634)
+    >>> pulses.read_record("no-such-file.sac")
+    Traceback (most recent call last):
+    ...
+    pulses.errors.RecordError: no-such-file.sac: no such file
     """
     path = os.fsdecode(path)  # bytes too; bytes that are not UTF-8 kept as surrogates (PEP 383)
     shown = printable(path)

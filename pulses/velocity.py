@@ -397,6 +397,15 @@ class PulseCandidate:
         Record's velocity in the candidate's orientation, m/s.
     pulse : numpy.ndarray
         Extracted pulse, m/s, on the record's samples.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 20.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.5, 4.0)(t), 0.01)
+    >>> cand = pulses.classify_pulse(rec).candidates[0]
+    >>> cand.is_pulse, cand.velocity.shape == cand.residual.shape
+    (True, True)
     """
 
     is_pulse: bool
@@ -446,6 +455,15 @@ class PulseClassification:
         Index of the chosen candidate.
     t_start, dt : float
         Time of the first sample and time step, s.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 20.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.5, 4.0)(t), 0.01)
+    >>> c = pulses.classify_pulse(rec)
+    >>> c.pulse.shape == rec.acc.shape, c.candidate is c.candidates[c.chosen]
+    (True, True)
     """
 
     name: str
@@ -661,6 +679,15 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     ------
     RecordError
         A pair that cannot be used (see :func:`pulses.pairs.check_pair`).
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 20.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.5, 4.0)(t), 0.01)
+    >>> c = pulses.classify_pulse(rec)
+    >>> c.is_pulse, len(c.candidates)
+    (True, 5)
     """
     from .pairs import _azimuth, check_pair, rotated_azimuth
 

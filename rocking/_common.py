@@ -44,6 +44,13 @@ class RockingResult:
         The block left its rest position at least once.
     t_overturn : float
         Time (s) at which ``|theta|`` reached ``pi/2`` during the integration, else nan.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> res = rocking.simulate(rocking.Block.from_dimensions(7.5, 1.8), pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
+    >>> res.verdict_by in ("no uplift", "integration", "energy rule"), res.t.shape == res.theta.shape
+    (True, True)
     """
 
     overturned: bool
@@ -107,7 +114,16 @@ class RockingResult:
 
 @dataclass
 class BatchResult:
-    """Scalar results of :func:`simulate_many`, one array entry per run."""
+    """Scalar results of :func:`simulate_many`, one array entry per run.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> columns = [rocking.Block.from_dimensions(7.5, w) for w in (1.0, 1.8)]
+    >>> many = rocking.simulate_many(columns, pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
+    >>> many.max_rotation_ratio.shape, many.model
+    ((2,), 'fast')
+    """
 
     overturned: np.ndarray
     exceeded_alpha: np.ndarray

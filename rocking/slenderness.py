@@ -39,6 +39,13 @@ class MinSlenderness:
         ``peak/g``: blocks at least this stocky never uplift (the upper end of the scan).
     runs : int
         Solver runs used.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> ms = rocking.min_slenderness(pulses.OneSine(0.71 * pulses.G, 0.8), 1.381)
+    >>> ms.criterion, ms.transitions[-1] <= ms.tan_alpha
+    ('overturn', True)
     """
 
     tan_alpha: float
@@ -172,6 +179,13 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     -------
     MinSlenderness
         with ``.tan_alpha`` and ``.transitions``.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> ms = rocking.min_slenderness(pulses.OneSine(0.71 * pulses.G, 0.8), 1.381)
+    >>> round(ms.tan_alpha, 4)                 # exact; Eq. 31 asks for 0.3727
+    0.1989
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)

@@ -220,6 +220,14 @@ def simulate(block: Block, excitation=None, *, theta0: float = 0.0, omega0: floa
     Returns
     -------
     RockingResult
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> res = rocking.simulate(column, pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
+    >>> res.overturned, round(res.max_rotation_ratio, 3), res.model
+    (False, 0.791, 'fast')
     """
     if vertical is not None:
         if not isinstance(excitation, Record) or theta0 != 0.0 or omega0 != 0.0:
@@ -616,6 +624,14 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     BatchResult
         Arrays ``overturned``, ``exceeded_alpha``, ``max_rotation`` (rad),
         ``max_rotation_ratio``, ``n_impacts``, ``uplifted``.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> columns = [rocking.Block.from_dimensions(7.5, w) for w in (1.0, 1.8, 3.0)]
+    >>> many = rocking.simulate_many(columns, pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
+    >>> many.overturned.tolist()
+    [True, False, False]
     """
     if model not in ("fast", "linear"):
         raise ValueError("simulate_many supports model='fast' or 'linear'")

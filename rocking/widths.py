@@ -37,6 +37,13 @@ class RequiredWidth:
     transition, a diagnostic); with a vertical record, the wider of the designs for the horizontal
     motion alone and with the vertical (:attr:`governed_by`).  With a performance level
     :attr:`limit` R, a width fails where ``max|theta|/alpha`` exceeds R (or the column overturns).
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> w = rocking.required_width(7.5, pulses.OneSine(0.71 * pulses.G, 0.8), rule="eq31")
+    >>> w.rule, round(w.tan_alpha, 4) == round(w.width / 7.5, 4)
+    ('eq31', True)
     """
 
     width: float
@@ -193,6 +200,12 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     -------
     RequiredWidth
         ``.width``, ``.tan_alpha``, ``.p``, ``.rule``, ``.iterations``.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> round(rocking.required_width(7.5, pulses.OneSine(0.71 * pulses.G, 0.8), rule="eq31").width, 3)
+    2.771
     """
     height = float(height)
     if not (math.isfinite(height) and height > 0):
