@@ -625,13 +625,6 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         Arrays ``overturned``, ``exceeded_alpha``, ``max_rotation`` (rad),
         ``max_rotation_ratio``, ``n_impacts``, ``uplifted``.
 
-    Examples
-    --------
-    >>> import rocking, pulses
-    >>> columns = [rocking.Block.from_dimensions(7.5, w) for w in (1.0, 1.8, 3.0)]
-    >>> many = rocking.simulate_many(columns, pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
-    >>> many.overturned.tolist()
-    [True, False, False]
     """
     if model not in ("fast", "linear"):
         raise ValueError("simulate_many supports model='fast' or 'linear'")

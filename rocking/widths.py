@@ -201,11 +201,6 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     RequiredWidth
         ``.width``, ``.tan_alpha``, ``.p``, ``.rule``, ``.iterations``.
 
-    Examples
-    --------
-    >>> import rocking, pulses
-    >>> round(rocking.required_width(7.5, pulses.OneSine(0.71 * pulses.G, 0.8), rule="eq31").width, 3)
-    2.771
     """
     height = float(height)
     if not (math.isfinite(height) and height > 0):
