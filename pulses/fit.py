@@ -100,7 +100,17 @@ GLS_HAUSMAN = 16.27
 
 class FitError(ValueError):
     """Input the pulse fit cannot use: a record with nothing to fit, or a period range that is
-    not one.  The message is one line that says what is wrong."""
+    not one.  The message is one line that says what is wrong.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> try:
+    ...     pulses.fit_pulse(pulses.Record(np.sin(np.arange(20) / 3.0), 0.01))
+    ... except pulses.FitError as exc:
+    ...     print(exc)
+    record 'record' (0.19 s) is too short to fit pulses of at least 0.2 s
+    """
 
 
 # -- sampled unit pulses ---------------------------------------------------------------------

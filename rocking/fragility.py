@@ -266,6 +266,13 @@ class Fragility:
     limit : float or None
         The performance level of the critical scales (``max|theta|/alpha`` exceeding it; None:
         overturning): ``P(max|theta|/alpha > limit | x)``.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> f = rocking.fragility([1.2, 1.5, 2.0, None], up_to=3.0)
+    >>> round(f.probability(f.median), 3)
+    0.5
     """
 
     median: float
@@ -330,6 +337,13 @@ def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility
         maximum-likelihood estimates, ``ddof = 0``).  Records that did not overturn are
         right-censored at their largest intensity and the likelihood
         ``prod pdf(x_i) prod (1 - cdf(c_j))`` is maximised numerically.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> f = rocking.fragility([1.2, 1.5, 2.0, None], up_to=3.0)   # critical scales; None: not up to 3
+    >>> round(f.median, 3), round(f.beta, 3), f.n
+    (1.921, 0.442, 4)
     """
     if measure not in ("scale", "pga"):
         raise ValueError(f"fragility: measure must be 'scale' or 'pga', got {measure!r}")

@@ -103,6 +103,13 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     bisection: the same ``tan_alpha`` (to ``rtol``) from fewer runs, which is what
     ``pipeline run`` needs for a few blocks per record.  ``n_scan``, ``n_zone``, ``rtol`` and
     ``ksection`` override the fields of ``settings`` (:class:`rocking.search.SearchSettings`).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> res = rocking.min_slenderness_batch("sine", [1.0, 2.0], [0.5, 0.5])    # pTp, ap/g
+    >>> [round(r.tan_alpha, 4) for r in res]
+    [0.1221, 0.3383]
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -234,6 +241,13 @@ class CriticalAmplitudes(list):
     The first ``low`` is the smallest overturning amplitude; the gaps between intervals are the
     safe islands (:attr:`safe_islands`).  A ``high`` equal to :attr:`up_to` means the interval
     runs on to the end of the scan.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> amps = rocking.critical_amplitudes(rocking.Block.from_dimensions(7.5, 1.2), "sine", 1.0)
+    >>> len(amps), amps.shape
+    (1, 'sine')
     """
 
     def __init__(self, intervals, *, block, shape, tp, up_to, criterion, runs):
@@ -287,6 +301,13 @@ def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n
     -------
     CriticalAmplitudes
         A list of ``(low, high)`` pairs; ``.safe_islands`` gives the gaps between them.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> amps = rocking.critical_amplitudes(rocking.Block.from_dimensions(7.5, 1.2), "sine", 1.0)
+    >>> round(amps.minimum / pulses.G, 3), amps.safe_islands
+    (0.317, [])
     """
     _check_criterion(criterion)
     uplift = block.uplift_acceleration
