@@ -92,8 +92,8 @@ def test_a_list_of_results_is_one_frame():
                                     "pulses.velocity", "pulses.scenario", "pulses.fit", "pulses.pairs", "pulses.sac",
                                     "pulses.io", "rocking.governing", "rocking.widths", "rocking._common",
                                     "rocking.slenderness", "rocking.block", "rocking.closed_forms", "rocking.frame",
-                                    "rocking.solver", "rocking.fragility", "rocking.spectrum", "rocking.reference_vertical", "pulses.errors",
-                                    "pipeline.api"])
+                                    "rocking.solver", "rocking.fragility", "rocking.spectrum",
+                                    "rocking.reference_vertical", "pulses.errors", "pipeline.api"])
 def test_the_examples_of_the_docstrings_run(module):
     """The Examples sections of the export, obspy, governing-pulse and batch docstrings (the API
     pages show them)."""
