@@ -49,9 +49,13 @@ def package_version() -> str:
 
 
 def file_digest(path) -> str | None:
-    """sha256 of a file's bytes, or None when it cannot be read."""
+    """sha256 of a file's bytes, or None when it cannot be read or is no regular file."""
+    import stat
+
     h = hashlib.sha256()
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO or /dev/zero: never opened (it would hang)
+            return None
         with open(path, "rb") as fh:
             for chunk in iter(lambda: fh.read(1 << 20), b""):
                 h.update(chunk)

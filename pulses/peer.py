@@ -457,13 +457,16 @@ class _Bounded(io.RawIOBase):
 def _open_regular(path):
     """``path`` opened for reading if it is a regular file; a FIFO, a device or a socket (which
     would block or never end) is refused before anything opens it."""
+    from .io import special_kind
+
     st = os.stat(path)
     if not stat.S_ISREG(st.st_mode):
-        raise RecordError(f"{path}: not a regular file (a FIFO, device or socket): not read")
+        raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced between the two looks
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):  # replaced between the two looks
         os.close(fd)
-        raise RecordError(f"{path}: not a regular file (a FIFO, device or socket): not read")
+        raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
     return io.FileIO(fd, "r")
 
 

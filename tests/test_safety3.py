@@ -81,3 +81,52 @@ def test_a_corrupted_member_fails_its_record_alone(tmp_path):
     assert {r["peer_rsn"] for r in read_rows(out / "pairs.csv")} == {"1"}
     (fail,) = read_rows(out / "failures.csv")
     assert "B000.AT2: cannot read" in fail["reason"]
+
+
+# -- (8) (9) FIFOs and devices -----------------------------------------------------------------------
+def _pipeline(args, cwd, timeout=120):
+    """``pipeline ARGS`` in a process of its own (a hang is a timeout, not a hung test run)."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "pipeline", *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=timeout)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
+def test_fifos_and_devices_among_the_inputs_are_failed_records_not_a_hang(tmp_path):
+    """A FIFO, or a link to /dev/zero, among the inputs hung the batch (every input was hashed
+    before anything checked it was a regular file); now each is a failed record saying what it is,
+    and the other record is designed."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "good.AT2").write_text(at2_text(pulse_values(0), "0"))
+    os.mkfifo(folder / "pipe.AT2")
+    os.symlink("/dev/zero", folder / "zero.AT2")
+    out = tmp_path / "out"
+    done = _pipeline(["run", str(folder), *RUN_ARGS, "--out", str(out)], tmp_path, timeout=60)
+    assert done.returncode == 1, done.stderr
+    reasons = {os.path.basename(r["file"]): r["reason"] for r in read_rows(out / "failures.csv")}
+    assert "a FIFO (named pipe), not a record file" in reasons["pipe.AT2"]
+    assert "a character device, not a record file" in reasons["zero.AT2"]
+    assert [r["record"] for r in read_rows(out / "design.csv")] == ["good"]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
+@pytest.mark.parametrize("command", ["run", "classify"])
+def test_a_fifo_as_an_output_is_refused_before_any_work(tmp_path, command):
+    """``--log FIFO`` or ``classify --csv FIFO`` hung the pre-check (it opened the file to see
+    whether this package wrote it); now refused at once, exit 2, one line."""
+    rec = tmp_path / "a.AT2"
+    rec.write_text(at2_text(pulse_values(0), "0"))
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    if command == "run":
+        args = ["run", str(rec), *RUN_ARGS, "--out", str(tmp_path / "out"), "--log", str(fifo)]
+    else:
+        args = ["classify", str(rec), "--csv", str(fifo)]
+    done = _pipeline(args, tmp_path, timeout=60)
+    assert done.returncode == 2, done.stderr
+    err = done.stderr.strip()
+    assert "is a FIFO (named pipe), not a file" in err and "\n" not in err, err
+    assert not (tmp_path / "out" / "design.csv").exists()
