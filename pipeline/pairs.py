@@ -244,7 +244,7 @@ def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_sc
             d = peer_inputs.open_download(download)
             path1, path2 = d.display(src.h1), d.display(src.h2) if src.h2 else None
             pname = pair_name(path1, path2 or path1)
-            k = float(entry.metadata.get("scale_factor") or 1.0) if peer_scales else 1.0
+            k = peer_inputs.scale_of(entry) if (peer_scales and not src.missing) else 1.0
             names = [path1, pname, f"RSN{entry.rsn}", src.h1 or ""]
             if scales is not None:
                 k *= _scale_for(scales, 1.0, names)
@@ -272,9 +272,33 @@ def _download_stem(path) -> str:
     return os.path.splitext(os.path.basename(os.path.normpath(str(path))))[0] or "download"
 
 
+def _distinct_pairs(tasks) -> list:
+    """``tasks`` with one pair name per pair of files: two pairs of the same file names (two PEER
+    downloads holding ``A000.AT2`` and ``A090.AT2``) were one pair of reports, one download's
+    metadata with the other's numbers; the later one becomes ``NAME-2``."""
+    owner, renamed = {}, {}
+    for t in tasks:
+        if t.pair is None or (t.pair, t.path, t.path2) in renamed:
+            continue
+        name, k = t.pair, 1
+        while owner.get(name.lower(), (t.path, t.path2)) != (t.path, t.path2):
+            k += 1
+            name = f"{t.pair}-{k}"
+        owner[name.lower()] = (t.path, t.path2)
+        renamed[(t.pair, t.path, t.path2)] = name
+    out = []
+    for t in tasks:
+        new = renamed.get((t.pair, t.path, t.path2), t.pair) if t.pair is not None else None
+        if new != t.pair:
+            rid = new + t.record_id[len(t.pair):] if t.record_id.startswith(t.pair) else t.record_id
+            t = dataclasses.replace(t, pair=new, record_id=rid)
+        out.append(t)
+    return out
+
+
 def combine(*groups) -> list:
     """Tasks of several sources as one batch: indices in order, record ids unique over all."""
-    tasks = [t for g in groups for t in g]
+    tasks = _distinct_pairs([t for g in groups for t in g])
     # a PEER task's id is still its name with an extension (``.dir``); the others' are final
     names = [t.record_id if t.peer is not None else t.record_id + ".id" for t in tasks]
     ids = record_ids(names)

@@ -112,13 +112,15 @@ class PeerEntry:
 @dataclass
 class SearchResults:
     """A parsed ``_SearchResults.csv``: ``entries`` in the report's order, the search's
-    ``scaling`` (``Scaling Method``, e.g. ``No Scaling``) and ``notes`` (lines such as ``These
-    records are UNSCALED, AS RECORDED``)."""
+    ``scaling`` (``Scaling Method``, e.g. ``No Scaling``), ``notes`` (lines such as ``These
+    records are UNSCALED, AS RECORDED``) and ``rejected``, ``(line number, reason)`` of the record
+    lines that cannot be used."""
 
     entries: list
     scaling: str = ""
     notes: list = field(default_factory=list)
     source: str = ""
+    rejected: list = field(default_factory=list)
 
 
 def _value(text: str, kind):
@@ -126,11 +128,11 @@ def _value(text: str, kind):
     if text.lower() in _ABSENT:
         return None
     if kind is str:
-        return text
+        return _printable(text)
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"{text!r} is not a number") from None
+        raise ValueError(f"{_printable(text)[:40]!r} is not a number") from None
     if not math.isfinite(value):
         return None
     if kind is int:
@@ -140,57 +142,62 @@ def _value(text: str, kind):
     return value
 
 
+def _printable(text: str) -> str:
+    """``text`` with its control characters written as escapes (``\\x1b``): a station or event
+    name of the report reaches terminals, CSV files and pages as text, never as a terminal command."""
+    if text.isprintable():
+        return text
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+
+
+def _fields(line: str, source: str, lineno: int) -> list[str]:
+    """The fields of one line of the report (:class:`RecordError` for a line the csv module refuses:
+    a field longer than its limit, a stray quote ...)."""
+    try:
+        return next(csv.reader([line], skipinitialspace=True), [])
+    except csv.Error as exc:
+        raise RecordError(f"{source}, line {lineno}: not a line of the table: {exc}") from None
+
+
 def parse_search_results(text: str, source: str = SEARCH_RESULTS) -> SearchResults:
     """Parse the text of a PEER ``_SearchResults.csv``.
+
+    A record line that cannot be used (the wrong number of fields, a value that is not a number
+    where the report has numbers, no record number, a record number listed twice, a file name
+    that is not a plain name, a line the csv module refuses) is set aside in
+    :attr:`SearchResults.rejected` with its reason; the other records are read.
 
     Raises
     ------
     RecordError
         Naming ``source`` and the line: no metadata section, a header without the record number or
-        the file columns, a record line with the wrong number of fields or a value that is not a
-        number where the report has numbers, or a record number listed twice.
+        the file columns, or no record line that can be used.
     """
     lines = text.splitlines()
     start = next((i for i, ln in enumerate(lines) if ln.strip() == METADATA_SECTION), None)
     if start is None or start + 1 >= len(lines):
         raise RecordError(f"{source}: not a PEER search report: no line {METADATA_SECTION!r}")
-    header = [h.strip() for h in next(csv.reader([lines[start + 1]], skipinitialspace=True))]
+    header = [h.strip() for h in _fields(lines[start + 1], source, start + 2)]
     col = {h: i for i, h in enumerate(header) if h}
     needed = [METADATA["rsn"][0], *_FILE_COLUMNS]
     lacking = [h for h in needed if h not in col]
     if lacking:
         raise RecordError(f"{source}, line {start + 2}: the metadata table has no column "
                           f"{', '.join(map(repr, lacking))}")
-    entries, seen = [], {}
+    entries, rejected, seen = [], [], {}
     n = start + 2
     while n < len(lines) and lines[n].strip():
-        lineno = n + 1
-        row = next(csv.reader([lines[n]], skipinitialspace=True))
         n += 1
-        if len(row) < len(header):
-            raise RecordError(f"{source}, line {lineno}: {len(row)} fields, the table's header has {len(header)}")
-        meta = {}
-        for key, (name, kind) in METADATA.items():
-            if name not in col:
-                meta[key] = None
-                continue
-            try:
-                meta[key] = _value(row[col[name]], kind)
-            except ValueError as exc:
-                raise RecordError(f"{source}, line {lineno}: {name}: {exc}") from None
-        if meta["rsn"] is None:
-            raise RecordError(f"{source}, line {lineno}: no record sequence number")
-        if meta["rsn"] in seen:
-            raise RecordError(f"{source}, line {lineno}: RSN {meta['rsn']} is listed twice "
-                              f"(also line {seen[meta['rsn']]})")
-        seen[meta["rsn"]] = lineno
-        files = {key: _value(row[col[name]], str) for name, key in _FILE_COLUMNS.items()}
-        for f in files.values():
-            if f is not None and not _safe_name(f):
-                raise RecordError(f"{source}, line {lineno}: file name {f!r} is not a plain file name")
-        entries.append(PeerEntry(meta["rsn"], files["h1"], files["h2"], files["vertical"], meta, lineno))
+        try:
+            entry = _entry(lines[n - 1], n, header, col, seen, source)
+        except RecordError as exc:
+            rejected.append((n, str(exc)))
+            continue
+        seen[entry.rsn] = n
+        entries.append(entry)
     if not entries:
-        raise RecordError(f"{source}: the metadata table lists no record")
+        why = f": {rejected[0][1]}" if rejected else ""
+        raise RecordError(f"{source}: the metadata table lists no record that can be read{why}")
     scaling = ""
     notes = []
     for ln in lines[:start]:
@@ -202,7 +209,33 @@ def parse_search_results(text: str, source: str = SEARCH_RESULTS) -> SearchResul
             break
         if "SCALED" in ln.upper():
             notes.append(ln.strip())
-    return SearchResults(entries, scaling, notes, source)
+    return SearchResults(entries, scaling, notes, source, rejected)
+
+
+def _entry(line: str, lineno: int, header, col, seen, source) -> PeerEntry:
+    """One record line of the metadata table (:class:`RecordError` naming the line otherwise)."""
+    row = _fields(line, source, lineno)
+    if len(row) < len(header):
+        raise RecordError(f"{source}, line {lineno}: {len(row)} fields, the table's header has {len(header)}")
+    meta = {}
+    for key, (name, kind) in METADATA.items():
+        if name not in col:
+            meta[key] = None
+            continue
+        try:
+            meta[key] = _value(row[col[name]], kind)
+        except ValueError as exc:
+            raise RecordError(f"{source}, line {lineno}: {name}: {exc}") from None
+    if meta["rsn"] is None:
+        raise RecordError(f"{source}, line {lineno}: no record sequence number")
+    if meta["rsn"] in seen:
+        raise RecordError(f"{source}, line {lineno}: RSN {meta['rsn']} is listed twice "
+                          f"(also line {seen[meta['rsn']]})")
+    files = {key: _value(row[col[name]], str) for name, key in _FILE_COLUMNS.items()}
+    for f in files.values():
+        if f is not None and not _safe_name(f):
+            raise RecordError(f"{source}, line {lineno}: file name {f!r} is not a plain file name")
+    return PeerEntry(meta["rsn"], files["h1"], files["h2"], files["vertical"], meta, lineno)
 
 
 def _safe_name(name: str) -> bool:

@@ -130,3 +130,95 @@ def test_a_fifo_as_an_output_is_refused_before_any_work(tmp_path, command):
     err = done.stderr.strip()
     assert "is a FIFO (named pipe), not a file" in err and "\n" not in err, err
     assert not (tmp_path / "out" / "design.csv").exists()
+
+
+# -- (1) (2) (3) (13) (14) the search report ---------------------------------------------------------
+@pytest.fixture(scope="module")
+def hostile_report(tmp_path_factory):
+    """A download whose report holds one good record and every wrong of the issue, run once with
+    ``--peer-scales``: ``(out folder, exit status, printed text)``."""
+    import contextlib
+
+    tmp = tmp_path_factory.mktemp("hostile-report")
+    members = {**pair_members("A"), **pair_members("B"), **pair_members("C")}
+    rows = [(1, "A000.AT2", "A090.AT2", "-----", "2.0", "Quake\x1b[2J\x07", "Sta\x1b]0;owned\x07tion"),
+            (2, "B000.AT2", "B090.AT2", "-----", "1e6"), (3, "B000.AT2", "B090.AT2", "-----", "nan"),
+            (4, "B000.AT2", "B090.AT2", "-----", "-"), (5, "B000.AT2", "B090.AT2", "-----", "0"),
+            (6, "C000.AT2", "C000.AT2", "-----"), (7, "C000.AT2", "c000.at2", "-----")]
+    raw = ["8, 9, 2.0, -, \"short row\"\n",
+           "9, 10, 2.0, -, \"" + "x" * 140_000 + "\", \"S\", 6.5, A000.AT2, A090.AT2, -----\n"]
+    path = make_zip(tmp / "dl.zip", rows, members, raw_rows=raw)
+    out = tmp / "out"
+    buf_out, buf_err = io.StringIO(), io.StringIO()
+    loud = [a for a in RUN_ARGS if a != "--quiet"]
+    with contextlib.redirect_stdout(buf_out), contextlib.redirect_stderr(buf_err):
+        code = main(["run", str(path), *loud, "--out", str(out), "--peer-scales"])
+    return out, code, buf_out.getvalue() + buf_err.getvalue()
+
+
+def _reasons(out):
+    return [r["reason"] for r in read_rows(out / "failures.csv")]
+
+
+def test_peer_scales_obey_the_scale_rule(hostile_report):
+    """A search factor of 1e6 designed for ~422,000 g; nan, '-' or 0 became 1 while the row said
+    peer_scaled=True.  Now each is a failed record with the reason; the good one is scaled by 2."""
+    out, code, _ = hostile_report
+    assert code == 1
+    (good,) = read_rows(out / "pairs.csv")
+    assert good["peer_rsn"] == "1" and float(good["scale"]) == 2.0 and good["peer_scaled"] == "True"
+    reasons = _reasons(out)
+    for rsn, words in ((2, "must lie between 0.001 and 1000, got '1000000.0'"), (3, "is missing"),
+                       (4, "is missing"), (5, "must lie between 0.001 and 1000, got '0.0'")):
+        assert any(r.startswith(f"RSN {rsn}: --peer-scales") and words in r for r in reasons), (rsn, reasons)
+
+
+def test_one_file_named_as_both_horizontals_is_no_pair(hostile_report):
+    """The same file as both horizontals (or two names equal but for case) was designed as a pair
+    with itself (45 deg: sqrt 2 times the record, 135 deg: zero)."""
+    out, _, _ = hostile_report
+    reasons = _reasons(out)
+    for rsn in (6, 7):
+        assert any(r.startswith(f"RSN {rsn}:") and "as both horizontal components" in r for r in reasons), reasons
+
+
+def test_malformed_and_huge_rows_fail_alone(hostile_report):
+    """A field over 131,072 characters was a ``_csv.Error`` traceback losing the command; one short
+    row failed the whole download.  Now each such row is a failed record naming its line, and the
+    valid records are designed."""
+    out, _, printed = hostile_report
+    reasons = _reasons(out)
+    assert any("line 11: 5 fields, the table's header has 10" in r for r in reasons), reasons
+    assert any("line 12: not a line of the table: field larger than field limit" in r for r in reasons), reasons
+    assert len(reasons) == 8  # six records and two rows
+    assert "Traceback" not in printed
+
+
+def test_control_characters_of_the_report_never_reach_the_terminal(hostile_report):
+    out, _, printed = hostile_report
+    assert "\x1b" not in printed and "\x07" not in printed
+    assert "Quake\\x1b[2J\\x07" in printed  # shown, as escapes
+    (good,) = read_rows(out / "pairs.csv")
+    assert good["peer_event"] == "Quake\\x1b[2J\\x07" and good["peer_station"] == "Sta\\x1b]0;owned\\x07tion"
+    page = (out / "report.html").read_text()
+    assert "\x1b" not in page and "\x07" not in page
+
+
+# -- (10) two downloads with the same file names --------------------------------------------------
+def test_two_downloads_with_the_same_file_names_stay_two_records(tmp_path):
+    """Two downloads holding A000.AT2 and A090.AT2 were merged into one design row (one's
+    metadata, the other's numbers)."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    make_zip(tmp_path / "a" / "dl.zip", [(1, "A000.AT2", "A090.AT2", "-----")], pair_members("A"))
+    weaker = pair_members("A")
+    weaker["A000.AT2"] = at2_text(0.5 * pulse_values(0), "0")
+    make_zip(tmp_path / "b" / "dl.zip", [(2, "A000.AT2", "A090.AT2", "-----")], weaker)
+    out = tmp_path / "out"
+    assert main(["run", str(tmp_path / "a" / "dl.zip"), str(tmp_path / "b" / "dl.zip"), *RUN_ARGS,
+                 "--out", str(out)]) == 0
+    pairs = {r["peer_rsn"]: r for r in read_rows(out / "pairs.csv")}
+    assert set(pairs) == {"1", "2"}
+    assert pairs["1"]["file"].startswith(str(tmp_path / "a")) and pairs["2"]["file"].startswith(str(tmp_path / "b"))
+    design = read_rows(out / "design.csv")
+    assert len(design) == 2 and len({r["record"] for r in design}) == 2
