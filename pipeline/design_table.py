@@ -44,7 +44,13 @@ DESIGN_COLUMNS = Columns(
                                     "after the search (over the directions; docs/slivers.md); blank where "
                                     "none was found, which does not prove there is none."),
     ("survives_vertical", "-", "The column as it stands does not overturn with the record's vertical "
-                               "component too (in any direction of a pair); blank without a vertical."),
+                               "component too (in any direction of a pair); blank without a vertical. "
+                               "False also where the block lifts off (`vertical_lift_off_s`): the "
+                               "response stops there, and nothing shows that the column survives."),
+    ("vertical_lift_off_s", "s", "Earliest time at which g + av < 0 before the response ended, over "
+                                 "the directions: the block leaves the ground, which the rocking model "
+                                 "does not describe (its own verdict, `lifts off at t s`); blank when "
+                                 "it never does."),
 )
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
 
@@ -115,7 +121,11 @@ def design_rows(rows, failed=None) -> list[dict]:
             "widest_failing_width_m": _widest([r.get("widest_failing_width_m") for r in group],
                                               above=number(gov.get("verified_width_m"))),
             "survives_vertical": (None if not block else _bool_all(
-                [None if r.get("vertical_overturns") is None else not r["vertical_overturns"] for r in group])),
+                [None if r.get("vertical_overturns") is None else not (r["vertical_overturns"] or r.get("vertical_lifts_off"))
+                 for r in group])),
+            "vertical_lift_off_s": (None if not block else min(
+                [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
+                 if t is not None], default=None)),
         }))
     return out
 
@@ -202,7 +212,12 @@ def table_cells(row) -> tuple[str, ...]:
             survives_text(row))
 
 
-def _vertical_text(row) -> str:
+def vertical_text(row) -> str:
+    """The verdict with the vertical: ``yes``, ``NO``, ``lifts off at 2.31 s`` (never ``yes``: the
+    rocking model stops where the block leaves the ground) or ``-``."""
+    t = number(row.get("vertical_lift_off_s"))
+    if t is not None:
+        return f"lifts off at {t:.2f} s"
     return _yes(row.get("survives_vertical"), no="NO")
 
 
@@ -259,7 +274,7 @@ def table_text(rows, failures=(), summary=()) -> str:
             if w is not None:
                 widths[key] = max(w, widths.get(key, w))
         headers = HEADERS + (VERTICAL_HEADER,)
-        body = [c + (_vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
+        body = [c + (vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
                                           if (r["record"], r.get("column")) in widths else ""),)
                 for c, r in zip(body, rows)]
     body = _align_failing(body, FAILS_COLUMN)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import re
 import zipfile
 
 import numpy as np
@@ -222,3 +223,75 @@ def test_two_downloads_with_the_same_file_names_stay_two_records(tmp_path):
     assert pairs["1"]["file"].startswith(str(tmp_path / "a")) and pairs["2"]["file"].startswith(str(tmp_path / "b"))
     design = read_rows(out / "design.csv")
     assert len(design) == 2 and len({r["record"] for r in design}) == 2
+
+
+# -- (7) a vertical that lifts the block off ---------------------------------------------------------
+def test_lift_off_is_its_own_verdict_never_survives(tmp_path, capsys):
+    """A vertical below -1 g (free flight) was reported "survives with the vertical" in design.csv,
+    the printed table and report.html, though the response stopped at lift-off."""
+    n = 400
+    v = 0.05 * np.sin(0.02 * np.arange(n))
+    v[150:160] = -1.5  # 1.5 g downwards at 1.5 s: the ground falls away faster than gravity
+    files = []
+    for name, values, comp in (("S000.AT2", pulse_values(0), "0"), ("S090.AT2", pulse_values(90), "90"),
+                               ("S-UP.AT2", v, "UP")):
+        (tmp_path / name).write_text(at2_text(values, comp))
+        files.append(str(tmp_path / name))
+    out = tmp_path / "out"
+    loud = [a for a in RUN_ARGS if a != "--quiet"]
+    assert main(["run", "--triplet", *files, *loud, "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    summary = read_rows(out / "summary.csv")
+    # g + av crosses zero between the samples at 1.49 s and 1.50 s (interpolated: 1.4967 s)
+    assert all(r["vertical_lifts_off"] == "True" and 1.49 < float(r["vertical_t_lift_off_s"]) <= 1.5
+               for r in summary)
+    (row,) = read_rows(out / "design.csv")
+    assert row["survives_vertical"] == "False" and 1.49 < float(row["vertical_lift_off_s"]) <= 1.5
+    line = [ln for ln in printed.splitlines() if ln.startswith("S000+90")][0]
+    assert line.rstrip().endswith("lifts off at 1.50 s"), line
+    page = (out / "report.html").read_text()
+    assert "lifts off at 1.50 s" in page
+    assert "with the vertical (" in page and "with the vertical (fast-vertical): survives" not in page
+
+
+# -- (12) anchors --------------------------------------------------------------------------------------
+def test_record_ids_get_distinct_anchors():
+    """Record ids ``a+b`` and ``a_2Bb`` had one anchor in report.html."""
+    from pipeline.html_report import _anchor
+
+    ids = ["a+b", "a_2Bb", "a_b", "a%b", "a_25b", "RSN77_SFERN_PUL164"]
+    anchors = [_anchor(i) for i in ids]
+    assert len(set(anchors)) == len(ids)
+    assert all(re.fullmatch(r"r-[A-Za-z0-9_.~-]+", a) for a in anchors)  # valid in a URL fragment
+
+
+# -- (5) (6) verticals that cannot be used -----------------------------------------------------------
+@pytest.mark.parametrize("vertical, reason", [
+    ("zero", "every sample is zero"), ("constant", "constant"), ("nan", "is not a list of numbers"), ("absent", "not in the download"), ("corrupt", "cannot read")])
+def test_an_unusable_peer_vertical_is_not_used_and_the_record_designed(tmp_path, vertical, reason):
+    """A PEER vertical that was constant, zero, NaN or inf (or a damaged member) failed the record
+    in every direction; now the horizontals are designed, as through --triplet, and every row
+    says why the vertical was not used, naming the member."""
+    values = {"zero": np.zeros(400), "constant": np.full(400, 0.1), "nan": np.r_[pulse_values(0)[:-1], np.nan]}.get(vertical, pulse_values(0))
+    members = pair_members("A", vertical=at2_text(values, "UP"))
+    if vertical == "absent":
+        del members["A-UP.AT2"]
+    path = make_zip(tmp_path / "dl.zip", [(1, "A000.AT2", "A090.AT2", "A-UP.AT2")], members)
+    if vertical == "corrupt":
+        corrupt_member(path, "A-UP.AT2")
+    out = tmp_path / "out"
+    assert main(["run", str(path), *RUN_ARGS, "--out", str(out)]) == 0
+    rows = read_rows(out / "summary.csv")
+    assert rows and all(r["vertical_file"] == "" for r in rows)
+    for r in rows:
+        assert "vertical not used" in r["warnings"] and "A-UP.AT2" in r["warnings"], r["warnings"]
+        assert reason.lower() in r["warnings"].lower(), r["warnings"]
+
+
+def test_vertical_none_needs_no_vertical(tmp_path):
+    """``--vertical none`` still failed a PEER record whose unneeded vertical was absent."""
+    path = make_zip(tmp_path / "dl.zip", [(1, "A000.AT2", "A090.AT2", "A-UP.AT2")], pair_members("A"))
+    out = tmp_path / "out"
+    assert main(["run", str(path), *RUN_ARGS, "--out", str(out), "--vertical", "none"]) == 0
+    rows = read_rows(out / "summary.csv")
+    assert rows and all(r["vertical_file"] == "" and "vertical" not in r["warnings"] for r in rows)
