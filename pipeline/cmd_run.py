@@ -114,7 +114,7 @@ def main(args) -> int:
     args.pair = list(args.pair) + [[a, b] for a, b in triplets]  # a triplet's horizontals are a pair
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
-    downloads, others = peer_inputs.split_inputs(args.records)
+    downloads, others = peer_inputs.split_inputs(args.records, args.format)
     paths = [p for p in expand_inputs(others) if p not in set(triplets.values())]
     if not paths and not args.pair and not downloads:
         from .report import display

@@ -81,13 +81,15 @@ def add_options(parser) -> None:
                              "(_SearchResults.csv); by default records are designed as recorded")
 
 
-def split_inputs(items) -> tuple[list[str], list[str]]:
-    """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``."""
+def split_inputs(items, format: str | None = None) -> tuple[list[str], list[str]]:
+    """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``.
+    With ``--format`` given, every file is a record of that format (a zip is no download)."""
     from pulses.peer import is_peer_download
 
     downloads, others = [], []
     for item in items:
-        (downloads if is_peer_download(str(item)) else others).append(str(item))
+        plain_file = format is not None and not os.path.isdir(item)
+        (downloads if not plain_file and is_peer_download(str(item)) else others).append(str(item))
     return downloads, others
 
 

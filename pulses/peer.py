@@ -503,10 +503,23 @@ def _open_regular(path):
     return io.FileIO(fd, "r")
 
 
+#: how a zip archive starts: a local file header (or the end record of an empty archive)
+_ZIP_STARTS = (b"PK\x03\x04", b"PK\x05\x06")
+
+
 def is_peer_zip(path) -> bool:
-    """A regular file that is a zip archive (its content says so, not its name)."""
+    """A regular file that is a zip archive (its content says so, not its name): it starts as a
+    zip starts, and :func:`zipfile.is_zipfile` finds its end record.  The end record alone is not
+    enough: a SAC or text record whose last bytes happen to hold a zip signature is a record."""
     path = os.fspath(path)
-    return os.path.isfile(path) and zipfile.is_zipfile(path)
+    if not os.path.isfile(path):
+        return False
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4)
+    except OSError:
+        return False
+    return head in _ZIP_STARTS and zipfile.is_zipfile(path)
 
 
 def is_peer_download(path) -> bool:

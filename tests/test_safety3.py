@@ -295,3 +295,26 @@ def test_vertical_none_needs_no_vertical(tmp_path):
     assert main(["run", str(path), *RUN_ARGS, "--out", str(out), "--vertical", "none"]) == 0
     rows = read_rows(out / "summary.csv")
     assert rows and all(r["vertical_file"] == "" and "vertical" not in r["warnings"] for r in rows)
+
+
+# -- (11) a record whose last bytes hold a zip signature ------------------------------------------
+def test_a_sac_record_ending_in_a_zip_signature_is_a_record(tmp_path):
+    """A SAC file whose last 22 bytes (its last samples) hold a zip's end record was taken as a PEER
+    download, even with ``--format sac``."""
+    import importlib.resources
+
+    import pulses
+
+    raw = bytearray((importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac").read_bytes())
+    buf = io.BytesIO()
+    zipfile.ZipFile(buf, "w").close()  # an empty zip: its 22-byte end record
+    raw[-22:] = buf.getvalue()
+    path = tmp_path / "tail.sac"
+    path.write_bytes(bytes(raw))
+    assert zipfile.is_zipfile(path)  # the case: the end record alone says "zip"
+    assert not peer.is_peer_zip(path)
+    assert pulses.read_record(path).npts == len(raw[632:]) // 4
+    for fmt in ([], ["--format", "sac"]):
+        out = tmp_path / f"out{len(fmt)}"
+        assert main(["run", str(path), *RUN_ARGS, *fmt, "--out", str(out)]) == 0
+        assert [r["record"] for r in read_rows(out / "design.csv")] == ["tail"]
