@@ -362,3 +362,38 @@ def test_finding_the_files_of_a_long_report_is_linear(tmp_path, monkeypatch):
     for k in range(4000):
         assert real(d, f"rsn{k}_x000.AT2") == f"RSN{k}_X000.AT2"
     assert len(scans) == 1  # the members were listed once, for the index
+
+
+def test_a_member_that_unpacks_far_beyond_its_size_is_refused_unread(tmp_path):
+    """A 650 kB zip whose member unpacked to 190 MB took 1.0 GB of memory; a member unpacking to
+    more than MAX_RATIO times its compressed size is now refused by its stated sizes, before it is
+    read, and its record fails alone."""
+    bomb = at2_text(pulse_values(0), "0") + " " * (8 << 20)  # 8 MB of blanks deflate ~1000 times
+    members = {**pair_members("A"), **pair_members("B")}
+    members["B000.AT2"] = bomb
+    path = make_zip(tmp_path / "dl.zip", [(1, "A000.AT2", "A090.AT2", "-----"), (2, "B000.AT2", "B090.AT2", "-----")],
+                    members)
+    with zipfile.ZipFile(path) as zf:
+        info = zf.getinfo("B000.AT2")
+    assert info.file_size > peer.MAX_RATIO * info.compress_size + peer.RATIO_SLACK
+    d = peer.PeerDownload(path)
+    with pytest.raises(RecordError, match=r"B000\.AT2: unpacks to \d+ bytes from \d+, more than 100 times"):
+        d.read_component("B000.AT2")
+    assert d.read_component("A000.AT2").npts == 400
+    out = tmp_path / "out"
+    assert main(["run", str(path), *RUN_ARGS, "--out", str(out)]) == 1
+    assert {r["peer_rsn"] for r in read_rows(out / "pairs.csv")} == {"1"}
+
+
+def test_a_member_whose_stated_size_lies_is_bounded_as_it_unpacks(tmp_path, monkeypatch):
+    """The bound holds while a member is read, not only on what the zip states: the reader stops
+    past it (here with the bound lowered below the member's true size)."""
+    path = make_zip(tmp_path / "dl.zip", [(1, "A000.AT2", "A090.AT2", "-----")], pair_members("A"))
+    d = peer.PeerDownload(path)
+    size = d._sizes["A000.AT2"]
+    d._sizes["A000.AT2"] = 10  # what a lying header would state
+    monkeypatch.setattr(peer, "RATIO_SLACK", 0)
+    monkeypatch.setattr(peer, "MAX_RATIO", 1)  # bound: the compressed size, below the true size
+    assert size > d._packed["A000.AT2"]
+    with pytest.raises(RecordError, match="unpacks to more than"):
+        d.read_component("A000.AT2")
