@@ -121,6 +121,11 @@ def main(args) -> int:
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
+    if paths and not downloads and not args.pair and not any(os.path.lexists(p) for p in paths):
+        from .report import display
+
+        shown = ", ".join(map(display, paths[:3])) + (f" and {len(paths) - 3} more" if len(paths) > 3 else "")
+        raise ArgumentError(f"none of the inputs exists ({shown}): nothing to do, nothing written")
     tasks = pairs.tasks_from_args(args, downloads, paths, columns, options)
     if tasks is not None and args.vertical == "auto":
         found = {}

@@ -397,3 +397,34 @@ def test_a_member_whose_stated_size_lies_is_bounded_as_it_unpacks(tmp_path, monk
     assert size > d._packed["A000.AT2"]
     with pytest.raises(RecordError, match="unpacks to more than"):
         d.read_component("A000.AT2")
+
+
+# -- new users ----------------------------------------------------------------------------------------
+def test_width_over_height_warns_with_the_swap(capsys):
+    from pipeline.args import parse_block
+
+    assert parse_block("1.8x7.5") == (1.8, 7.5)  # allowed: a squat block exists
+    assert "did you mean 7.5x1.8?" in capsys.readouterr().err
+    assert parse_block("7.5x1.8") == (7.5, 1.8)
+    assert capsys.readouterr().err == ""
+
+
+def test_every_input_missing_is_an_argument_error_and_nothing_is_written(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", str(tmp_path / "a.AT2"), str(tmp_path / "b*.AT2"), *RUN_ARGS, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pipeline run: error: none of the inputs exists") and "\n" not in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv, hint", [
+    (["rn", "x"], "did you mean 'run'?"), (["clasify", "x"], "did you mean 'classify'?"),
+    (["run", "x.AT2", "--blok", "7.5x1.8"], "did you mean --block for --blok?"),
+    (["run", "x.AT2", "--block", "7.5x1.8", "--vertcal", "none"], "did you mean --vertical for --vertcal?"),
+])
+def test_mistyped_commands_and_options_get_a_suggestion(argv, hint, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(hint) and "\n" not in err, err
