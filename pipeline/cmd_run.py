@@ -115,7 +115,16 @@ def main(args) -> int:
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     downloads, others = peer_inputs.split_inputs(args.records, args.format)
-    paths = [p for p in expand_inputs(others) if p not in set(triplets.values())]
+    skipped = []
+    paths = [p for p in expand_inputs(others, skipped) if p not in set(triplets.values())]
+    if skipped and not args.quiet:
+        import sys
+
+        from .report import display
+
+        shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
+        print(f"pipeline run: note: {len(skipped)} file(s) of the folders skipped, plainly not records "
+              f"({shown}); name a file to read it as a record", file=sys.stderr)
     if not paths and not args.pair and not downloads:
         from .report import display
 

@@ -428,3 +428,23 @@ def test_mistyped_commands_and_options_get_a_suggestion(argv, hint, capsys):
     assert stop.value.code == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith(hint) and "\n" not in err, err
+
+
+def test_files_of_a_folder_that_are_plainly_not_records_are_skipped_with_one_line(tmp_path, capsys):
+    """A README.txt or notes.md in a records folder was a failed record; now skipped, named in one
+    line; a record that fails to read is still a failure, and a file named directly is read."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "good.AT2").write_text(at2_text(pulse_values(0), "0"))
+    (folder / "README.txt").write_text("Records of the 1994 event\n")
+    (folder / "notes.md").write_text("# notes\n")
+    (folder / "words.txt").write_text("no numbers here\n")
+    (folder / "photo.png").write_bytes(b"\x89PNG\r\n\x1a\n")
+    (folder / "broken.AT2").write_text("not a record\n")
+    out = tmp_path / "out"
+    assert main(["run", str(folder), *[a for a in RUN_ARGS if a != "--quiet"], "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    (line,) = [ln for ln in err.splitlines() if "plainly not records" in ln]
+    assert "4 file(s)" in line and all(n in line for n in ("README.txt", "notes.md", "words.txt", "photo.png"))
+    assert [f["record"] for f in read_rows(out / "failures.csv")] == ["broken"]
+    assert [r["record"] for r in read_rows(out / "design.csv")] == ["good"]
