@@ -107,6 +107,7 @@ def test_fifos_and_devices_among_the_inputs_are_failed_records_not_a_hang(tmp_pa
     out = tmp_path / "out"
     done = _pipeline(["run", str(folder), *RUN_ARGS, "--out", str(out)], tmp_path, timeout=60)
     assert done.returncode == 1, done.stderr
+    assert (out / "failures.csv").is_file(), (done.stdout, done.stderr)
     reasons = {os.path.basename(r["file"]): r["reason"] for r in read_rows(out / "failures.csv")}
     assert "a FIFO (named pipe), not a record file" in reasons["pipe.AT2"]
     assert "a character device, not a record file" in reasons["zero.AT2"]
