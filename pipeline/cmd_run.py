@@ -135,7 +135,8 @@ def main(args) -> int:
 
         shown = ", ".join(map(display, paths[:3])) + (f" and {len(paths) - 3} more" if len(paths) > 3 else "")
         raise ArgumentError(f"none of the inputs exists ({shown}): nothing to do, nothing written")
-    tasks = pairs.tasks_from_args(args, downloads, paths, columns, options)
+    absent = [] if downloads else None  # the search's records not in the download: listed, not failed
+    tasks = pairs.tasks_from_args(args, downloads, paths, columns, options, absent)
     if tasks is not None and args.vertical == "auto":
         found = {}
         if args.pairs == "auto":
@@ -146,5 +147,6 @@ def main(args) -> int:
             found = vertical.auto_verticals(rest, _ro(args), say)
         tasks = vertical.attach(tasks, {**found, **triplets})
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
-                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
+                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log,
+                  lists={peer_inputs.NOT_DOWNLOADED: peer_inputs.not_downloaded_text(absent)})
     return summary.exit_code

@@ -28,7 +28,7 @@ MAX_DIRECTIONS = 180
 
 
 # -- the command line --------------------------------------------------------------------------------
-def tasks_from_args(args, downloads, paths, columns, options):
+def tasks_from_args(args, downloads, paths, columns, options, absent: list | None = None):
     """Every task of ``pipeline run``: the files' (one per file, or pairs), then the PEER downloads';
     None when there are no pairs, scales or downloads (the runner's own tasks, one per file)."""
     if not downloads:
@@ -45,7 +45,8 @@ def tasks_from_args(args, downloads, paths, columns, options):
         others = _file_tasks(args, paths, columns, options)
         if others is None:
             others = make_tasks(paths, columns, options)
-    return combine(others, peer_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say))
+    return combine(others, peer_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say,
+                                      absent))
 
 
 def _file_tasks(args, paths, columns, options):
@@ -228,15 +229,17 @@ def _both_readable(a, b, opts) -> bool:
 
 
 # -- PEER downloads ---------------------------------------------------------------------------------
-def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_scales: bool, say):
+def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_scales: bool, say,
+               absent: list | None = None):
     """The tasks of the PEER downloads: each complete record a pair in every direction
     (:func:`directions`), each incomplete one a task that fails when read, with the
-    reason.  Indices and record ids are set by :func:`combine`."""
+    reason; the records not downloaded at all go to ``absent``, when given
+    (:func:`pipeline.peer_inputs.record_units`).  Indices and record ids are set by :func:`combine`."""
     from pulses import RecordError, check_pair
 
     tasks = []
     for download in downloads:
-        for entry, src in peer_inputs.record_units(download, peer_scales, say):
+        for entry, src in peer_inputs.record_units(download, peer_scales, say, absent):
             if entry is None:  # the download itself cannot be read: one failure for it
                 tasks.append(Task(0, _download_stem(download) + ".zip", download, tuple(columns), options,
                                   peer=src))

@@ -155,10 +155,30 @@ def _why_not(d, e, scaled: bool) -> str:
     return ""
 
 
-def record_units(download, scaled: bool, say) -> list[tuple]:
+#: the list, in ``--out``, of the records a search report lists that are not in the download
+NOT_DOWNLOADED = "peer-not-downloaded.csv"
+NOT_DOWNLOADED_FIELDS = ["download", "peer_rsn", "line", "peer_event", "peer_station", "h1", "h2", "vertical"]
+
+
+def not_downloaded_text(rows) -> str | None:
+    """The text of :data:`NOT_DOWNLOADED` (None when no download was given)."""
+    from .report import csv_text
+
+    return None if rows is None else csv_text(NOT_DOWNLOADED_FIELDS, rows)
+
+
+def _absent(d, e) -> bool:
+    """Not one file of record ``e`` is in download ``d`` (none refused either): a record of the
+    search that was not downloaded, the usual case (PEER's zip holds the records ticked)."""
+    return bool(e.files) and all(d.find(f) is None and d.refusal(f) is None for f in e.files)
+
+
+def record_units(download, scaled: bool, say, absent: list | None = None) -> list[tuple]:
     """``(entry, PeerSource)`` for every record the report lists, in its order; a record line the
     report's parser set aside is ``(None, PeerSource)`` failing with its reason.  A vertical
-    that is not in the download is no reason to fail the record: it is not used (the row says why)."""
+    that is not in the download is no reason to fail the record: it is not used (the row says why).
+    With ``absent`` (a list), the records none of whose files is in the download are appended to
+    it as rows of :data:`NOT_DOWNLOADED` instead of being failures."""
     from pulses import RecordError
 
     try:
@@ -168,7 +188,14 @@ def record_units(download, scaled: bool, say) -> list[tuple]:
     entries = d.search.entries
     units = [(None, PeerSource(download, None, None, missing=why)) for _, why in d.search.rejected]
     n_missing = len(units)
+    n_absent = 0
     for e in entries:
+        if absent is not None and _absent(d, e):
+            n_absent += 1
+            absent.append({"download": d.path, "peer_rsn": e.rsn, "line": e.line, "h1": e.h1, "h2": e.h2,
+                           "vertical": e.vertical, "peer_event": e.metadata.get("event"),
+                           "peer_station": e.metadata.get("station")})
+            continue
         why = _why_not(d, e, scaled)
         n_missing += bool(why)
         vertical = d.find(e.vertical) if e.vertical else None
@@ -181,8 +208,10 @@ def record_units(download, scaled: bool, say) -> list[tuple]:
     for member, why in d.refused.items():
         say(f"pipeline run: note: {d.path}: {why}")
     listed = len(entries) + len(d.search.rejected)
+    not_here = f", {n_absent} not in the download (listed in {NOT_DOWNLOADED})" if n_absent else ""
     say(f"pipeline run: PEER download {d.path}: {listed} records listed, "
-        f"{listed - n_missing} complete, {n_missing} incomplete (failures); designed {scaling}")
+        f"{listed - n_missing - n_absent} complete{not_here}, {n_missing} incomplete (failures); "
+        f"designed {scaling}")
     return units
 
 

@@ -449,3 +449,27 @@ def test_files_of_a_folder_that_are_plainly_not_records_are_skipped_with_one_lin
     assert "4 file(s)" in line and all(n in line for n in ("README.txt", "notes.md", "words.txt", "photo.png"))
     assert [f["record"] for f in read_rows(out / "failures.csv")] == ["broken"]
     assert [r["record"] for r in read_rows(out / "design.csv")] == ["good"]
+
+
+def test_records_not_downloaded_are_listed_not_failed(tmp_path, capsys):
+    """A partial PEER download printed one "failed" line per record not downloaded, counted them as
+    failures in report.html and exited 1 for the usual case; now one line and a list in --out, and
+    exit 0 when every downloaded record was designed.  A record half there is still a failure."""
+    rows = [(1, "A000.AT2", "A090.AT2", "-----"), (2, "N000.AT2", "N090.AT2", "N-UP.AT2"),
+            (3, "M000.AT2", "M090.AT2", "-----")]
+    path = make_zip(tmp_path / "dl.zip", rows, pair_members("A"))
+    out = tmp_path / "out"
+    assert main(["run", str(path), *[a for a in RUN_ARGS if a != "--quiet"], "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "1 complete, 2 not in the download (listed in peer-not-downloaded.csv), 0 incomplete" in captured.err
+    assert "failed" not in captured.out + captured.err
+    assert read_rows(out / "failures.csv") == []
+    listed = read_rows(out / "peer-not-downloaded.csv")
+    assert [(r["peer_rsn"], r["h1"], r["vertical"]) for r in listed] == [("2", "N000.AT2", "N-UP.AT2"), ("3", "M000.AT2", "")]
+    # half there: a failure naming what it lacks
+    members = {**pair_members("A"), "M000.AT2": at2_text(pulse_values(0), "0")}
+    path = make_zip(tmp_path / "dl.zip", rows, members)
+    assert main(["run", str(path), *RUN_ARGS, "--out", str(out)]) == 1
+    (fail,) = read_rows(out / "failures.csv")
+    assert fail["reason"].startswith("RSN 3:") and fail["reason"].endswith("not in the download: M090.AT2")
+    assert [r["peer_rsn"] for r in read_rows(out / "peer-not-downloaded.csv")] == ["2"]
