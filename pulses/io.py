@@ -175,9 +175,21 @@ def record_from_reading(path: str, reading, units=None, dt=None, name=None, *,
         unit_factor(units)
     meta = reading.metadata
     meta.setdefault("warnings", [])
-    used_units, units_source = _units(path, reading, units)
+    # units and time step both looked at before either is refused: all of a file's missing
+    # settings in one message, not one per run
+    problems = []
+    try:
+        used_units, units_source = _units(path, reading, units)
+    except RecordError as exc:
+        problems.append(str(exc))
+    try:
+        dt = _time_step(path, reading, dt)
+    except RecordError as exc:
+        problems.append(str(exc))
+    if problems:
+        prefix = f"{path}: "
+        raise RecordError(prefix + "; and ".join(p[len(prefix):] if p.startswith(prefix) else p for p in problems))
     acc = np.asarray(reading.values, dtype=float) * unit_factor(used_units)
-    dt = _time_step(path, reading, dt)
     meta.update(units=used_units, units_source=units_source, source=path, dt=dt)
     for key in ("station", "component", "event"):
         meta.setdefault(key, "")

@@ -473,3 +473,18 @@ def test_records_not_downloaded_are_listed_not_failed(tmp_path, capsys):
     (fail,) = read_rows(out / "failures.csv")
     assert fail["reason"].startswith("RSN 3:") and fail["reason"].endswith("not in the download: M090.AT2")
     assert [r["peer_rsn"] for r in read_rows(out / "peer-not-downloaded.csv")] == ["2"]
+
+
+def test_all_of_a_files_missing_settings_in_one_message(tmp_path):
+    """A text file stating neither units nor time step said only the first; after --units, the
+    next run said the second."""
+    import pulses
+
+    path = tmp_path / "plain.txt"
+    path.write_text("".join(f"{v:.3f}\n" for v in pulse_values(0, n=50)))
+    with pytest.raises(RecordError) as err:
+        pulses.read_record(path)
+    text = str(err.value)
+    assert "does not state its units" in text and "does not state its time step" in text
+    assert text.count(str(path)) == 1 and "\n" not in text
+    assert pulses.read_record(path, units="g", dt=0.01).npts == 50
