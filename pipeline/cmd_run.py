@@ -48,6 +48,10 @@ def add_parser(subparsers) -> None:
                    help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
                         "...), folders of them, or PEER NGA-West2 downloads (a .zip, or a folder "
                         "holding _SearchResults.csv; see docs/peer.md)")
+    p.add_argument("--glob", metavar="PATTERN",
+                   help="folders given: take exactly their files whose names match this shell pattern "
+                        "(e.g. '*.AT2'); by default every file but those plainly not records "
+                        "(README, documents, images), which are named in one line")
     p.add_argument("--block", action="append", default=[], metavar="HxW",
                    help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
@@ -116,7 +120,7 @@ def main(args) -> int:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
     downloads, others = peer_inputs.split_inputs(args.records, args.format)
     skipped = []
-    paths = [p for p in expand_inputs(others, skipped) if p not in set(triplets.values())]
+    paths = [p for p in expand_inputs(others, skipped, args.glob) if p not in set(triplets.values())]
     if skipped and not args.quiet:
         import sys
 
@@ -124,7 +128,7 @@ def main(args) -> int:
 
         shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
         print(f"pipeline run: note: {len(skipped)} file(s) of the folders skipped, plainly not records "
-              f"({shown}); name a file to read it as a record", file=sys.stderr)
+              f"({shown}); name a file to read it as a record, or choose files with --glob", file=sys.stderr)
     if not paths and not args.pair and not downloads:
         from .report import display
 

@@ -5,6 +5,7 @@ Plain, picklable data: a task runs the same in this process, in a process pool o
 """
 from __future__ import annotations
 
+import fnmatch
 import glob
 import hashlib
 import os
@@ -138,10 +139,11 @@ def plainly_not_a_record(path) -> bool:
     return bool(head.strip()) and re.search(rb"[0-9]", head) is None
 
 
-def expand_inputs(items, skipped: list | None = None) -> list[str]:
+def expand_inputs(items, skipped: list | None = None, pattern: str | None = None) -> list[str]:
     """File arguments as given; folders give their entries (sorted; not hidden ones, not folders,
     not files that are plainly no record, :func:`plainly_not_a_record`, which are appended to
-    ``skipped`` when given); unexpanded wildcards are globbed.
+    ``skipped`` when given; with ``pattern``, a shell pattern such as ``*.AT2``, exactly the
+    entries whose names match it); unexpanded wildcards are globbed.
 
     A path that does not exist stays in the list: it is reported as a failed record, not an argument
     error, so one missing file does not stop a batch.  So are a folder's entries that cannot be
@@ -170,6 +172,10 @@ def expand_inputs(items, skipped: list | None = None) -> list[str]:
                 # every entry but hidden ones and folders: a broken link, a link loop or a file
                 # that cannot be looked at is a failed record with the reason, never skipped
                 if name.startswith(".") or os.path.isdir(full):
+                    continue
+                if pattern is not None:  # chosen by name: nothing else is looked at
+                    if fnmatch.fnmatchcase(name, pattern):
+                        add(full)
                     continue
                 if plainly_not_a_record(full):
                     if skipped is not None:

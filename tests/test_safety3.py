@@ -488,3 +488,17 @@ def test_all_of_a_files_missing_settings_in_one_message(tmp_path):
     assert "does not state its units" in text and "does not state its time step" in text
     assert text.count(str(path)) == 1 and "\n" not in text
     assert pulses.read_record(path, units="g", dt=0.01).npts == 50
+
+
+def test_glob_chooses_the_files_of_a_folder(tmp_path):
+    """``--glob PATTERN`` takes exactly the folder's files whose names match (a README.txt with
+    numbers in it, which the default would read as a record, is left out)."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "good.AT2").write_text(at2_text(pulse_values(0), "0"))
+    (folder / "other.AT2").write_text(at2_text(pulse_values(90), "90"))
+    (folder / "list.txt").write_text("stations 1 2 3\n")
+    out = tmp_path / "out"
+    assert main(["run", str(folder), "--glob", "g*.AT2", *RUN_ARGS, "--out", str(out)]) == 0
+    assert [r["record"] for r in read_rows(out / "design.csv")] == ["good"]
+    assert read_rows(out / "failures.csv") == []
