@@ -127,9 +127,14 @@ def test_demo_summary_same_as_the_numba_engine(current):
         for col in a:
             if col in ("file", "file2"):
                 continue  # where the package's data sits
+            # the numba engine's verified width was the search's first transition, now
+            # search_width_m (verified_width_m is the design width above every failing width, issue 33)
+            if col == "verified_tan_alpha" and "search_width_m" in b:
+                continue  # the tangent of that width
+            got = b["search_width_m"] if (col == "verified_width_m" and "search_width_m" in b) else b[col]
             try:
-                x, y = float(a[col]), float(b[col])
+                x, y = float(a[col]), float(got)
             except ValueError:
-                assert a[col] == b[col], (a["record"], col)
+                assert a[col] == got, (a["record"], col)
                 continue
-            assert _close(x, y, rel=2e-5), (a["record"], col, a[col], b[col])
+            assert _close(x, y, rel=2e-5), (a["record"], col, a[col], got)
