@@ -299,7 +299,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         No messages and no table on stderr/stdout (default); False prints what ``pipeline run`` prints.
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
-        ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``.
+        ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
+        ``glob``.
 
     Returns
     -------
@@ -333,7 +334,7 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
 
 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
-         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None}
+         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None}
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
@@ -370,7 +371,7 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
         record_opts=opts, pairs=mode, pair=explicit, triplets=triplets, directions=str(directions),
         scale=None if scale is None else repr(_number_option(scale, "scale")), scales=more["scales"],
         peer_scales=bool(more["peer_scales"]), jobs=_jobs(jobs), out=out, force=bool(force),
-        quiet=bool(quiet), dask=more["dask"], log=more["log"])
+        quiet=bool(quiet), dask=more["dask"], log=more["log"], glob=more["glob"])
 
 
 @dataclass
@@ -396,32 +397,52 @@ class Plan:
     quiet: bool = True
     dask: str | None = None
     log: object = None
+    #: ``--glob``: the files of the folders given that are read
+    glob: str | None = None
+
+
+def _paths(plan, say):
+    """``(downloads, record paths)`` of a run's inputs; the files of its folders that are plainly
+    not records are skipped with a note."""
+    from . import peer_inputs
+    from .report import display
+    from .tasks import expand_inputs
+
+    if not plan.records and not plan.pair:
+        raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
+    downloads, others = peer_inputs.split_inputs(plan.records, plan.record_opts.get("format"))
+    skipped = []
+    paths = [p for p in expand_inputs(others, skipped, plan.glob) if p not in set(plan.triplets.values())]
+    if skipped:
+        shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
+        say(f"pipeline run: note: {len(skipped)} file(s) of the folders skipped, plainly not records "
+            f"({shown}); name a file to read it as a record, or choose files with --glob")
+    if not paths and not plan.pair and not downloads:
+        raise ArgumentError(f"no record files in {', '.join(map(display, plan.records))} "
+                            "(a folder gives the files directly in it)")
+    if paths and not downloads and not plan.pair and not any(os.path.lexists(p) for p in paths):
+        shown = ", ".join(map(display, paths[:3])) + (f" and {len(paths) - 3} more" if len(paths) > 3 else "")
+        raise ArgumentError(f"none of the inputs exists ({shown}): nothing to do, nothing written")
+    return downloads, paths
 
 
 def _tasks(plan, say):
-    """``(paths, tasks or None)`` of a run, as ``pipeline run`` makes them."""
-    from . import pairs, peer_inputs, vertical
-    from .tasks import expand_inputs
+    """``(paths, tasks or None, absent)`` of a run, as ``pipeline run`` makes them (``absent``: the
+    PEER search's records not in the download, listed, not failed)."""
+    from . import pairs, vertical
 
     # a triplet's horizontals are a pair
     plan = dataclasses.replace(plan, pair=list(plan.pair) + [[a, b] for a, b in plan.triplets])
-    if not plan.records and not plan.pair:
-        raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
-    downloads, others = peer_inputs.split_inputs(plan.records)
-    paths = [p for p in expand_inputs(others) if p not in set(plan.triplets.values())]
-    if not paths and not plan.pair and not downloads:
-        from .report import display
-
-        raise ArgumentError(f"no record files in {', '.join(map(display, plan.records))} "
-                            "(a folder gives the files directly in it)")
-    tasks = pairs.tasks_from_args(plan, downloads, paths, plan.columns, plan.options)
+    downloads, paths = _paths(plan, say)
+    absent = [] if downloads else None
+    tasks = pairs.tasks_from_args(plan, downloads, paths, plan.columns, plan.options, absent)
     if tasks is not None and plan.options.vertical == "auto":
         found = {}
         if plan.pairs == "auto":
             rest = [p for p in paths if p not in {q for ab in plan.pair for q in ab}]
             found = vertical.auto_verticals(rest, plan.record_opts, say)
         tasks = vertical.attach(tasks, {**found, **plan.triplets})
-    return paths, tasks
+    return paths, tasks, absent
 
 
 def run_plan(plan) -> DesignRun:
@@ -429,10 +450,13 @@ def run_plan(plan) -> DesignRun:
     from .runner import run
 
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
-    paths, tasks = _tasks(plan, say)
+    from .peer_inputs import NOT_DOWNLOADED, not_downloaded_text
+
+    paths, tasks, absent = _tasks(plan, say)
     with _folder(plan.out) as out:
         summary = run(paths, plan.columns, out, options=plan.options, jobs=plan.jobs, dask=plan.dask,
-                      quiet=plan.quiet, tasks=tasks, force=plan.force, log=plan.log)
+                      quiet=plan.quiet, tasks=tasks, force=plan.force, log=plan.log,
+                      lists={NOT_DOWNLOADED: not_downloaded_text(absent)})
     t = summary.tables
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
                      summary.n_failed, None if plan.out is None else summary.out)

@@ -48,6 +48,10 @@ def add_parser(subparsers) -> None:
                    help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
                         "...), folders of them, or PEER NGA-West2 downloads (a .zip, or a folder "
                         "holding _SearchResults.csv; see docs/peer.md)")
+    p.add_argument("--glob", metavar="PATTERN",
+                   help="folders given: take exactly their files whose names match this shell pattern "
+                        "(e.g. '*.AT2'); by default every file but those plainly not records "
+                        "(README, documents, images), which are named in one line")
     p.add_argument("--block", action="append", default=[], metavar="HxW",
                    help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
@@ -116,5 +120,5 @@ def main(args) -> int:
                     triplets={(str(a), str(b)): str(v) for a, b, v in args.triplet},
                     directions=args.directions, scale=args.scale, scales=args.scales,
                     peer_scales=args.peer_scales, jobs=jobs, out=args.out, force=args.force,
-                    quiet=args.quiet, dask=args.dask, log=args.log)
+                    quiet=args.quiet, dask=args.dask, log=args.log, glob=args.glob)
     return api.run_plan(plan).exit_code
