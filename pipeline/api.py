@@ -453,11 +453,18 @@ def run_plan(plan) -> DesignRun:
     from .peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
     paths, tasks, absent = _tasks(plan, say)
+    # with no folder of the caller's, the runner's messages would name the private one: the table
+    # is printed here instead
+    quiet = plan.quiet or plan.out is None
     with _folder(plan.out) as out:
         summary = run(paths, plan.columns, out, options=plan.options, jobs=plan.jobs, dask=plan.dask,
-                      quiet=plan.quiet, tasks=tasks, force=plan.force, log=plan.log,
+                      quiet=quiet, tasks=tasks, force=plan.force, log=plan.log,
                       lists={NOT_DOWNLOADED: not_downloaded_text(absent)})
     t = summary.tables
+    if not plan.quiet and plan.out is None:
+        from .design_table import table_text
+
+        print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
                      summary.n_failed, None if plan.out is None else summary.out)
 

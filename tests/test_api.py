@@ -108,6 +108,16 @@ def test_out_none_writes_nothing_and_out_writes_the_reports(tmp_path, monkeypatc
     assert d["design"][0]["verified_width_m"] == run.design_rows[0]["verified_width_m"] and d["out"] is None
 
 
+def test_not_quiet_prints_pipeline_runs_table_and_names_no_private_folder(tmp_path, capsys):
+    with bundled_records() as paths:
+        pipeline.design(paths[3:4], heights=7.5, shapes="sine", quiet=False)
+        api_out = capsys.readouterr().out
+        main(["run", paths[3], "--height", "7.5", "--shapes", "sine", "--no-plots", "--out", str(tmp_path)])
+        cli_out = capsys.readouterr().out
+    assert "synth_sine_055g_0.9s" in api_out and "pipeline-design." not in api_out
+    assert cli_out.startswith(api_out)  # the command line's table, then its line about the run
+
+
 def test_a_missing_or_unreadable_file_is_a_failures_row(tmp_path):
     bad = tmp_path / "garbage.at2"
     bad.write_text("not a record\n")
