@@ -138,7 +138,8 @@ def run(args) -> int:
               f"pTp = {b['pTp']:.4g}")
     labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})",
               "envelope": f"envelope ({pulse.shape})",
-              "exact": f"exact ({args.criterion})", "level": f"exact (level {limit:g})"}
+              "exact": f"exact ({args.criterion})",
+              "level": f"exact (level {limit:g})" if limit is not None else ""}
     head = f"{'rule':<22}"
     if block is not None:
         head += f"{'min tan(alpha)':>15}  {'adequate':>8}"
