@@ -33,13 +33,6 @@ def _g(x):
     return None if x is None else float(x) / G
 
 
-def _fits(candidate, best) -> bool:
-    b = float(best.score)
-    if not math.isfinite(b) or b <= 0.0:
-        return candidate is best
-    return float(candidate.score) >= FIT_TOLERANCE * b
-
-
 def _sim(block, record, history):
     import rocking
 
@@ -407,20 +400,23 @@ def _verified_fields(col: Column, ver) -> dict:
 
 
 CHECK_COLUMNS = Columns(
-    ("failing_share", "-", "Resolution of the verified width (docs/slivers.md): the verified width is the "
-                           "smallest width above which every width the search examined survives; near "
-                           "it the response is chaotic and failing slivers thinner than the search's "
-                           "0.05 % grid may lie above it. After the search, a check runs `check_runs` "
-                           "jittered widths (seeded from the record, off the search's grid) from the "
-                           "verified width up to twice it or the no-uplift width (height x PGA / g), "
-                           "whichever is smaller, half of them log-spaced just above it: this is the "
-                           "share of them that overturn (0: none did; blank: no check, as in a direction of a pair whose "
-                           "check could not reach the pair's design width, docs/site.md)."),
-    ("widest_failing_width_m", "m", "The widest width the check found to overturn (a failing sliver "
-                                    "above the verified width; blank where none was found, which "
-                                    "does not prove there is none)."),
+    ("failing_share", "-", "What the check above the search width found (docs/slivers.md): near the "
+                           "search's first transition (`search_width_m`) the response is chaotic and "
+                           "failing slivers thinner than the search's 0.05 % grid may lie above it. "
+                           "After the search, a check runs `check_runs` jittered widths (seeded from "
+                           "the record, off the search's grid) in two rounds, each from the design "
+                           "width so far up to twice it or the no-uplift width (height x PGA / g), "
+                           "whichever is smaller: this is the share of them that fail (0: none did; "
+                           "blank: no check, as in a direction of a pair whose check could not reach "
+                           "the pair's design width, docs/site.md). The design width `verified_width_m` lies just above the "
+                           "widest failing width found."),
+    ("widest_failing_width_m", "m", "The widest width the search or the check found to fail above "
+                                    "the search width (a failing sliver; blank where none was found, "
+                                    "which does not prove there is none); the design width lies just "
+                                    "above it."),
     ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width (0: "
-                        "not checked)."),
+                        "not checked; fewer than its 1500 where its later rounds could not reach the "
+                        "pair's design width, docs/site.md)."),
 )
 
 
@@ -449,7 +445,7 @@ def _process(task: Task):
     fit = _stage("fit", _fit, record, opts.shapes, opts.weighting)
     best = fit.best
     candidates = list(fit.candidates)
-    fitting = [c for c in candidates if _fits(c, best)]
+    fitting = rocking.fitting_candidates(fit)
     by_shape = {}
     for c in candidates:  # candidates are ranked: keep the best of each shape
         by_shape.setdefault(c.shape, c)
@@ -484,14 +480,9 @@ def _process(task: Task):
         curves = []
 
         # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
-        def eq31_widths():
-            return [(float(rocking.required_width(H, c.pulse, rule="eq31", cap_mass_ratio=gamma).width), c)
-                    for c in fitting]
-
-        if H not in eq31_cache:
-            eq31_cache[H] = _stage("design", eq31_widths)
-        widths = eq31_cache[H]
-        w31, gov = max(widths, key=lambda wc: wc[0])  # ties: the better fit (ranked first)
+        if H not in eq31_cache:  # rocking.governing_pulse: pipeline run's rule, in public
+            eq31_cache[H] = _stage("design", rocking.governing_pulse, fit, H, cap_mass_ratio=gamma)
+        widths, w31, gov = eq31_cache[H].widths, eq31_cache[H].width, eq31_cache[H].candidate
 
         # -- the column as it stands: design rules, then the full record ---------------------------
         def design():

@@ -18,7 +18,7 @@ from .args import ArgumentError, output_folder
 from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV  # noqa: F401 (tests set it through the runner)
-from .tasks import Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
+from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
 
 
 @dataclass
@@ -28,6 +28,9 @@ class RunSummary:
     n_failed: int
     out: pathlib.Path
     n_reused: int = 0
+    #: the run's tables as row dicts (``design``, ``summary``, ``failures``, ``suite``): the rows the
+    #: CSV reports were written from (pipeline.api.DesignRun makes DataFrames of them)
+    tables: dict | None = dataclasses.field(default=None, repr=False)
 
     @property
     def exit_code(self) -> int:
@@ -106,13 +109,15 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None, tasks=None, force: bool = False,
-        log=None) -> RunSummary:
+        log=None, lists=None) -> RunSummary:
     """Process ``paths`` for ``columns`` and write every report into ``out``.
 
     A record whose report in ``out`` was made by an earlier run from the same file content, options
     and package version is kept, not computed again (:mod:`pipeline.resume`), unless ``force``;
     ``summary.csv``, ``failures.csv`` and the plots are rebuilt from every record's report.
-    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.joblog`).
+    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.joblog`).  ``lists``: files the
+    inputs add to the reports, ``{name: text}`` (None: a file of that name from an earlier run is
+    removed), such as :data:`pipeline.peer_inputs.NOT_DOWNLOADED`.
 
     Raises
     ------
@@ -124,15 +129,18 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         :func:`pipeline.interrupts.handling` is active): workers stopped, reports already written
         complete, no temporary file left.
     """
+    if tasks is None and not all(isinstance(c, Column) for c in columns):  # not an error per record
+        raise TypeError("columns: expected pipeline.tasks.Column objects; from Python, "
+                        "pipeline.design(records, blocks='7.5x1.8', heights=12.0) takes blocks and heights")
     out = output_folder(out)  # checked before the Path: pathlib makes "" the current folder
     if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)
     with outlock.locked(out):  # one run at a time in one folder
         return _run_locked(out, tasks, options=options, jobs=jobs, dask=dask, quiet=quiet,
-                           progress=progress, force=force, log=log)
+                           progress=progress, force=force, log=log, lists=lists or {})
 
 
-def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log) -> RunSummary:
+def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log, lists) -> RunSummary:
     """:func:`run`, the folder locked."""
     outputs = prepare_output(out, tasks, options.plots, options)
     if log is not None:  # never onto an input or one of this run's own files (pipeline.outpaths)
@@ -204,11 +212,21 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts
+    for rel, listed in lists.items():  # e.g. the records of a PEER search not in its download
+        try:
+            if listed is not None:
+                outputs.write(rel, listed)
+            elif outputs.owned(rel):
+                outputs.remove(rel)
+        except report.NotOurs as exc:
+            say(f"pipeline run: note: {exc}")
     design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
     n_reused = len(tasks) - len(computed)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
+                         {"design": design, "summary": rows, "failures": failures,
+                          "suite": site.suite_rows(rows) if rows else []})
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
         if any(t.direction is not None for t in tasks):  # a pair's directions are one task each

@@ -100,7 +100,17 @@ GLS_HAUSMAN = 16.27
 
 class FitError(ValueError):
     """Input the pulse fit cannot use: a record with nothing to fit, or a period range that is
-    not one.  The message is one line that says what is wrong."""
+    not one.  The message is one line that says what is wrong.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> try:
+    ...     pulses.fit_pulse(pulses.Record(np.sin(np.arange(20) / 3.0), 0.01))
+    ... except pulses.FitError as exc:
+    ...     print(exc)
+    record 'record' (0.19 s) is too short to fit pulses of at least 0.2 s
+    """
 
 
 # -- sampled unit pulses ---------------------------------------------------------------------
@@ -160,6 +170,15 @@ class Candidate:
     fit_window : (float, float) or None
         First and last sample times (s) used by the least-squares refinement (``None`` if the
         refinement did not improve on the coarse match).
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> best = pulses.fit_pulse(rec, shapes=["sine"]).best
+    >>> best.rank, round(best.t0, 3), type(best.pulse).__name__
+    (1, 2.0, 'OneSine')
     """
 
     shape: str
@@ -220,6 +239,15 @@ class PulseFit:
         The least squares that gave the candidates: ``"background"`` (weighted by the
         background's spectrum) or ``"plain"`` (asked for, or where the record did not support
         the weighting: see :func:`fit_pulse`).
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> fit = pulses.fit_pulse(rec, shapes=["sine", "ricker-sym"])
+    >>> [c.shape for c in fit.candidates], fit["sine"] is fit.best
+    (['sine', 'ricker-sym'], True)
     """
 
     name: str
@@ -311,6 +339,15 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         Candidates ranked by score, ``.best``, the record's PGA, PGV and duration, and the least
         squares that answered.  A record the plain fit explains to round-off has no background
         to weight by: its fit is the plain one.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> fit = pulses.fit_pulse(rec, shapes=["sine", "ricker-sym"])
+    >>> fit.best.shape, round(fit.best.ap_g, 3), round(fit.best.tp, 3)
+    ('sine', 0.5, 1.0)
     """
     shapes = tuple(DEFAULT_SHAPES if shapes is None else shapes)
     for s in shapes:

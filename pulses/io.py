@@ -35,7 +35,7 @@ from .units import (
     PLAUSIBLE_MIN_G,
     WARN_PEAK_G,
     canonical_units,
-    plausible_units,
+    implausible_peak,
     unit_factor,
 )
 
@@ -100,6 +100,18 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
     -----
     The formats are those registered in :mod:`pulses.formats` (one module each); this function
     only dispatches to them and applies the checks every record gets.
+
+    Examples
+    --------
+    >>> import importlib.resources, pulses
+    >>> path = importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"   # a bundled record
+    >>> rec = pulses.read_record(str(path))
+    >>> rec.dt, round(rec.pga / pulses.G, 3)
+    (0.01, 0.634)
+    >>> pulses.read_record("no-such-file.sac")
+    Traceback (most recent call last):
+    ...
+    pulses.errors.RecordError: no-such-file.sac: no such file
     """
     path = os.fsdecode(path)  # bytes too; bytes that are not UTF-8 kept as surrogates (PEP 383)
     shown = printable(path)
@@ -113,7 +125,8 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
 
 def _check_entry(path) -> None:
     """A :class:`RecordError` saying why ``path`` is no file that can be read, if it is not: missing,
-    a symbolic link to nothing or in a loop, in a folder without search permission, a folder."""
+    a symbolic link to nothing or in a loop, in a folder without search permission, a folder, a
+    FIFO, a device or a socket (by :func:`os.stat`, before anything opens it)."""
     import errno
     import stat
 
@@ -134,6 +147,19 @@ def _check_entry(path) -> None:
         except OSError as exc:
             raise RecordError(f"{path}: a folder whose files cannot be listed: {exc.strerror or exc}") from None
         raise RecordError(f"{path}: is a directory, not a record file")
+    if not stat.S_ISREG(st.st_mode):  # reading a FIFO or /dev/zero would block or never end
+        raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
+
+
+def special_kind(mode: int) -> str:
+    """What a file that is neither a regular file nor a folder is, in words (``a FIFO`` ...)."""
+    import stat
+
+    for test, what in ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return what
+    return "not a regular file"
 
 
 def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
@@ -161,9 +187,21 @@ def record_from_reading(path: str, reading, units=None, dt=None, name=None, *,
         unit_factor(units)
     meta = reading.metadata
     meta.setdefault("warnings", [])
-    used_units, units_source = _units(path, reading, units)
+    # units and time step both looked at before either is refused: all of a file's missing
+    # settings in one message, not one per run
+    problems = []
+    try:
+        used_units, units_source = _units(path, reading, units)
+    except RecordError as exc:
+        problems.append(str(exc))
+    try:
+        dt = _time_step(path, reading, dt)
+    except RecordError as exc:
+        problems.append(str(exc))
+    if problems:
+        prefix = f"{path}: "
+        raise RecordError(prefix + "; and ".join(p[len(prefix):] if p.startswith(prefix) else p for p in problems))
     acc = np.asarray(reading.values, dtype=float) * unit_factor(used_units)
-    dt = _time_step(path, reading, dt)
     meta.update(units=used_units, units_source=units_source, source=path, dt=dt)
     for key in ("station", "component", "event"):
         meta.setdefault(key, "")
@@ -262,14 +300,8 @@ def _validate(path, acc, raw, units, units_source, meta):
     if peak_g == 0.0:
         raise RecordError(f"{path}: every sample is zero")
     if not PLAUSIBLE_MIN_G <= peak_g <= PLAUSIBLE_MAX_G:
-        raw_peak = float(np.max(np.abs(raw)))
-        options = [(u, pg) for u, pg in plausible_units(raw_peak) if u != units]
         where = "given" if units_source == "user" else "stated in the file"
-        listed = " or ".join(f"{u} (peak {pg:.2g} g)" for u, pg in options)
-        fix = (f"if the samples are in {listed}, pass units='{options[0][0]}' (--units {options[0][0]})"
-               if options else "no acceleration units make it plausible")
-        raise RecordError(f"{path}: peak {raw_peak:.4g} {units} ({where}) is {peak_g:.3g} g, implausible "
-                          f"for an accelerogram (outside {PLAUSIBLE_MIN_G:g} to {PLAUSIBLE_MAX_G:g} g); {fix}")
+        raise RecordError(f"{path}: {implausible_peak(float(np.max(np.abs(raw))), units, where)}")
     if peak_g > WARN_PEAK_G:
         meta["warnings"].append(f"peak acceleration {peak_g:.3g} g is above {WARN_PEAK_G:g} g: check the units")
     _check_offset(path, acc, meta)

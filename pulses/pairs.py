@@ -72,6 +72,15 @@ def check_pair(first: Record, second: Record) -> tuple[Record, Record]:
         Naming both files: different ``dt``, start times more than half a sample apart, lengths
         more than :data:`MAX_LENGTH_DIFFERENCE` samples apart, a vertical component, or azimuths more than
         :data:`ORTHOGONAL_TOLERANCE_DEG` from orthogonal.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> first = pulses.Record(3.0 * np.sin(t), 0.01, metadata={"azimuth": 0.0})
+    >>> second = pulses.Record(4.0 * np.cos(t[:-5]), 0.01, metadata={"azimuth": 90.0})
+    >>> [r.npts for r in pulses.check_pair(first, second)]      # cut to one length
+    [995, 995]
     """
     names = f"{_label(first)} and {_label(second)}"
     n = check_time_axis(first, second, names, "a pair", ("the first", "the second"))
@@ -171,6 +180,16 @@ def component(first, second, theta):
     Record or numpy.ndarray
         A record (same ``dt``, metadata of the first with ``azimuth`` updated where both
         azimuths are known) when records are given, an array otherwise.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> first = pulses.Record(3.0 * np.sin(t), 0.01, metadata={"azimuth": 0.0})
+    >>> second = pulses.Record(4.0 * np.cos(t), 0.01, metadata={"azimuth": 90.0})
+    >>> along = pulses.component(first, second, 90.0)
+    >>> bool(np.allclose(along.acc, second.acc)), along.metadata["azimuth"]
+    (True, 90.0)
     """
     c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
     if not isinstance(first, Record):
@@ -187,7 +206,18 @@ def component(first, second, theta):
 
 
 def rotate_pair(first: Record, second: Record, theta: float) -> tuple[Record, Record]:
-    """The pair rotated by ``theta`` degrees: components at ``theta`` and ``theta + 90``."""
+    """The pair rotated by ``theta`` degrees: components at ``theta`` and ``theta + 90``.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> first = pulses.Record(3.0 * np.sin(t), 0.01, metadata={"azimuth": 0.0})
+    >>> second = pulses.Record(4.0 * np.cos(t), 0.01, metadata={"azimuth": 90.0})
+    >>> a, b = pulses.rotate_pair(first, second, 30.0)
+    >>> round(a.pga, 3)
+    3.279
+    """
     return component(first, second, theta), component(first, second, theta + 90.0)
 
 

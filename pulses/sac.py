@@ -131,6 +131,15 @@ def write_sac(record: Record, path) -> str:
     -------
     str
         The path written.
+
+    Examples
+    --------
+    >>> import os, tempfile, numpy as np, pulses
+    >>> rec = pulses.Record(np.sin(np.arange(0.0, 10.0, 0.01)), 0.01, name="demo")
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     back = pulses.read_record(pulses.write_sac(rec, os.path.join(folder, "demo.sac")))
+    >>> bool(np.allclose(back.acc, rec.acc)), back.metadata["units"]    # SAC iacc: nm/s^2
+    (True, 'nm/s2')
     """
     from obspy.io.sac import SACTrace
 

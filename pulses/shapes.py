@@ -56,6 +56,14 @@ class Pulse:
     - ``window_tau`` (where the fitter's correlation is measured) and ``fit_tau`` (the samples
       its least squares uses, before a margin is added);
     - ``pywt`` (PyWavelets' wavelet of the same curve and Tp per unit scale) where there is one.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> pulse = pulses.make_pulse("ricker-sym", 3.0, 1.0, 5.0)
+    >>> acc = pulse(np.arange(0.0, 10.0, 0.01))     # m/s^2 at any times (here a record's axis)
+    >>> round(float(acc.max()), 6), acc.size
+    (3.0, 1000)
     """
 
     ap: float
@@ -126,7 +134,8 @@ class Pulse:
 
     @classmethod
     def sampled(cls, tp: float, t0: float, t, dt: float) -> np.ndarray:
-        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support.
+        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support (the fitter's
+        shape; a pulse in m/s^2 on a record's axis is ``pulse(record.time)``, see :meth:`sample`).
 
         Point samples; a shape whose point samples do not locate it finer than ``dt`` (the
         rectangle) overrides this with cell averages over ``[t - dt/2, t + dt/2]``.
@@ -205,7 +214,24 @@ class Pulse:
         return type(self)(self.ap * factor, self.tp, self.t0)
 
     def sample(self, dt: float, name: str | None = None):
-        """Sample the pulse at step ``dt`` (s) over its support, as a :class:`pulses.Record`."""
+        """The pulse alone as a new :class:`pulses.Record`, sampled at step ``dt`` (s) over its own
+        support: it starts at ``t_start = support[0]`` and lasts as long as the pulse.
+
+        Not the pulse on a record's time axis: for that, evaluate it at the record's sample times,
+        ``pulse(record.time)`` (m/s^2, one value per sample).  Nor :meth:`sampled`, the fitter's
+        unit-amplitude shape.
+
+        Examples
+        --------
+        >>> import numpy as np, pulses
+        >>> pulse = pulses.OneSine(3.0, 1.0, t0=2.0)
+        >>> alone = pulse.sample(0.01)
+        >>> alone.t_start, alone.npts
+        (2.0, 101)
+        >>> on_axis = pulse(np.arange(0.0, 5.0, 0.01))   # a 5 s record's axis: 500 values
+        >>> on_axis.size, round(float(on_axis[225]), 6)   # 2.25 s: the crest, ap
+        (500, 3.0)
+        """
         from .record import Record
 
         start, end = self.support
@@ -226,6 +252,13 @@ class Rectangular(Pulse):
     """Housner's rectangular pulse: ``ap`` for ``t0 < t < t0 + tp`` (design pulse of Eq. 31).
 
     It leaves a residual velocity ``ap Tp``: it is not realisable, only a design idealisation.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.Rectangular(3.0, 1.0)
+    >>> pulse.support, float(pulse(0.5))
+    ((0.0, 1.0), 3.0)
     """
 
     shape = "rect"
@@ -278,7 +311,15 @@ class Rectangular(Pulse):
 
 
 class OneSine(Pulse):
-    """One-sine pulse, Eq. 9: ``ap sin(2 pi (t - t0) / tp)`` for ``t0 < t < t0 + tp``."""
+    """One-sine pulse, Eq. 9: ``ap sin(2 pi (t - t0) / tp)`` for ``t0 < t < t0 + tp``.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.OneSine(3.0, 1.0)       # ap = 3 m/s^2, Tp = 1 s, t0 = 0
+    >>> round(float(pulse(0.25)), 6), pulse.support      # the crest at Tp/4
+    (3.0, (0.0, 1.0))
+    """
 
     shape = "sine"
     label = "one-sine"
@@ -320,6 +361,12 @@ class SymmetricRicker(_Ricker):
 
     The second derivative of a Gaussian (PyWavelets' ``mexh``); its Fourier amplitude peaks at
     period ``tp``.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulses.SymmetricRicker(3.0, 1.0).support      # centred on t0 = 0
+    (-2.2, 2.2)
     """
 
     shape = "ricker-sym"
@@ -361,6 +408,12 @@ class AntisymmetricRicker(_Ricker):
     ``x = 2 pi (t - t0) / (sqrt(3) tp)``; ``beta`` (:data:`BETA`) makes the peak equal ``ap``.
     The third derivative of a Gaussian (PyWavelets' ``gaus3``); its Fourier amplitude peaks at
     period ``tp``.  With ``ap > 0`` the lobe before the centre is positive, the one after negative.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulses.AntisymmetricRicker(3.0, 1.0).support
+    (-2.8, 2.8)
     """
 
     shape = "ricker-anti"
@@ -407,7 +460,14 @@ SHAPES = {cls.shape: cls for cls in (Rectangular, OneSine, SymmetricRicker, Anti
 
 
 def shape_class(shape: str) -> type[Pulse]:
-    """The class of a shape from its short name; ValueError for an unknown name."""
+    """The class of a shape from its short name; ValueError for an unknown name.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulses.shape_class("ricker-sym").__name__
+    'SymmetricRicker'
+    """
     try:
         return SHAPES[shape]
     except (KeyError, TypeError):
@@ -415,5 +475,13 @@ def shape_class(shape: str) -> type[Pulse]:
 
 
 def make_pulse(shape: str, ap: float, tp: float, t0: float = 0.0) -> Pulse:
-    """Build a pulse from its short name (``"rect"``, ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``)."""
+    """Build a pulse from its short name (``"rect"``, ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``).
+
+    Examples
+    --------
+    >>> import pulses
+    >>> p = pulses.make_pulse("sine", 3.0, 1.0, 0.5)      # ap 3 m/s^2, Tp 1 s, from t0 = 0.5 s
+    >>> type(p).__name__, p.support
+    ('OneSine', (0.5, 1.5))
+    """
     return shape_class(shape)(ap, tp, t0)

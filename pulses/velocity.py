@@ -397,6 +397,15 @@ class PulseCandidate:
         Record's velocity in the candidate's orientation, m/s.
     pulse : numpy.ndarray
         Extracted pulse, m/s, on the record's samples.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 20.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.5, 4.0)(t), 0.01)
+    >>> cand = pulses.classify_pulse(rec).candidates[0]
+    >>> cand.is_pulse, cand.velocity.shape == cand.residual.shape
+    (True, True)
     """
 
     is_pulse: bool
@@ -446,6 +455,15 @@ class PulseClassification:
         Index of the chosen candidate.
     t_start, dt : float
         Time of the first sample and time step, s.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 20.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.5, 4.0)(t), 0.01)
+    >>> c = pulses.classify_pulse(rec)
+    >>> c.pulse.shape == rec.acc.shape, c.candidate is c.candidates[c.chosen]
+    (True, True)
     """
 
     name: str
@@ -494,8 +512,28 @@ class PulseClassification:
         """Sample times, s."""
         return self.t_start + self.dt * np.arange(self.pulse.size)
 
+    def to_frame(self):
+        """One row per candidate (:class:`pandas.DataFrame`), strongest first, ``chosen`` marking
+        the one whose values the classification reports (``tp`` in s, ``pgv`` in m/s)."""
+        import pandas as pd
+
+        from .export import fields_dict
+
+        rows = [{"name": self.name, "candidate": i, "chosen": i == self.chosen,
+                 **fields_dict(c)} for i, c in enumerate(self.candidates)]
+        return pd.DataFrame(rows)
+
     def as_dict(self) -> dict:
-        """The scalar fields (plain Python types)."""
+        """The scalar fields (plain Python types).
+
+        Examples
+        --------
+        >>> import numpy as np, pulses
+        >>> t = np.arange(0.0, 20.0, 0.01)
+        >>> rec = pulses.Record(pulses.make_pulse("sine", 4.0, 1.5, 5.0)(t), 0.01)
+        >>> pulses.classify_pulse(rec).as_dict()["is_pulse"]
+        True
+        """
         return {"name": self.name, "is_pulse": bool(self.is_pulse), "indicator": float(self.indicator),
                 "tp": float(self.tp), "pgv": float(self.pgv), "pgv_ratio": float(self.pgv_ratio),
                 "energy_ratio": float(self.energy_ratio), "late": bool(self.late),
@@ -641,6 +679,15 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     ------
     RecordError
         A pair that cannot be used (see :func:`pulses.pairs.check_pair`).
+
+    Examples
+    --------
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 20.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.5 * pulses.G, 1.5, 4.0)(t), 0.01)
+    >>> c = pulses.classify_pulse(rec)
+    >>> c.is_pulse, len(c.candidates)
+    (True, 5)
     """
     from .pairs import _azimuth, check_pair, rotated_azimuth
 

@@ -47,6 +47,13 @@ def eq31(ap, tp, p):
 
     Returns the minimum ``tan(alpha)`` (float, or array when any input is an array).
     Rinaldi (0.71 g, 0.8 s, p = 1.381 rad/s) gives 0.373.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> from pulses import G
+    >>> round(float(rocking.eq31(0.71 * G, 0.8, 1.381)), 4)    # tan(alpha) Rinaldi 228's pulse needs
+    0.3727
     """
     ap, tp, p = _inputs(ap, tp, p)
     x = p * tp
@@ -54,7 +61,15 @@ def eq31(ap, tp, p):
 
 
 def eq20(ap, tp, p, lam=1.0):
-    """Eq. 20: ``tan(alpha_min) = (ap/g) (1 - exp(-lam p Tp))`` (``ap`` in m/s^2)."""
+    """Eq. 20: ``tan(alpha_min) = (ap/g) (1 - exp(-lam p Tp))`` (``ap`` in m/s^2).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> from pulses import G
+    >>> round(float(rocking.eq20(0.71 * G, 0.8, 1.381)), 4)
+    0.4748
+    """
     ap, tp, p = _inputs(ap, tp, p)
     if not (math.isfinite(lam) and lam > 0):
         raise RockingInputError(f"lam must be positive and finite, got {lam!r}")
@@ -94,6 +109,13 @@ def envelope_rule(ap, tp, p, shape=None):
     its over-design is at most about 3x for ``pTp >= 1`` (Eq. 31 is up to 9 % short for the
     one-sine pulse and up to 33 % for the rectangular pulse).  For ``pTp < 1`` it is far above the
     exact answer of the Rickers, which barely rock such large blocks.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> from pulses import G
+    >>> round(float(rocking.envelope_rule(0.71 * G, 0.8, 1.381)), 4)
+    0.2898
     """
     if shape not in ENVELOPE:
         raise ValueError(f"envelope_rule: unknown shape {shape!r}; choose one of "

@@ -59,6 +59,16 @@ class VerticalRockingResult(RockingResult):
         First time (s) of ``g + av < 0``, else nan.
     min_effective_gravity : float
         Smallest ``1 + av/g`` of the vertical record (1 without one).
+
+    Examples
+    --------
+    >>> import numpy as np, pulses, rocking
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.3 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> up = pulses.Record(-1.2 * pulses.G * np.sin(5.0 * t), 0.01)      # beyond g: the block lifts off
+    >>> res = rocking.simulate_vertical_reference(rocking.Block.from_dimensions(7.5, 1.8), rec, up)
+    >>> res.lifts_off, res.verdict_by, round(res.min_effective_gravity, 2)
+    (True, 'lifts off', -0.2)
     """
 
     lifts_off: bool = False
@@ -252,6 +262,16 @@ def simulate_vertical_reference(block: Block, record: Record, vertical: Record |
     VerticalRockingResult
         ``model`` is ``"reference-vertical"``; ``lifts_off`` says whether the model ended in free
         flight (``g + av < 0``) and when.
+
+    Examples
+    --------
+    >>> import numpy as np, pulses, rocking
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.3 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> up = pulses.Record(0.2 * pulses.G * np.sin(5.0 * t), 0.01)       # upward, m/s^2
+    >>> res = rocking.simulate_vertical_reference(rocking.Block.from_dimensions(7.5, 1.8), rec, up)
+    >>> res.overturned, res.lifts_off
+    (False, False)
     """
     uval = record.acc / G
     vval = np.zeros_like(uval) if vertical is None else check_axes(record, vertical).acc / G

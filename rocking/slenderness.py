@@ -39,6 +39,13 @@ class MinSlenderness:
         ``peak/g``: blocks at least this stocky never uplift (the upper end of the scan).
     runs : int
         Solver runs used.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> ms = rocking.min_slenderness(pulses.OneSine(0.71 * pulses.G, 0.8), 1.381)
+    >>> ms.criterion, ms.transitions[-1] <= ms.tan_alpha
+    ('overturn', True)
     """
 
     tan_alpha: float
@@ -56,6 +63,20 @@ class MinSlenderness:
     def alpha(self) -> float:
         """``atan(tan_alpha)``, rad."""
         return math.atan(self.tan_alpha)
+
+    def as_dict(self) -> dict:
+        """The fields (not the excitation) and ``alpha``: plain, JSON-safe numbers.
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> m = rocking.min_slenderness(pulses.make_pulse("sine", 3.0, 1.0), p=1.5)
+        >>> sorted(m.as_dict())[:3]
+        ['alpha', 'criterion', 'eq31']
+        """
+        from pulses.export import fields_dict
+
+        return fields_dict(self, skip=("excitation",), properties=("alpha",))
 
     @property
     def safe_islands(self) -> list:
@@ -82,6 +103,13 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     bisection: the same ``tan_alpha`` (to ``rtol``) from fewer runs, which is what
     ``pipeline run`` needs for a few blocks per record.  ``n_scan``, ``n_zone``, ``rtol`` and
     ``ksection`` override the fields of ``settings`` (:class:`rocking.search.SearchSettings`).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> res = rocking.min_slenderness_batch("sine", [1.0, 2.0], [0.5, 0.5])    # pTp, ap/g
+    >>> [round(r.tan_alpha, 4) for r in res]
+    [0.1221, 0.3383]
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -158,6 +186,13 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     -------
     MinSlenderness
         with ``.tan_alpha`` and ``.transitions``.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> ms = rocking.min_slenderness(pulses.OneSine(0.71 * pulses.G, 0.8), 1.381)
+    >>> round(ms.tan_alpha, 4)                 # exact; Eq. 31 asks for 0.3727
+    0.1989
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -206,6 +241,13 @@ class CriticalAmplitudes(list):
     The first ``low`` is the smallest overturning amplitude; the gaps between intervals are the
     safe islands (:attr:`safe_islands`).  A ``high`` equal to :attr:`up_to` means the interval
     runs on to the end of the scan.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> amps = rocking.critical_amplitudes(rocking.Block.from_dimensions(7.5, 1.2), "sine", 1.0)
+    >>> len(amps), amps.shape
+    (1, 'sine')
     """
 
     def __init__(self, intervals, *, block, shape, tp, up_to, criterion, runs):
@@ -222,6 +264,20 @@ class CriticalAmplitudes(list):
     def safe_islands(self) -> list:
         """``(low, high)`` amplitude ranges (m/s^2) of survival above the smallest failing one."""
         return [(self[i][1], self[i + 1][0]) for i in range(len(self) - 1)]
+
+    def as_dict(self) -> dict:
+        """The intervals, islands and settings: plain, JSON-safe numbers (m/s^2, s)."""
+        from pulses.export import plain
+
+        return plain({"shape": self.shape, "tp": self.tp, "up_to": self.up_to, "criterion": self.criterion,
+                      "runs": self.runs, "minimum": self.minimum, "intervals": list(self),
+                      "safe_islands": self.safe_islands, "p": self.block.p, "alpha": self.block.alpha})
+
+    def to_frame(self):
+        """One row per failing interval: ``low_m_s2``, ``high_m_s2``."""
+        import pandas as pd
+
+        return pd.DataFrame(list(self), columns=["low_m_s2", "high_m_s2"])
 
 
 def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n_scan=400,
@@ -245,6 +301,13 @@ def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n
     -------
     CriticalAmplitudes
         A list of ``(low, high)`` pairs; ``.safe_islands`` gives the gaps between them.
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> amps = rocking.critical_amplitudes(rocking.Block.from_dimensions(7.5, 1.2), "sine", 1.0)
+    >>> round(amps.minimum / pulses.G, 3), amps.safe_islands
+    (0.317, [])
     """
     _check_criterion(criterion)
     uplift = block.uplift_acceleration

@@ -37,6 +37,13 @@ class RequiredWidth:
     transition, a diagnostic); with a vertical record, the wider of the designs for the horizontal
     motion alone and with the vertical (:attr:`governed_by`).  With a performance level
     :attr:`limit` R, a width fails where ``max|theta|/alpha`` exceeds R (or the column overturns).
+
+    Examples
+    --------
+    >>> import rocking, pulses
+    >>> w = rocking.required_width(7.5, pulses.OneSine(0.71 * pulses.G, 0.8), rule="eq31")
+    >>> w.rule, round(w.tan_alpha, 4) == round(w.width / 7.5, 4)
+    ('eq31', True)
     """
 
     width: float
@@ -92,6 +99,31 @@ class RequiredWidth:
     @property
     def tan_alpha(self) -> float:
         return self.width / self.height
+
+    def as_dict(self) -> dict:
+        """Every field but the check's arrays, with ``tan_alpha`` and ``p``: plain, JSON-safe
+        numbers (widths and heights in m, ``p`` in rad/s).
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> w = rocking.required_width(7.5, pulses.make_pulse("sine", 3.0, 1.0), rule="eq31")
+        >>> d = w.as_dict()
+        >>> d["rule"], round(d["width"], 3) == round(w.width, 3)
+        ('eq31', True)
+        """
+        from pulses.export import fields_dict
+
+        return fields_dict(self, properties=("tan_alpha", "p"))
+
+    def to_frame(self):
+        """The check above the verified width, one row per width checked (``width_m``,
+        ``failed``); empty where there was no check."""
+        import pandas as pd
+
+        widths = np.asarray(self.check_widths if self.check_widths is not None else [], dtype=float)
+        failed = np.asarray(self.check_failed if self.check_failed is not None else [], dtype=bool)
+        return pd.DataFrame({"width_m": widths, "failed": failed})
 
     @property
     def block(self) -> Block:
@@ -168,6 +200,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     -------
     RequiredWidth
         ``.width``, ``.tan_alpha``, ``.p``, ``.rule``, ``.iterations``.
+
     """
     height = float(height)
     if not (math.isfinite(height) and height > 0):
@@ -431,11 +464,16 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
     xs, fs, rs = (np.asarray(v) for v in seen)
     cx, cf = np.zeros(0), np.zeros(0, dtype=bool)
     base_method, notes = res.method, []
+    # the last refinement's runs come out of the check's budget too (a bracket up to 1.6 % of the
+    # width bisected to design_rtol), so that search + check + refinement stay within today's
+    reserve = max(0, math.ceil(math.log2(0.016 / settings.design_rtol)))
+    left = max(left - reserve, 0)
     for k in range(rounds):
         if k and min(settings.check_span ** (rounds - k) * res.width, top) <= settings.check_above:
             break  # the rounds left could not reach above check_above (SearchSettings)
         n = left // (rounds - k)
         left -= n
+        before = res.refine_runs
         x, f, r = _add_check(res, top, evaluate, settings.replace(check_runs=n), seed + k,
                              (xs, fs, rs))
         notes.append(f"{x.size} widths from {res.width:.6g} m up to "
@@ -444,6 +482,7 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
         xs, fs, rs = np.concatenate([xs, x]), np.concatenate([fs, f]), np.concatenate([rs, r])
         res.check_widths, res.check_failed = cx, cf
         _raise_to_failures(res, evaluate, (xs, fs), settings)
+        left = max(left - (res.refine_runs - before), 0)     # a round's refinement: from the rest
     order = np.argsort(cx, kind="stable")
     res.check_widths, res.check_failed = cx[order], cf[order]
     res.check_runs = int(cx.size)

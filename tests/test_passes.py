@@ -195,7 +195,7 @@ def test_the_check_stops_after_a_round_when_the_rounds_left_could_not_reach_chec
     above = min(s.check_span * full.search_width, top) * (1.0 + 1e-9)
     one = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=above))
     assert one.search_width == full.search_width
-    if one.width == one.search_width:  # the first round found no failing width
-        assert one.check_runs == s.check_runs // s.check_rounds
+    if one.width == one.search_width:  # the first round found no failing width: one round only
+        assert 0 < one.check_runs <= full.check_runs // s.check_rounds + 1
     else:
-        assert one.check_runs in (s.check_runs // s.check_rounds, full.check_runs)
+        assert 0 < one.check_runs <= full.check_runs
