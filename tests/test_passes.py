@@ -53,9 +53,13 @@ def _same_answer(default, thorough):
     n_checked = 0
     for r in default:
         ref = by_dir[r["direction_deg"]]
-        if r["check_runs"] not in ("", "0"):
+        if r["check_runs"] == ref["check_runs"]:
             n_checked += 1
             assert r == ref
+        elif r["check_runs"] not in ("", "0"):  # its last round could not reach the design width
+            n_checked += 1
+            assert {k: v for k, v in r.items() if k not in DESIGN} == {k: v for k, v in ref.items() if k not in DESIGN}
+            assert float(r["verified_width_m"]) <= design and int(r["check_runs"]) < int(ref["check_runs"])
         else:
             assert {k: v for k, v in r.items() if k not in DESIGN} == {k: v for k, v in ref.items() if k not in DESIGN}
             assert r["failing_share"] == "" and r["widest_failing_width_m"] == ""
