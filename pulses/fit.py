@@ -100,7 +100,19 @@ GLS_HAUSMAN = 16.27
 
 class FitError(ValueError):
     """Input the pulse fit cannot use: a record with nothing to fit, or a period range that is
-    not one.  The message is one line that says what is wrong."""
+    not one.  The message is one line that says what is wrong.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> quiet = pulses.Record(np.zeros(500), dt=0.01, name="quiet")
+    >>> try:
+    ...     pulses.fit_pulse(quiet)
+    ... except pulses.FitError as err:
+    ...     print("refused")
+    refused
+    """
 
 
 # -- sampled unit pulses ---------------------------------------------------------------------
@@ -160,6 +172,17 @@ class Candidate:
     fit_window : (float, float) or None
         First and last sample times (s) used by the least-squares refinement (``None`` if the
         refinement did not improve on the coarse match).
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> best = pulses.fit_pulse(rec).best
+    >>> best.rank, best.shape, round(best.t0, 1)
+    (1, 'sine', 7.0)
+    >>> round(float(best.pulse(best.t0 + best.tp / 4)) / pulses.G, 2)
+    0.59
     """
 
     shape: str
@@ -220,6 +243,17 @@ class PulseFit:
         The least squares that gave the candidates: ``"background"`` (weighted by the
         background's spectrum) or ``"plain"`` (asked for, or where the record did not support
         the weighting: see :func:`fit_pulse`).
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> fit = pulses.fit_pulse(rec)
+    >>> fit.weighting, round(fit.pgv, 2), fit.duration
+    ('background', 1.61, 25.0)
+    >>> fit.best is fit.candidates[0]
+    True
     """
 
     name: str
@@ -311,6 +345,18 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         Candidates ranked by score, ``.best``, the record's PGA, PGV and duration, and the least
         squares that answered.  A record the plain fit explains to round-off has no background
         to weight by: its fit is the plain one.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> fit = pulses.fit_pulse(rec)
+    >>> best = fit.best
+    >>> best.shape, round(best.ap_g, 2), round(best.tp, 2), round(best.score, 2)
+    ('sine', 0.59, 0.9, 0.8)
+    >>> [c.shape for c in fit.candidates]
+    ['sine', 'ricker-anti', 'ricker-sym', 'rect']
     """
     shapes = tuple(DEFAULT_SHAPES if shapes is None else shapes)
     for s in shapes:

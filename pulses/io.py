@@ -100,6 +100,16 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
     -----
     The formats are those registered in :mod:`pulses.formats` (one module each); this function
     only dispatches to them and applies the checks every record gets.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> rec
+    Record(name='synth_sine_055g_0.9s.sac', npts=2501, dt=0.01 s, PGA=0.634 g)
+    >>> rec.dt, rec.npts
+    (0.01, 2501)
     """
     path = os.fsdecode(path)  # bytes too; bytes that are not UTF-8 kept as surrogates (PEP 383)
     shown = printable(path)

@@ -72,6 +72,16 @@ def check_pair(first: Record, second: Record) -> tuple[Record, Record]:
         Naming both files: different ``dt``, start times more than half a sample apart, lengths
         more than :data:`MAX_LENGTH_DIFFERENCE` samples apart, a vertical component, or azimuths more than
         :data:`ORTHOGONAL_TOLERANCE_DEG` from orthogonal.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> a = pulses.Record(np.zeros(1000), dt=0.01, name="a")
+    >>> b = pulses.Record(np.zeros(998), dt=0.01, name="b")
+    >>> first, second = pulses.check_pair(a, b)
+    >>> first.npts, second.npts
+    (998, 998)
     """
     names = f"{_label(first)} and {_label(second)}"
     n = check_time_axis(first, second, names, "a pair", ("the first", "the second"))
@@ -148,6 +158,16 @@ def read_pair(path1, path2, **read_options) -> tuple[Record, Record]:
     -------
     (Record, Record)
         Accelerations in m/s^2, truncated to the same length (see :func:`check_pair`).
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> data = files("pipeline.data")
+    >>> first, second = pulses.read_pair(str(data / "synth_sine_055g_0.9s.sac"),
+    ...                                  str(data / "synth_broadband_only.sac"))
+    >>> first.npts == second.npts, first.dt
+    (True, 0.01)
     """
     from .io import read_record
 
@@ -171,6 +191,13 @@ def component(first, second, theta):
     Record or numpy.ndarray
         A record (same ``dt``, metadata of the first with ``azimuth`` updated where both
         azimuths are known) when records are given, an array otherwise.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> pulses.component(np.array([1.0, 0.0]), np.array([0.0, 1.0]), 90).round(12)
+    array([0., 1.])
     """
     c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
     if not isinstance(first, Record):
@@ -187,7 +214,19 @@ def component(first, second, theta):
 
 
 def rotate_pair(first: Record, second: Record, theta: float) -> tuple[Record, Record]:
-    """The pair rotated by ``theta`` degrees: components at ``theta`` and ``theta + 90``."""
+    """The pair rotated by ``theta`` degrees: components at ``theta`` and ``theta + 90``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> t = np.arange(0, 5, 0.01)
+    >>> ns = pulses.Record(np.sin(t), dt=0.01, name="N")
+    >>> ew = pulses.Record(np.zeros_like(t), dt=0.01, name="E")
+    >>> at45, at135 = pulses.rotate_pair(ns, ew, 45)
+    >>> round(at45.pga / ns.pga, 3), round(at135.pga / ns.pga, 3)
+    (0.707, 0.707)
+    """
     return component(first, second, theta), component(first, second, theta + 90.0)
 
 
@@ -213,7 +252,17 @@ _AZIMUTH_CODE = re.compile(r"^(.*?[A-Za-z_\-.])(\d{3})$")
 class Pairing:
     """What :func:`pair_files` found: ``pairs`` (first, second), ``singles`` (horizontals
     without a partner, or in groups that are ambiguous), ``verticals`` (left out) and ``notes``
-    (one line per ambiguous group)."""
+    (one line per ambiguous group).
+
+    Examples
+    --------
+    >>> import pulses
+    >>> found = pulses.pair_files(["RSN1_A_1.AT2", "RSN1_A_2.AT2", "RSN2_B_1.AT2"])
+    >>> found.pairs
+    [('RSN1_A_1.AT2', 'RSN1_A_2.AT2')]
+    >>> found.singles
+    ['RSN2_B_1.AT2']
+    """
 
     pairs: list = field(default_factory=list)
     singles: list = field(default_factory=list)
@@ -289,6 +338,15 @@ def pair_files(paths, metadata=None) -> Pairing:
         Groups of exactly two horizontals become pairs (ordered ``_1`` before ``_2``, otherwise
         by file name); a group with more than two horizontals is ambiguous and its files stay
         single (with a note); verticals are listed apart.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> found = pulses.pair_files(["RSN1_A_1.AT2", "RSN1_A_2.AT2", "RSN2_B_1.AT2"])
+    >>> found.pairs
+    [('RSN1_A_1.AT2', 'RSN1_A_2.AT2')]
+    >>> found.singles
+    ['RSN2_B_1.AT2']
     """
     metadata = metadata or {}
     result = Pairing()

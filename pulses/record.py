@@ -25,6 +25,20 @@ class Record:
         Time of the first sample, s (default 0).
     metadata : dict, optional
         Header information (station, component, units as stated, source file, ...).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> t = np.arange(0, 10, 0.01)
+    >>> rec = pulses.Record(0.3 * pulses.G * np.sin(2 * np.pi * t), dt=0.01, name="sine")
+    >>> rec
+    Record(name='sine', npts=1000, dt=0.01 s, PGA=0.3 g)
+    >>> rec.npts, rec.duration, round(rec.pga / pulses.G, 2)
+    (1000, 9.99, 0.3)
+    >>> half = rec.scaled(0.5)
+    >>> round(half.pga / pulses.G, 2)
+    0.15
     """
 
     kind = 0

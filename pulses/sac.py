@@ -131,6 +131,17 @@ def write_sac(record: Record, path) -> str:
     -------
     str
         The path written.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "copy.sac")
+    >>> back = pulses.read_record(pulses.write_sac(rec, path))
+    >>> back.npts == rec.npts, bool(abs(back.acc - rec.acc).max() < 1e-6 * rec.pga)
+    (True, True)
     """
     from obspy.io.sac import SACTrace
 

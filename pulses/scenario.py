@@ -22,7 +22,14 @@ VP_RANGE = (0.6, 1.2)
 
 
 def pulse_period(magnitude: float) -> float:
-    """Eq. 6: near-fault pulse period (s) for moment magnitude ``Mw``: ``exp(-2.9 + 0.5 Mw)``."""
+    """Eq. 6: near-fault pulse period (s) for moment magnitude ``Mw``: ``exp(-2.9 + 0.5 Mw)``.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> round(pulses.pulse_period(7.0), 2)
+    1.82
+    """
     magnitude = float(magnitude)
     if not math.isfinite(magnitude):
         raise ValueError(f"magnitude must be finite, got {magnitude!r}")
@@ -53,6 +60,13 @@ def design_pulse(magnitude: float, shape: str = "sine", vp: float = 0.9, t0: flo
     pulses.Pulse
         With ``ap = c vp / Tp`` (m/s^2, ``c`` from :data:`VP_TO_AP`).  Mw 7.0, one-sine,
         0.9 m/s: Tp = 1.822 s, ap = 1.552 m/s^2 = 0.158 g.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.design_pulse(7.0, shape="sine", vp=0.9)
+    >>> pulse.shape, round(pulse.tp, 2), round(pulse.ap / pulses.G, 2)
+    ('sine', 1.82, 0.16)
     """
     cls = shape_class(shape)
     vp = float(vp)

@@ -56,6 +56,15 @@ class Pulse:
     - ``window_tau`` (where the fitter's correlation is measured) and ``fit_tau`` (the samples
       its least squares uses, before a margin is added);
     - ``pywt`` (PyWavelets' wavelet of the same curve and Tp per unit scale) where there is one.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
+    >>> isinstance(pulse, pulses.Pulse), pulse.shape
+    (True, 'sine')
+    >>> round(float(pulse(0.25)) / pulses.G, 3)
+    0.5
     """
 
     ap: float
@@ -226,6 +235,13 @@ class Rectangular(Pulse):
     """Housner's rectangular pulse: ``ap`` for ``t0 < t < t0 + tp`` (design pulse of Eq. 31).
 
     It leaves a residual velocity ``ap Tp``: it is not realisable, only a design idealisation.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.Rectangular(ap=0.3 * pulses.G, tp=0.5)
+    >>> [float(pulse(t)) for t in (0.1, 0.6)]
+    [2.943, 0.0]
     """
 
     shape = "rect"
@@ -278,7 +294,16 @@ class Rectangular(Pulse):
 
 
 class OneSine(Pulse):
-    """One-sine pulse, Eq. 9: ``ap sin(2 pi (t - t0) / tp)`` for ``t0 < t < t0 + tp``."""
+    """One-sine pulse, Eq. 9: ``ap sin(2 pi (t - t0) / tp)`` for ``t0 < t < t0 + tp``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
+    >>> np.round(pulse(np.array([0.25, 0.75, 1.5])) / pulses.G, 3)
+    array([ 0.5, -0.5,  0. ])
+    """
 
     shape = "sine"
     label = "one-sine"
@@ -320,6 +345,13 @@ class SymmetricRicker(_Ricker):
 
     The second derivative of a Gaussian (PyWavelets' ``mexh``); its Fourier amplitude peaks at
     period ``tp``.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.SymmetricRicker(ap=0.4 * pulses.G, tp=1.2, t0=3.0)
+    >>> round(float(pulse(3.0)) / pulses.G, 3)
+    0.4
     """
 
     shape = "ricker-sym"
@@ -361,6 +393,15 @@ class AntisymmetricRicker(_Ricker):
     ``x = 2 pi (t - t0) / (sqrt(3) tp)``; ``beta`` (:data:`BETA`) makes the peak equal ``ap``.
     The third derivative of a Gaussian (PyWavelets' ``gaus3``); its Fourier amplitude peaks at
     period ``tp``.  With ``ap > 0`` the lobe before the centre is positive, the one after negative.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> pulse = pulses.AntisymmetricRicker(ap=0.6 * pulses.G, tp=1.5, t0=3.0)
+    >>> t = np.linspace(0, 6, 6001)
+    >>> round(float(np.abs(pulse(t)).max()) / pulses.G, 3)
+    0.6
     """
 
     shape = "ricker-anti"
@@ -407,7 +448,16 @@ SHAPES = {cls.shape: cls for cls in (Rectangular, OneSine, SymmetricRicker, Anti
 
 
 def shape_class(shape: str) -> type[Pulse]:
-    """The class of a shape from its short name; ValueError for an unknown name."""
+    """The class of a shape from its short name; ValueError for an unknown name.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulses.shape_class("sine")
+    <class 'pulses.shapes.OneSine'>
+    >>> sorted(pulses.SHAPES)
+    ['rect', 'ricker-anti', 'ricker-sym', 'sine']
+    """
     try:
         return SHAPES[shape]
     except (KeyError, TypeError):
@@ -415,5 +465,13 @@ def shape_class(shape: str) -> type[Pulse]:
 
 
 def make_pulse(shape: str, ap: float, tp: float, t0: float = 0.0) -> Pulse:
-    """Build a pulse from its short name (``"rect"``, ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``)."""
+    """Build a pulse from its short name (``"rect"``, ``"sine"``, ``"ricker-sym"``, ``"ricker-anti"``).
+
+    Examples
+    --------
+    >>> import pulses
+    >>> pulse = pulses.make_pulse("ricker-sym", 0.45 * pulses.G, 1.2)
+    >>> type(pulse).__name__, pulse.shape
+    ('SymmetricRicker', 'ricker-sym')
+    """
     return shape_class(shape)(ap, tp, t0)

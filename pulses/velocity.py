@@ -397,6 +397,18 @@ class PulseCandidate:
         Record's velocity in the candidate's orientation, m/s.
     pulse : numpy.ndarray
         Extracted pulse, m/s, on the record's samples.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> cls = pulses.classify_pulse(rec)
+    >>> len(cls.candidates), cls.chosen
+    (5, 0)
+    >>> chosen = cls.candidates[cls.chosen]
+    >>> bool(chosen.is_pulse), round(chosen.pgv_ratio, 2), round(chosen.energy_ratio, 2), bool(chosen.late)
+    (True, 0.47, 0.43, False)
     """
 
     is_pulse: bool
@@ -446,6 +458,18 @@ class PulseClassification:
         Index of the chosen candidate.
     t_start, dt : float
         Time of the first sample and time step, s.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> cls = pulses.classify_pulse(rec)
+    >>> len(cls.candidates), cls.chosen
+    (5, 0)
+    >>> chosen = cls.candidates[cls.chosen]
+    >>> bool(chosen.is_pulse), round(chosen.pgv_ratio, 2), round(chosen.energy_ratio, 2), bool(chosen.late)
+    (True, 0.47, 0.43, False)
     """
 
     name: str
@@ -641,6 +665,15 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     ------
     RecordError
         A pair that cannot be used (see :func:`pulses.pairs.check_pair`).
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> cls = pulses.classify_pulse(rec)
+    >>> bool(cls.is_pulse), round(cls.indicator, 1), round(cls.tp, 2)
+    (True, 23.0, 1.75)
     """
     from .pairs import _azimuth, check_pair, rotated_azimuth
 

@@ -44,6 +44,14 @@ class RockingResult:
         The block left its rest position at least once.
     t_overturn : float
         Time (s) at which ``|theta|`` reached ``pi/2`` during the integration, else nan.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> res = rocking.simulate(column, pulses.OneSine(ap=0.5 * pulses.G, tp=1.0))
+    >>> res.t.shape == res.theta.shape, bool(res.exceeded_alpha)
+    (True, False)
     """
 
     overturned: bool
@@ -78,7 +86,19 @@ class RockingResult:
 
 @dataclass
 class BatchResult:
-    """Scalar results of :func:`simulate_many`, one array entry per run."""
+    """Scalar results of :func:`simulate_many`, one array entry per run.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> pulse = pulses.OneSine(ap=0.3 * pulses.G, tp=1.0)
+    >>> batch = rocking.simulate_many(column, pulse, scales=[1.0, 2.0, 4.0])
+    >>> batch.overturned.tolist()
+    [False, True, True]
+    >>> batch.max_rotation_ratio.round(2).tolist()
+    [0.1, 6.67, 6.67]
+    """
 
     overturned: np.ndarray
     exceeded_alpha: np.ndarray

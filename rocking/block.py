@@ -16,6 +16,13 @@ def eta_housner(alpha: float) -> float:
     """Largest coefficient of restitution for rocking, Eq. 5: ``1 - 1.5 sin^2(alpha)``.
 
     Clipped at 0 beyond ``alpha = 54.7 deg`` (no rocking, the impact is perfectly plastic).
+
+    Examples
+    --------
+    >>> import math
+    >>> import rocking
+    >>> round(rocking.eta_housner(math.atan(1.8 / 7.5)), 3)
+    0.918
     """
     return eta_frame(alpha, 0.0)  # the frame's formula at gamma = 0: one place for Eq. 5
 
@@ -40,6 +47,13 @@ class Block:
         times their total mass.  ``p`` is then the frame's (see :meth:`from_dimensions`); 0 (the
         default) is the lone column.  Not part of equality: blocks with the same ``p``,
         ``alpha`` and ``eta`` rock alike.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> round(column.p, 3), round(column.tan_alpha, 2), round(column.eta, 3)
+    (1.381, 0.24, 0.918)
     """
 
     p: float

@@ -47,6 +47,12 @@ def eq31(ap, tp, p):
 
     Returns the minimum ``tan(alpha)`` (float, or array when any input is an array).
     Rinaldi (0.71 g, 0.8 s, p = 1.381 rad/s) gives 0.373.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> round(rocking.eq31(0.5 * pulses.G, 1.0, 1.381), 4)
+    0.29
     """
     ap, tp, p = _inputs(ap, tp, p)
     x = p * tp
@@ -54,7 +60,14 @@ def eq31(ap, tp, p):
 
 
 def eq20(ap, tp, p, lam=1.0):
-    """Eq. 20: ``tan(alpha_min) = (ap/g) (1 - exp(-lam p Tp))`` (``ap`` in m/s^2)."""
+    """Eq. 20: ``tan(alpha_min) = (ap/g) (1 - exp(-lam p Tp))`` (``ap`` in m/s^2).
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> round(rocking.eq20(0.5 * pulses.G, 1.0, 1.381), 4)
+    0.3743
+    """
     ap, tp, p = _inputs(ap, tp, p)
     if not (math.isfinite(lam) and lam > 0):
         raise RockingInputError(f"lam must be positive and finite, got {lam!r}")
@@ -94,6 +107,12 @@ def envelope_rule(ap, tp, p, shape=None):
     its over-design is at most about 3x for ``pTp >= 1`` (Eq. 31 is up to 9 % short for the
     one-sine pulse and up to 33 % for the rectangular pulse).  For ``pTp < 1`` it is far above the
     exact answer of the Rickers, which barely rock such large blocks.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> round(rocking.envelope_rule(0.5 * pulses.G, 1.0, 1.381, shape="sine"), 4)
+    0.2732
     """
     if shape not in ENVELOPE:
         raise ValueError(f"envelope_rule: unknown shape {shape!r}; choose one of "

@@ -68,6 +68,18 @@ class CriticalScale:
         The scan settings used (see :func:`critical_scale`).
     runs, calls : int
         Solver runs, and batch-solver calls.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses, rocking
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> found = rocking.critical_scale(column, rec)
+    >>> round(found.scale, 2), round(found.uplift_scale, 3)
+    (1.11, 0.379)
+    >>> bool(found.scale < found.islands[0][0])
+    True
     """
 
     scale: float | None
@@ -136,6 +148,16 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
     ``step`` wide elsewhere; real records have failing slivers thinner than 0.01 % (README
     "Rocking frames and collapse fragility").  ``tests/test_fragility.py`` checks the answer against a 1000-factor brute-force
     scan on three real records.
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses, rocking
+    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> found = rocking.critical_scale(column, rec)
+    >>> round(found.scale, 2), round(found.uplift_scale, 3)
+    (1.11, 0.379)
     """
     if not isinstance(block, Block):
         raise TypeError("critical_scale: block must be a rocking.Block")
@@ -242,6 +264,15 @@ class Fragility:
         ``up_to``: right-censored there).
     censored_at : ndarray
         For each censored record, the largest intensity examined.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> curve = rocking.fragility([1.2, 1.5, 1.9, 2.4, 3.1])
+    >>> round(curve.median, 3), round(curve.beta, 3)
+    (1.91, 0.335)
+    >>> round(float(curve.probability(curve.median)), 2)
+    0.5
     """
 
     median: float
@@ -294,6 +325,13 @@ def fragility(critical, *, measure="scale", up_to=None) -> Fragility:
         maximum-likelihood estimates, ``ddof = 0``).  Records that did not overturn are
         right-censored at their largest intensity and the likelihood
         ``prod pdf(x_i) prod (1 - cdf(c_j))`` is maximised numerically.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> curve = rocking.fragility([1.2, 1.5, 1.9, 2.4, 3.1])
+    >>> round(curve.median, 3), round(curve.beta, 3)
+    (1.91, 0.335)
     """
     if measure not in ("scale", "pga"):
         raise ValueError(f"fragility: measure must be 'scale' or 'pga', got {measure!r}")

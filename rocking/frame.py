@@ -41,6 +41,12 @@ def frame_p(p: float, gamma: float) -> float:
         Frequency parameter of one column, ``sqrt(3 g / (4 R))``, rad/s.
     gamma : float
         Cap mass ratio ``m_b / (N m)``.  ``gamma = 0`` returns ``p`` itself.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> round(rocking.frame_p(1.381, 0.5), 3)
+    1.235
     """
     if gamma == 0.0:
         return p
@@ -49,7 +55,14 @@ def frame_p(p: float, gamma: float) -> float:
 
 def equivalent_size(radius: float, gamma: float) -> float:
     """Half-diagonal (m) of the lone column of the same ``alpha`` that rocks like the frame:
-    ``R (1 + 3 gamma) / (1 + 2 gamma)``."""
+    ``R (1 + 3 gamma) / (1 + 2 gamma)``.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> round(rocking.equivalent_size(3.857, 0.5), 3)
+    4.821
+    """
     return radius * (1.0 + 3.0 * gamma) / (1.0 + 2.0 * gamma)
 
 
@@ -66,6 +79,13 @@ def eta_frame(alpha: float, gamma: float) -> float:
         Slenderness ``atan(b/h)`` of the columns, rad.
     gamma : float
         Cap mass ratio ``m_b / (N m)``.
+
+    Examples
+    --------
+    >>> import math
+    >>> import rocking
+    >>> round(rocking.eta_frame(math.atan(0.24), 0.0), 3), round(rocking.eta_frame(math.atan(0.24), 1.0), 3)
+    (0.918, 0.898)
     """
     s2 = math.sin(alpha) ** 2
     if gamma == 0.0:

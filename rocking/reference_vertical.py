@@ -59,6 +59,18 @@ class VerticalRockingResult(RockingResult):
         First time (s) of ``g + av < 0``, else nan.
     min_effective_gravity : float
         Smallest ``1 + av/g`` of the vertical record (1 without one).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> t = np.arange(0, 6, 0.005)
+    >>> horizontal = pulses.Record(pulses.OneSine(0.5 * pulses.G, 1.0, t0=1.0)(t), dt=0.005, name="H")
+    >>> up = pulses.Record(0.3 * pulses.G * np.sin(2 * np.pi * 3 * t), dt=0.005, name="Z_UP")
+    >>> res = rocking.simulate_vertical_reference(column, horizontal, up)
+    >>> res.model, bool(res.overturned), bool(res.lifts_off)
+    ('reference-vertical', True, False)
     """
 
     lifts_off: bool = False
@@ -252,6 +264,18 @@ def simulate_vertical_reference(block: Block, record: Record, vertical: Record |
     VerticalRockingResult
         ``model`` is ``"reference-vertical"``; ``lifts_off`` says whether the model ended in free
         flight (``g + av < 0``) and when.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> t = np.arange(0, 6, 0.005)
+    >>> horizontal = pulses.Record(pulses.OneSine(0.5 * pulses.G, 1.0, t0=1.0)(t), dt=0.005, name="H")
+    >>> up = pulses.Record(0.3 * pulses.G * np.sin(2 * np.pi * 3 * t), dt=0.005, name="Z_UP")
+    >>> res = rocking.simulate_vertical_reference(column, horizontal, up)
+    >>> res.model, bool(res.overturned), bool(res.lifts_off)
+    ('reference-vertical', True, False)
     """
     uval = record.acc / G
     vval = np.zeros_like(uval) if vertical is None else check_axes(record, vertical).acc / G

@@ -39,6 +39,15 @@ class MinSlenderness:
         ``peak/g``: blocks at least this stocky never uplift (the upper end of the scan).
     runs : int
         Solver runs used.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> res = rocking.min_slenderness(pulses.OneSine(ap=0.5 * pulses.G, tp=1.0), 1.381)
+    >>> round(res.tan_alpha, 3), round(res.eq31, 3)
+    (0.231, 0.29)
+    >>> res.criterion, len(res.transitions) >= 1
+    ('overturn', True)
     """
 
     tan_alpha: float
@@ -82,6 +91,13 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     bisection: the same ``tan_alpha`` (to ``rtol``) from fewer runs, which is what
     ``pipeline run`` needs for a few blocks per record.  ``n_scan``, ``n_zone``, ``rtol`` and
     ``ksection`` override the fields of ``settings`` (:class:`rocking.search.SearchSettings`).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> results = rocking.min_slenderness_batch("sine", [1.0, 4.0], [0.5, 0.5])
+    >>> [round(r.tan_alpha, 3) for r in results]
+    [0.122, 0.421]
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -158,6 +174,13 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     -------
     MinSlenderness
         with ``.tan_alpha`` and ``.transitions``.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> res = rocking.min_slenderness(pulses.OneSine(ap=0.5 * pulses.G, tp=1.0), 1.381)
+    >>> round(res.tan_alpha, 3), round(res.eq31, 3)
+    (0.231, 0.29)
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -206,6 +229,17 @@ class CriticalAmplitudes(list):
     The first ``low`` is the smallest overturning amplitude; the gaps between intervals are the
     safe islands (:attr:`safe_islands`).  A ``high`` equal to :attr:`up_to` means the interval
     runs on to the end of the scan.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> found = rocking.critical_amplitudes(column, "sine", 1.0)
+    >>> low, high = found[0]
+    >>> round(low / 9.81, 3)
+    0.526
+    >>> found.safe_islands
+    []
     """
 
     def __init__(self, intervals, *, block, shape, tp, up_to, criterion, runs):
@@ -245,6 +279,15 @@ def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n
     -------
     CriticalAmplitudes
         A list of ``(low, high)`` pairs; ``.safe_islands`` gives the gaps between them.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> found = rocking.critical_amplitudes(column, "sine", 1.0)
+    >>> low, high = found[0]
+    >>> round(low / 9.81, 3)
+    0.526
     """
     _check_criterion(criterion)
     uplift = block.uplift_acceleration

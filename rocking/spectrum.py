@@ -25,6 +25,16 @@ class OverturningSpectrum:
 
     Arrays are indexed ``[i, j]`` with ``i`` over :attr:`wp_over_p` and ``j`` over
     :attr:`ap_over_gtan` (the order of the arguments of :func:`overturning_spectrum`).
+
+    Examples
+    --------
+    >>> import math
+    >>> import rocking
+    >>> spec = rocking.overturning_spectrum(math.atan(0.25), "sine", [0.5, 4.0], [1.5, 3.0])
+    >>> spec.overturned.tolist()
+    [[True, True], [False, True]]
+    >>> spec.shape, spec.overturned.shape
+    ('sine', (2, 2))
     """
 
     alpha: float
@@ -110,6 +120,14 @@ def overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, *, eta=None, mod
 
     All points are solved in one batch call: by similarity, ``Tp = 1 s`` and ``p = 2 pi /
     (omega_p/p)``, amplitudes as scales of a unit pulse.
+
+    Examples
+    --------
+    >>> import math
+    >>> import rocking
+    >>> spec = rocking.overturning_spectrum(math.atan(0.25), "sine", [0.5, 4.0], [1.5, 3.0])
+    >>> spec.overturned.tolist()
+    [[True, True], [False, True]]
     """
     if shape not in SHAPES:
         raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}")
@@ -150,6 +168,15 @@ def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
     ratio`` (``exact / eq31``; above 1 where Eq. 31 is unconservative), ``transitions`` (how
     many verdict changes the scan found) and ``islands`` (how many safe islands lie below the
     answer).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> frame = rocking.slenderness_chart(shapes=("sine",), p_tp=(2.0,), ap_over_g=(0.3, 0.6))
+    >>> frame[["shape", "pTp", "ap_over_g"]].values.tolist()
+    [['sine', 2.0, 0.3], ['sine', 2.0, 0.6]]
+    >>> frame["ratio"].round(2).tolist()
+    [1.05, 0.99]
     """
     import pandas as pd
 
@@ -171,7 +198,16 @@ def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
 
 def plot_chart(frame, path=None, dpi=110):
     """Draw Fig. 8 from :func:`slenderness_chart`: one panel per shape, Eq. 31 dashed over it
-    (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is chosen for the caller)."""
+    (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is chosen for the caller).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> frame = rocking.slenderness_chart(shapes=("sine",), p_tp=(2.0,), ap_over_g=(0.3, 0.6))
+    >>> fig = rocking.plot_chart(frame)
+    >>> len(fig.axes)
+    1
+    """
     import matplotlib
     from matplotlib.figure import Figure
 

@@ -30,6 +30,14 @@ class RequiredWidth:
     Under a record, failing slivers thinner than the scan's resolution can lie above it (the
     response is chaotic near the verge of overturning): a check of jittered widths above it
     reports what it finds (:attr:`failing_share`, :attr:`widest_failing_width`; docs/slivers.md).
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
+    >>> need = rocking.required_width(7.5, pulse, rule="exact")
+    >>> need.rule, need.height, round(need.width, 3), need.runs > 0
+    ('exact', 7.5, 1.736, True)
     """
 
     width: float
@@ -132,6 +140,15 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     -------
     RequiredWidth
         ``.width``, ``.tan_alpha``, ``.p``, ``.rule``, ``.iterations``.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
+    >>> round(rocking.required_width(7.5, pulse, rule="eq31").width, 3)
+    2.17
+    >>> round(rocking.required_width(7.5, pulse, rule="exact").width, 3)
+    1.736
     """
     height = float(height)
     if not (math.isfinite(height) and height > 0):
