@@ -135,5 +135,18 @@ def _plain_docstring(app, what, name, obj, options, lines):
                 for line, code in joined]
 
 
+def _list_new_pages(app, docname, source):
+    """A page added to docs/ and not yet placed in a section of the index is listed under
+    "More" (so that it is never left out of the site, nor listed twice)."""
+    if docname != root_doc:
+        return
+    here = os.path.dirname(__file__)
+    pages = sorted(f[:-3] for f in os.listdir(here) if f.endswith(".md") and f[:-3] != root_doc)
+    unlisted = [p for p in pages if not re.search(rf"^{re.escape(p)}$", source[0], re.M)]
+    if unlisted:
+        source[0] += "\n```{toctree}\n:caption: More\n:maxdepth: 1\n\n" + "\n".join(unlisted) + "\n```\n"
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _plain_docstring)
+    app.connect("source-read", _list_new_pages)
