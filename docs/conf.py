@@ -110,6 +110,8 @@ html_theme_options = {
     "secondary_sidebar_items": ["page-toc"],
 }
 html_sidebars = {"index": []}
+# a stated mode: with none stored yet the theme's script logs an error ("invalid theme mode")
+html_context = {"default_mode": "light"}
 
 
 # The docstrings write absolute values as |x| (plain text, as printed by help()) and may break an

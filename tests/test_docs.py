@@ -2,11 +2,15 @@
 built with warnings as errors, its examples run (``sphinx.ext.doctest``)."""
 from __future__ import annotations
 
+import html as html_lib
+import json
 import os
 import pathlib
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 
 import pytest
 
@@ -165,3 +169,69 @@ def test_docs_examples_run(site):
     failures = re.search(r"(\d+) failures? in tests", report)
     assert failures and failures.group(1) == "0", report[-2000:]
     assert tried >= 3, report[-2000:]
+
+
+CHROMIUM = shutil.which("chromium") or ("/usr/bin/chromium" if os.path.exists("/usr/bin/chromium") else None)
+
+#: first in the theory page's head (a copy beside it): records every error, then once MathJax has
+#: typeset the page writes into the DOM how many formulas it rendered and whether raw TeX is left
+_MATH_PROBE = r"""<script>
+(function () {
+  var errors = [];
+  window.addEventListener("error", function (e) {
+    var t = e.target;
+    errors.push(t && t !== window && (t.src || t.href) ? "failed to load " + (t.src || t.href) : String(e.message));
+  }, true);
+  var ce = console.error;
+  console.error = function () { errors.push(Array.prototype.join.call(arguments, " ")); ce.apply(console, arguments); };
+  function report(extra) {
+    var text = document.body.innerText;
+    var pre = document.createElement("pre");
+    pre.id = "probe-result";
+    pre.textContent = JSON.stringify({rendered: document.querySelectorAll("mjx-container").length,
+                                      raw: text.indexOf("\\[") >= 0 || text.indexOf("\\tag") >= 0 || text.indexOf("\\frac") >= 0,
+                                      errors: errors.concat(extra || [])});
+    document.body.appendChild(pre);
+  }
+  window.addEventListener("load", function () {
+    if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
+      MathJax.startup.promise.then(function () { report(); }, function (e) { report(["MathJax: " + e]); });
+    } else { report(["MathJax did not load"]); }
+  });
+})();
+</script>"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (Debian: apt-get install chromium; "
+                                              ".ci/run installs it)")
+def test_theory_maths_render_offline_in_chromium(site):
+    """The theory page in headless Chromium with every host unreachable: MathJax, copied into the
+    site, renders every formula (no raw TeX left) with no console error."""
+    html = site / "html"
+    page = (html / "theory.html").read_text(encoding="utf-8")
+    probe = html / "theory-probe.html"  # beside the page: the same relative links
+    probe.write_text(page.replace("<head>", "<head>" + _MATH_PROBE, 1), encoding="utf-8")
+    with tempfile.TemporaryDirectory() as profile:
+        proc = subprocess.run(
+            [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+             "--no-first-run", "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}",
+             # networking off: every host name fails to resolve, any proxy is a closed port
+             "--host-resolver-rules=MAP * ~NOTFOUND", "--proxy-server=127.0.0.1:9",
+             "--allow-file-access-from-files", "--enable-logging=stderr", "--v=0",
+             "--virtual-time-budget=20000", "--dump-dom", probe.as_uri()],
+            capture_output=True, text=True, timeout=180)
+    m = re.search(r'<pre id="probe-result"[^>]*>(.*?)</pre>', proc.stdout, re.S)
+    assert m, f"chromium showed no result (exit {proc.returncode}): {proc.stderr[-2000:]}"
+    result = json.loads(html_lib.unescape(m.group(1)))
+    n_tex = theory_formulas()
+    assert result["errors"] == []
+    assert not result["raw"]
+    assert result["rendered"] >= n_tex >= 20, (result["rendered"], n_tex)
+    console = [l for l in proc.stderr.splitlines() if "CONSOLE" in l and ("Uncaught" in l or "ERROR" in l)]
+    assert console == [], console
+
+
+def theory_formulas() -> int:
+    """Numbered formulas of docs/theory.md (each display formula carries a tag)."""
+    return len(re.findall(r"\\tag\{", (DOCS / "theory.md").read_text(encoding="utf-8")))
