@@ -235,3 +235,72 @@ def test_theory_maths_render_offline_in_chromium(site):
 def theory_formulas() -> int:
     """Numbered formulas of docs/theory.md (each display formula carries a tag)."""
     return len(re.findall(r"\\tag\{", (DOCS / "theory.md").read_text(encoding="utf-8")))
+
+
+# -- one name and one verified width per record file ---------------------------------------------
+def _records_table() -> list[dict]:
+    """The rows of "The records these pages use" in docs/records.md."""
+    text = (DOCS / "records.md").read_text(encoding="utf-8")
+    section = text[text.index("## The records these pages use"):]
+    rows = [[c.strip() for c in line.strip().strip("|").split("|")]
+            for line in section.splitlines() if line.startswith("| ")]
+    head, body = rows[0], rows[1:]
+    return [dict(zip(head, r)) for r in body]
+
+
+def _doc_texts() -> dict[str, str]:
+    return {p.name: p.read_text(encoding="utf-8") for p in [README, *sorted(DOCS.glob("*.md"))]}
+
+
+def _sentences(text: str) -> list[str]:
+    # a sentence ends at ". " before a capital, a bold mark or a new paragraph ("Eq. 31" does not)
+    return re.split(r"(?<=[.;:])\s+(?=[A-Z*(`])|\n\s*\n", text.replace("\n", " \n"))
+
+
+def test_each_record_file_has_one_name_and_one_release():
+    rows = _records_table()
+    files = [r["file"].strip("`") for r in rows if r["file"] != "-"]
+    names = [r["name in these pages"] for r in rows]
+    assert len(files) == len(set(files)) and len(names) == len(set(names)), (files, names)
+    assert all(r["release"] for r in rows)
+    # where one recording has several releases, its bare name (without the release) is ambiguous:
+    # every mention in the docs carries the release in parentheses
+    bases = {}
+    for name in names:
+        m = re.match(r"(.*?) \((.*)\)$", name)
+        if m:
+            bases.setdefault(m.group(1), []).append(m.group(2))
+    for base, releases in bases.items():
+        bare = re.compile(rf"{re.escape(base)}(?! \((?:{'|'.join(map(re.escape, releases))})\))")
+        found = [f"{page}: ...{text[max(0, m.start() - 40):m.end() + 40]}..."
+                 for page, text in _doc_texts().items() for m in bare.finditer(text)]
+        assert not found, f"{base!r} without its release: {found}"
+
+
+def test_each_record_file_has_one_verified_width_across_the_docs():
+    """Every sentence that names a record (or its file) and states its verified width, and every
+    row of the demo's table, gives the width of docs/records.md's table (at the digits printed)."""
+    checked = 0
+    for row in _records_table():
+        if row["verified width, 7.5 m"] == "-":
+            continue
+        width = float(row["verified width, 7.5 m"].split()[0])
+        file = row["file"].strip("`")
+        keys = {row["name in these pages"], file, file.rsplit("/", 1)[-1]}
+        for page, text in _doc_texts().items():
+            if page == "records.md":
+                continue
+            stem = file.rsplit(".", 1)[0]
+            for line in re.findall(rf"^{re.escape(stem)}\s+7\.5x1\.8\s.*$", text, re.M):  # the demo's table
+                stated = re.findall(r"(\d+\.\d+) m\b", line)[1]
+                assert abs(float(stated) - width) <= 0.5 * 10 ** -len(stated.split(".")[1]) + 1e-9, (page, line)
+                checked += 1
+            prose = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)  # the tables above: by column
+            for sentence in _sentences(prose):
+                if not any(k in sentence for k in keys) or "cap_mass_ratio" in sentence:
+                    continue
+                for stated in re.findall(r"verified width[^;()]*?(\d+\.\d+) m\b", sentence):
+                    assert abs(float(stated) - width) <= 0.5 * 10 ** -len(stated.split(".")[1]) + 1e-9, \
+                        (page, row["name in these pages"], stated, sentence)
+                    checked += 1
+    assert checked >= 8  # the demo's five rows in two pages and the Rinaldi sentences were read
