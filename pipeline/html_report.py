@@ -66,6 +66,12 @@ document.querySelectorAll("table.sortable").forEach(function (table) {
 """
 
 
+
+def _whole(value):
+    """A count as a whole number (``1500``, not ``1500.0`` as a CSV round trip gives it)."""
+    number = _num(value)
+    return int(number) if number is not None and float(number).is_integer() else value
+
 def output_files() -> list[str]:
     """The files this module writes into ``--out``."""
     return [REPORT_HTML]
@@ -182,7 +188,7 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      f"verified width {_fixed(r.get('verified_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
-                parts.append(f"check above it: {r.get('check_runs')} widths, "
+                parts.append(f"check above it: {_whole(r.get('check_runs'))} widths, "
                              + (f"{100 * share:.2g} % overturn, the widest at "
                                 + (failing_text(r.get("widest_failing_width_m"), r.get("verified_width_m")) or "-")
                                 if share else "none overturns"))
