@@ -152,3 +152,6 @@ def _list_new_pages(app, docname, source):
 def setup(app):
     app.connect("autodoc-process-docstring", _plain_docstring)
     app.connect("source-read", _list_new_pages)
+    # a page added or removed changes the index's "More" list: read the index again
+    app.connect("env-get-outdated", lambda app, env, added, changed, removed:
+                [root_doc] if added or removed else [])
