@@ -171,7 +171,8 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
             ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s"),
             ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
                            f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
-                           f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"),
+                           f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"
+                           + (f": {first['pulse_like_reason']}" if first.get("pulse_like_reason") else "")),
             ("fitted pulse", f"{first.get('pulse_shape') or '-'}: ap {_fixed(first.get('pulse_ap_g'), 3) or '-'} g, "
                              f"Tp {_fixed(first.get('pulse_tp_s'), 3) or '-'} s, score {_fixed(first.get('pulse_score'), 2) or '-'} "
                              f"({first.get('pulse_fit') or '-'} least squares); shapes that fit: "
@@ -182,7 +183,11 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
         out.append("<dl>" + "".join(f"<dt>{_e(k)}</dt><dd>{_e(v)}</dd>" for k, v in facts) + "</dl>")
         out.append("<ul>")
         for r in rows:
-            parts = [f"column {r.get('column')}: governing pulse {pulse_text(r)}",
+            governs = f"column {r.get('column')}: governing pulse {pulse_text(r)}"
+            if r.get("governing_shape") and r.get("governing_shape") != first.get("pulse_shape"):
+                governs += (f" (not the best fit, {first.get('pulse_shape')}: of the shapes that fit, "
+                            "the one asking for the widest column by Eq. 31)")
+            parts = [governs,
                      f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
                      f"verified width {_fixed(r.get('verified_width_m')) or '-'} m"]
