@@ -18,6 +18,7 @@ import urllib.parse
 from . import report
 from .design_table import failing_text, metadata_text, pulse_text, survives_text
 from .design_table import number as _num
+from .report import FIT_TOLERANCE
 
 #: the file in ``--out``
 REPORT_HTML = "report.html"
@@ -175,7 +176,8 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                            + (f": {first['pulse_like_reason']}" if first.get("pulse_like_reason") else "")),
             ("fitted pulse", f"{first.get('pulse_shape') or '-'}: ap {_fixed(first.get('pulse_ap_g'), 3) or '-'} g, "
                              f"Tp {_fixed(first.get('pulse_tp_s'), 3) or '-'} s, score {_fixed(first.get('pulse_score'), 2) or '-'} "
-                             f"({first.get('pulse_fit') or '-'} least squares); shapes that fit: "
+                             f"({first.get('pulse_fit') or '-'} least squares); shapes fitting almost as well (score at least "
+                             f"{FIT_TOLERANCE:g} x the best): "
                              f"{first.get('shapes_fitting') or '-'}"),
         ]
         if first.get("warnings"):
