@@ -82,8 +82,8 @@ def _check(record, v, seen, top, layout, n, seed):
 
     res = dataclasses.replace(v)
     settings = rocking.search.SearchSettings(check_runs=n, **layout)
-    rw._add_check(res, top, lambda x: _run(record, x), settings, seed, seen)
-    return res.failing_share, res.widest_failing_width
+    x, f, _ = rw._add_check(res, top, lambda x: _run(record, x), settings, seed, seen)
+    return (float(f.mean()) if x.size else 0.0), (float(x[f].max()) if f.any() else None)
 
 
 def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):

@@ -373,15 +373,27 @@ def _eq31_design_fields(height, w31, res31) -> dict:
 
 
 VERIFIED_COLUMNS = Columns(
-    ("verified_width_m", "m", "Verified width: the smallest width for which a column of this height "
-                              "survives the full record, at that width and every larger one (a search "
-                              "that finds every transition, so it is not fooled by safe islands; "
-                              "`rocking.required_width`, rule exact). Independent of the pulse fit."),
-    ("verified_tan_alpha", "-", "tan(alpha) of the verified width, verified_width_m / height_m."),
-    ("verified_adequate", "-", "The column as it stands is at least as wide as the verified width "
+    ("verified_width_m", "m", "Design width: the smallest width for which a column of this height "
+                              "survives the full record (max|theta|/alpha <= `design_limit` with "
+                              "`--limit`), at that width and at every larger one the search and the "
+                              "check above it examined: at least every width they found to fail, "
+                              "refined just above the widest (`rocking.required_width`, rule exact, "
+                              "`.width`); with a vertical component, the wider of the horizontal "
+                              "motion's and the one with the vertical (`design_governed_by`). "
+                              "Independent of the pulse fit."),
+    ("verified_tan_alpha", "-", "tan(alpha) of the design width, verified_width_m / height_m."),
+    ("verified_adequate", "-", "The column as it stands is at least as wide as the design width "
                                "(blank for `--height`). A column that survives (`overturns` False) "
                                "but is not verified-adequate stands on a safe island: some slightly "
                                "wider column of the same height overturns under the same record."),
+    ("search_width_m", "m", "Diagnostic: the search's first transition (the smallest width above "
+                            "which every width the search examined survives; `search_width`), "
+                            "before the check above it; the design width is at least this."),
+    ("design_governed_by", "-", "Which motion sets the design width: `horizontal` (the horizontal "
+                                "motion alone) or `with vertical` (the horizontal motion with the "
+                                "record's vertical); blank without a vertical."),
+    ("design_limit", "-", "The performance level of the design (`--limit` R: max|theta|/alpha <= R); "
+                          "blank: overturning, the paper's question."),
 )
 
 
@@ -389,6 +401,8 @@ def _verified_fields(col: Column, ver) -> dict:
     return VERIFIED_COLUMNS.row({
         "verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / col.height,
         "verified_adequate": None if col.width is None else col.width >= float(ver.width),
+        "search_width_m": None if ver.search_width is None else float(ver.search_width),
+        "design_governed_by": ver.governed_by, "design_limit": ver.limit,
     })
 
 
@@ -493,14 +507,16 @@ def _process(task: Task):
         if opts.plots:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
 
-        # -- verified width: smallest width surviving the full record (islands respected) ---------
+        # -- design width: smallest width surviving the full record (islands respected), above
+        #    every width found to fail, with the vertical where there is one ----------------------
         if H not in verified_cache:
-            verified_cache[H] = _stage("verify", rocking.required_width, H, record, rule="exact",
-                                       cap_mass_ratio=gamma)
+            alone = _stage("verify", rocking.required_width, H, record, rule="exact",
+                           cap_mass_ratio=gamma, limit=opts.limit)
+            verified_cache[H] = _stage("verify", vertical.design, record, up, H, alone, gamma, opts.limit)
         if opts.plots:  # the column at its verified width, for the figure
             wv = float(verified_cache[H].width)
             block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
-            curves.append((f"verified width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
+            curves.append((f"design width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
             histories.append((col.label, curves))
 
         row = dict(base)
@@ -511,7 +527,7 @@ def _process(task: Task):
         row.update(_verified_fields(col, verified_cache[H]))
         row.update(_check_fields(verified_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, H, gamma))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, verified_cache[H]))
         rows.append(row)
 
     return rows, (record, fit, fitting, histories), verified_cache

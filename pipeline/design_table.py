@@ -32,8 +32,10 @@ DESIGN_COLUMNS = Columns(
     ("governing_tp_s", "s", "Its period Tp."),
     ("eq31_width_m", "m", "Width the column's height needs by Eq. 31 for the governing pulse."),
     ("eq31_width_overturns", "-", "That Eq. 31 design overturns under the full record."),
-    ("verified_width_m", "m", "Verified width: the smallest width surviving the full record at it and "
-                              "at every larger width (for a pair: the widest over its directions)."),
+    ("verified_width_m", "m", "Design width: the smallest width surviving the full record at it and at "
+                              "every larger width examined, above every width the search and the check "
+                              "found to fail, with the vertical where there is one (for a pair: the "
+                              "widest over its directions; `--limit` R: max|theta|/alpha <= R)."),
     ("width_m", "m", "Width of the column as it stands (blank for `--height`)."),
     ("survives", "-", "The column as it stands does not overturn under the record (in any direction "
                       "of a pair); blank for `--height`."),
@@ -45,6 +47,17 @@ DESIGN_COLUMNS = Columns(
                                     "none was found, which does not prove there is none."),
     ("survives_vertical", "-", "The column as it stands does not overturn with the record's vertical "
                                "component too (in any direction of a pair); blank without a vertical."),
+    ("search_width_m", "m", "Diagnostic: the search's first transition in the governing direction, "
+                            "before the check above it (docs/slivers.md); the design width is at least this."),
+    ("design_governed_by", "-", "`horizontal` or `with vertical`: which motion sets the design width "
+                                "(blank without a vertical)."),
+    ("design_limit", "-", "`--limit` R (max|theta|/alpha <= R); blank: overturning."),
+    ("eq31_below_design", "-", "The Eq. 31 width is below the design width (Eq. 31 is not conservative "
+                               "for this record)."),
+    ("verdict", "-", "The column as it stands: `survives`, `NO` (overturns; with `--limit`, exceeds "
+                     "R), `NO: safe island` (it survives but is narrower than the design width: a "
+                     "wider column fails); blank for `--height`."),
+    ("check_runs", "-", "Widths the check ran above the search width in the governing direction."),
 )
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
 
@@ -88,6 +101,14 @@ def _whole(value):
     return str(int(v)) if v is not None and v == int(v) else str(value)
 
 
+def _meets(r, limit):
+    """The column as it stands survives the row's record (and keeps max|theta|/alpha <= limit)."""
+    if r.get("overturns") is None:
+        return None
+    ratio = number(r.get("max_theta_ratio"))
+    return (not r["overturns"]) and (limit is None or (ratio is not None and ratio <= limit))
+
+
 def design_rows(rows, failed=None) -> list[dict]:
     """The rows of ``design.csv`` from the rows of ``summary.csv`` (dicts of typed values) and
     ``failed`` (``{pair: directions that failed}``)."""
@@ -95,9 +116,13 @@ def design_rows(rows, failed=None) -> list[dict]:
     for (pair, column), group in _groups(rows).items():
         gov = max(group, key=lambda r: number(r.get("verified_width_m")) or -math.inf)  # first of equals
         block = gov.get("column_kind") == "block"
+        limit = number(gov.get("design_limit"))
         ratios = [number(r.get("max_theta_ratio")) for r in group]
         ratios = [v for v in ratios if v is not None]
-        out.append(DESIGN_COLUMNS.row({
+        survives = _bool_all([_meets(r, limit) for r in group]) if block else None
+        adequate = _bool_all([r.get("verified_adequate") for r in group]) if block else None
+        w31, wd = number(gov.get("eq31_width_m")), number(gov.get("verified_width_m"))
+        row = DESIGN_COLUMNS.row({
             "record": pair, "column": column,
             "direction_deg": gov.get("direction_deg"),
             "n_directions": len(group), "n_directions_failed": (failed or {}).get(pair, 0),
@@ -108,15 +133,20 @@ def design_rows(rows, failed=None) -> list[dict]:
             "eq31_width_m": gov.get("eq31_width_m"), "eq31_width_overturns": gov.get("eq31_width_overturns"),
             "verified_width_m": gov.get("verified_width_m"),
             "width_m": gov.get("width_m") if block else None,
-            "survives": (None if not block else
-                         _bool_all([None if r.get("overturns") is None else not r["overturns"] for r in group])),
-            "verified_adequate": _bool_all([r.get("verified_adequate") for r in group]) if block else None,
+            "survives": survives, "verified_adequate": adequate,
             "max_theta_ratio": max(ratios) if (block and ratios) else None,
             "widest_failing_width_m": _widest([r.get("widest_failing_width_m") for r in group],
-                                              above=number(gov.get("verified_width_m"))),
+                                              above=number(gov.get("search_width_m"))),
             "survives_vertical": (None if not block else _bool_all(
                 [None if r.get("vertical_overturns") is None else not r["vertical_overturns"] for r in group])),
-        }))
+            "search_width_m": gov.get("search_width_m"), "design_governed_by": gov.get("design_governed_by"),
+            "design_limit": limit,
+            "eq31_below_design": None if (w31 is None or wd is None) else w31 < wd,
+            "check_runs": gov.get("check_runs"),
+            "verdict": None if survives is None else verdict_text({"survives": survives,
+                                                                   "verified_adequate": adequate}),
+        })
+        out.append(row)
     return out
 
 
@@ -173,18 +203,37 @@ def pulse_text(row) -> str:
     return f"{shape} {ap:+.2f}g {tp:.2f}s"
 
 
-def survives_text(row) -> str:
-    """``yes``, ``yes, safe island`` (survives, but narrower than the verified width), ``NO`` or ``-``."""
+def verdict_text(row) -> str:
+    """``survives``, ``NO`` (overturns, or exceeds the level), ``NO: safe island`` (survives, but
+    narrower than the design width: a wider column fails) or ``-``."""
     s = row.get("survives")
     if s is None:
         return "-"
     if not s:
         return "NO"
-    return "yes" if row.get("verified_adequate") else "yes, safe island"
+    return "survives" if row.get("verified_adequate") else "NO: safe island"
 
 
-HEADERS = ("record", "column", "pulse-like", "governing pulse", "Eq.31 width", "verified width",
-           "fails above", "survives")
+def survives_text(row) -> str:
+    """The printed verdict of the column as it stands (:func:`verdict_text`, ``yes`` for survives)."""
+    text = verdict_text(row)
+    return "yes" if text == "survives" else text
+
+
+def eq31_text(row) -> str:
+    """``2.441 m``, or ``0.400 m BELOW`` where the Eq. 31 width is below the design width (``,
+    overturns`` where its design overturns under the record)."""
+    text = _m(row.get("eq31_width_m"))
+    if text == "-":
+        return text
+    text += " m"
+    if row.get("eq31_below_design"):
+        text += " BELOW" + (", overturns" if row.get("eq31_width_overturns") else "")
+    return text
+
+
+HEADERS = ("record", "column", "pulse-like", "governing pulse", "Eq.31 width", "design width",
+           "search width", "survives")
 #: the heading of the column added where a run used vertical components
 VERTICAL_HEADER = "with vertical"
 
@@ -196,10 +245,20 @@ def table_cells(row) -> tuple[str, ...]:
     if d is not None and (row.get("n_directions") or 1) > 1:
         name += f" @{d:.0f}deg"
     return (name, display(row.get("column") or "-"), _yes(row.get("pulse_like")), pulse_text(row),
-            _m(row.get("eq31_width_m")) + (" m" if number(row.get("eq31_width_m")) is not None else ""),
-            _m(row.get("verified_width_m")) + (" m" if number(row.get("verified_width_m")) is not None else ""),
-            failing_text(row.get("widest_failing_width_m"), row.get("verified_width_m")) or "-",
-            survives_text(row))
+            eq31_text(row),
+            _m(row.get("verified_width_m")) + (" m" if number(row.get("verified_width_m")) is not None else "")
+            + (" (vertical)" if row.get("design_governed_by") == "with vertical" else ""),
+            search_text(row), survives_text(row))
+
+
+def search_text(row) -> str:
+    """``0.584 m (-9.2 %)``: the search's first transition, with how far the design width lies
+    above it (``-`` where blank)."""
+    w = number(row.get("search_width_m"))
+    if w is None:
+        return "-"
+    excess = excess_text(row.get("verified_width_m"), w)
+    return f"{w:.3f} m" + (f" ({excess})" if excess else "")
 
 
 def _vertical_text(row) -> str:
@@ -229,8 +288,8 @@ def metadata_text(row) -> str | None:
     return display(parts[0] + (": " + ", ".join(site) if site else ""))
 
 
-#: the index of "fails above" in :data:`HEADERS`
-FAILS_COLUMN = HEADERS.index("fails above")
+#: the index of "search width" in :data:`HEADERS`
+FAILS_COLUMN = HEADERS.index("search width")
 
 
 def _align_failing(body, col):
@@ -274,6 +333,7 @@ def table_text(rows, failures=(), summary=()) -> str:
     lines += [line(c) for c in body]
     for f in failures:
         lines.append(f"{display(f['record'])}  failed ({f['stage']}): {' '.join(display(f['reason']).split())}")
+    lines += [""] + verdict_lines(rows) + [t for t in (fine_print(rows),) if t]
     seen = {}
     for r in summary:
         text = metadata_text(r)
@@ -283,6 +343,56 @@ def table_text(rows, failures=(), summary=()) -> str:
         lines.append("")
         lines += [f"{display(name)}: {text}" for name, text in seen.items()]
     return "\n".join(lines) + "\n"
+
+
+def _count(rows, key, value=True) -> int:
+    return sum(1 for r in rows if r.get(key) == value)
+
+
+def verdict_lines(rows) -> list[str]:
+    """The lines that end a run (and head ``report.html``): per column, the suite's answer (the
+    design width covering every record), the Eq. 31 line, then the fine print of the design width."""
+    by_column = {}
+    for r in rows:
+        by_column.setdefault(r.get("column"), []).append(r)
+    out = []
+    for column, group in by_column.items():
+        widths = [(number(r.get("verified_width_m")), r) for r in group]
+        widths = [(w, r) for w, r in widths if w is not None]
+        if not widths:
+            continue
+        top, gov = max(widths, key=lambda wr: wr[0])
+        n = len(group)
+        limit = number(gov.get("design_limit"))
+        level = "" if limit is None else f" for max theta/alpha <= {limit:g}"
+        line = (f"Suite, column {display(column)}: the design width covering all {n} record(s) is "
+                f"{top:.3f} m{level} (set by {display(gov['record'])})")
+        if gov.get("width_m") is not None:
+            safe = _count(group, "verdict", "NO: safe island")
+            fails = _count(group, "verdict", "NO")
+            line += (f"; as it stands ({number(gov['width_m']):.3f} m) it "
+                     + ("passes: it survives every record" if not (safe or fails) and top <= number(gov["width_m"])
+                        else f"FAILS: {fails} record(s) overturn it" + ("" if limit is None else " or exceed the level")
+                        + f", {safe} leave it on a safe island"))
+        out.append(line)
+        below = _count(group, "eq31_below_design")
+        over = _count(group, "eq31_width_overturns")
+        out.append(f"Eq. 31 is below the design width on {below} of {n} record(s); its design "
+                   f"overturns under {over}.")
+    return out
+
+
+def fine_print(rows) -> str | None:
+    """What was tested above the design width (None where no check ran)."""
+    runs = [number(r.get("check_runs")) for r in rows if number(r.get("check_runs"))]
+    if not runs:
+        return None
+    return ("Design width: at least every width the search and the check above it found to "
+            f"fail, refined just above the widest; the check ran {min(runs):.0f}"
+            + (f"-{max(runs):.0f}" if max(runs) > min(runs) else "")
+            + " widths per record from the search width up to twice it (or the no-uplift "
+            "width); thinner failing slivers may remain (docs/slivers.md). Search width: the "
+            "search's first transition, with how far the design width lies above it.")
 
 
 def columns_markdown() -> str:

@@ -16,7 +16,8 @@ import pathlib
 import urllib.parse
 
 from . import report
-from .design_table import failing_text, metadata_text, pulse_text, survives_text
+from .design_table import (eq31_text, failing_text, metadata_text, pulse_text, search_text,
+                           survives_text, verdict_lines, fine_print)
 from .design_table import number as _num
 from .report import FIT_TOLERANCE
 
@@ -122,13 +123,13 @@ def _batch_table(design, anchors) -> list[str]:
     vertical = any(r.get("survives_vertical") is not None for r in design)  # verticals in the run
     heads = ["record", "column"] + (["direction (deg)"] if directions else []) + [
         "pulse-like", "velocity Tp (s)", "governing pulse", "ap (g)", "Tp (s)", "Eq. 31 width (m)",
-        "verified width (m)", "widest failing width (m)", "width (m)", "survives"] + (
+        "design width (m)", "search width (m)", "widest failing width (m)", "width (m)", "survives"] + (
         ["with vertical"] if vertical else []) + ["max theta/alpha"]
     out = ['<div class="wide"><table class="sortable" id="batch"><thead><tr>'
            + "".join(f"<th>{_e(h)}</th>" for h in heads) + "</tr></thead><tbody>"]
     for r in design:
         surv = survives_text(r)
-        cls = {"NO": ' class="no"', "yes, safe island": ' class="island"'}.get(surv, "")
+        cls = {"NO": ' class="no"', "NO: safe island": ' class="island"'}.get(surv, "")
         target = anchors.get(r["record"])
         name = _e(r["record"])
         name = f'<a href="#{target}">{name}</a>' if target else name
@@ -142,14 +143,17 @@ def _batch_table(design, anchors) -> list[str]:
             + _cell(r["governing_shape"])
             + _cell(r["governing_ap_g"], _fixed(r["governing_ap_g"], 3), numeric=True)
             + _cell(r["governing_tp_s"], _fixed(r["governing_tp_s"], 3), numeric=True)
-            + _cell(r["eq31_width_m"], _fixed(r["eq31_width_m"]), numeric=True)
-            + _cell(r["verified_width_m"], _fixed(r["verified_width_m"]), numeric=True)
+            + _cell(r["eq31_width_m"], eq31_text(r).replace(" m", ""), numeric=True)
+            + _cell(r["verified_width_m"], _fixed(r["verified_width_m"])
+                    + (" (vertical)" if r.get("design_governed_by") == "with vertical" else ""), numeric=True)
+            + _cell(r.get("search_width_m"), search_text(r).replace(" m", ""), numeric=True)
             + _cell(r.get("widest_failing_width_m"),
-                    failing_text(r.get("widest_failing_width_m"), r["verified_width_m"], unit=""), numeric=True)
+                    failing_text(r.get("widest_failing_width_m"), r.get("search_width_m"), unit=""), numeric=True)
             + _cell(r["width_m"], _fixed(r["width_m"]), numeric=True)
             + _cell(surv if r["survives"] is not None else None, surv)
             + (_cell(r.get("survives_vertical"), _yes(r.get("survives_vertical"))) if vertical else "")
-            + _cell(r["max_theta_ratio"], _fixed(r["max_theta_ratio"]), numeric=True)
+            + _cell(r["max_theta_ratio"], "overturned" if r.get("survives") is False and r.get("verdict") == "NO"
+                    and (_num(r["max_theta_ratio"]) or 0) > 1 else _fixed(r["max_theta_ratio"]), numeric=True)
             + "</tr>")
     out.append("</tbody></table></div>")
     return out
@@ -191,21 +195,27 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                             "the one asking for the widest column by Eq. 31)")
             parts = [governs,
                      f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
+                     + (" (below the design width)" if (_num(r.get("eq31_width_m")) or 0) < (_num(r.get("verified_width_m")) or 0) else "")
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
-                     f"verified width {_fixed(r.get('verified_width_m')) or '-'} m"]
+                     f"design width {_fixed(r.get('verified_width_m')) or '-'} m"
+                     + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
+                     + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else ""),
+                     f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
-                parts.append(f"check above it: {_whole(r.get('check_runs'))} widths, "
-                             + (f"{100 * share:.2g} % overturn, the widest at "
-                                + (failing_text(r.get("widest_failing_width_m"), r.get("verified_width_m")) or "-")
-                                if share else "none overturns"))
+                parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to twice "
+                             "it (or the no-uplift width), "
+                             + (f"{100 * share:.2g} % fail, the widest at "
+                                + (failing_text(r.get("widest_failing_width_m"), r.get("search_width_m")) or "-")
+                                + " (the design width lies just above it)"
+                                if share else "none fails"))
             if r.get("column_kind") == "block":
                 surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
                                       "verified_adequate": r.get("verified_adequate")})
                 verdict = {"yes": "survives", "NO": "overturns",
-                           "yes, safe island": "survives on a safe island (narrower than the verified width)"}
-                parts.append(f"as it stands: {verdict.get(surv, surv)}, max theta/alpha "
-                             f"{_fixed(r.get('max_theta_ratio')) or '-'}")
+                           "NO: safe island": "NO: survives only on a safe island (narrower than the design width)"}
+                parts.append(f"as it stands: {verdict.get(surv, surv)}"
+                             + ("" if r.get("overturns") else f", max theta/alpha {_fixed(r.get('max_theta_ratio')) or '-'}"))
                 if r.get("vertical_overturns") is not None:
                     parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): "
                                  + ("overturns" if r["vertical_overturns"] else "survives")
@@ -251,12 +261,16 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
     out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
            '<meta name="viewport" content="width=device-width, initial-scale=1">',
            f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
-           f"<h1>{_e(title)}</h1>",
+           f"<h1>{_e(title)}</h1>"]
+    out += [f'<p class="verdict"><b>{_e(line)}</b></p>' for line in verdict_lines(design)]
+    out += [f'<p class="muted">{_e(t)}</p>' for t in (fine_print(design),) if t]
+    out += [
            f"<p>{len(record_ids)} records, {len(failures)} failed. Files: "
            + ", ".join(f'<a href="{_href(f)}">{_e(f)}</a>' for f in
                        ("design.csv", "summary.csv", "failures.csv", "columns.md"))
            + ". Click a heading to sort the table. Rows in red: the column as it stands overturns; "
-             "in yellow: it survives on a safe island (a slightly wider column overturns).</p>",
+             "in yellow: it survives only on a safe island (a slightly wider column overturns), flagged "
+             "like a failure.</p>",
            "<h2>Designs</h2>"]
     out += _batch_table(design, pair_anchor)
     if failures:

@@ -99,16 +99,19 @@ def record_widths_png(record_id, verified) -> bytes | None:
     axes = fig.subplots(len(found), 1, squeeze=False)[:, 0]
     for ax, (label, v) in zip(axes, found):
         x, f = np.asarray(v.check_widths), np.asarray(v.check_failed, dtype=bool)
-        pct = 100.0 / v.width
-        _bars(ax, x, f, scale=pct, offset=v.width)
+        w = v.search_width if v.search_width else v.width      # the check starts above it
+        pct = 100.0 / w
+        _bars(ax, x, f, scale=pct, offset=w)
         ax.set_xscale("log")
-        ax.set_xlim(max(1e-3, 0.5 * (x[0] - v.width) * pct), (v.check_top - v.width) * pct)
-        ax.axvline((v.widest_failing_width - v.width) * pct, color=FAIL, lw=2, ls="--",
+        ax.set_xlim(max(1e-3, 0.5 * (x[0] - w) * pct), (max(v.check_top, x[-1]) - w) * pct)
+        ax.axvline((v.widest_failing_width - w) * pct, color=FAIL, lw=2, ls="--",
                    label=f"widest failing width {v.widest_failing_width:.4g} m "
-                         f"({excess_text(v.widest_failing_width, v.width)})")
-        ax.set_title(f"{record_id}, column height {label}: verified width {v.width:.4g} m; the check "
-                     f"above it: {x.size} widths, {int(f.sum())} overturn (share "
-                     f"{v.failing_share:.3g})", fontsize=9)
+                         f"({excess_text(v.widest_failing_width, w)})")
+        ax.axvline((v.width - w) * pct, color="k", lw=1,
+                   label=f"design width {v.width:.4g} m ({excess_text(v.width, w) or '+0 %'})")
+        ax.set_title(f"{record_id}, column height {label}: design width {v.width:.4g} m (the "
+                     f"search's first transition {w:.4g} m); the check above it: {x.size} widths, "
+                     f"{int(f.sum())} fail (share {v.failing_share:.3g})", fontsize=9)
         ax.legend(loc="upper right", fontsize=7, framealpha=0.9)
-        ax.set_xlabel("B / verified width - 1 (%, log scale): vermillion overturns, pale blue survives")
+        ax.set_xlabel("B / search width - 1 (%, log scale): vermillion fails, pale blue survives")
     return _png(fig)

@@ -66,8 +66,8 @@ ENVELOPE_COLUMNS = Columns(
 FRAGILITY_COLUMNS = Columns(
     ("critical_scale", "-", "`--fragility`: smallest factor k (on this row's record, already scaled "
                             "by `scale`) for which k times the record overturns the column as it "
-                            "stands (`rocking.critical_scale`: a scan that respects safe islands, "
-                            "refined to 1e-6); blank when no factor up to `fragility_up_to` does, or "
+                            "stands (with `--limit` R: makes max|theta|/alpha exceed R; `rocking.critical_scale`: "
+                            "a scan that respects safe islands, refined to 1e-6); blank when no factor up to `fragility_up_to` does, or "
                             "without `--fragility`."),
     ("critical_pga_g", "g", "PGA of the record at its critical scale."),
     ("critical_islands", "-", "Factor ranges above `critical_scale` where the column survives again "
@@ -132,7 +132,7 @@ def extra_fields(H, block, record, fitting, options, cache) -> dict:
         return fields
     from pulses import G
 
-    cs = rocking.critical_scale(block, record, up_to=options.up_to)
+    cs = rocking.critical_scale(block, record, up_to=options.up_to, limit=options.limit)
     fields.update(FRAGILITY_COLUMNS.row({
         "critical_scale": cs.scale,
         "critical_pga_g": None if cs.critical_pga is None else cs.critical_pga / G,
@@ -168,6 +168,10 @@ def add_options(parser) -> None:
                              "scale factor per record and direction, the suite's lognormal curve")
     parser.add_argument("--up-to", metavar="K", default="10",
                         help="--fragility: largest scale factor examined (default 10)")
+    parser.add_argument("--limit", metavar="R", default=None,
+                        help="performance level: design widths for max|theta|/alpha <= R and "
+                             "critical scales at which it first exceeds R, 0 < R <= 1 (default: "
+                             "overturning; docs/design.md)")
 
 
 def _number(text, what, lo, hi) -> float:
@@ -184,7 +188,12 @@ def options_from_args(args) -> dict:
     """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.Options`."""
     gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
     up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
-    return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to}
+    limit = getattr(args, "limit", None)
+    if limit is not None:
+        limit = _number(limit, "--limit (max|theta|/alpha)", 0.0, 1.0)
+        if limit <= 0.0:
+            raise SiteError(f"--limit (max|theta|/alpha) must lie in (0, 1], got {args.limit!r}")
+    return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to, "limit": limit}
 
 
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------
@@ -331,7 +340,7 @@ def _critical(group):
     pga = r["pga_g"] * G
     return CriticalScale(scale=r["critical_scale"], islands=[], up_to=r["fragility_up_to"],
                          uplift_scale=r["uplift_scale"], pga=pga, n_scan=0, step=0.0, resolution=0.0,
-                         near=0.0, rtol=0.0, runs=0, calls=0)
+                         near=0.0, rtol=0.0, runs=0, calls=0, limit=r.get("design_limit"))
 
 
 def fragility_tables(rows):
@@ -350,8 +359,9 @@ def fragility_tables(rows):
         n_over = sum(e.scale is not None for e in entries)
         base = {"column": label, "n_records": len(entries), "n_overturned": n_over}
         try:
-            fs = rocking.fragility(entries, measure="scale")
-            fp = rocking.fragility(entries, measure="pga")
+            level = entries[0].limit if entries else None
+            fs = rocking.fragility(entries, measure="scale", limit=level)
+            fp = rocking.fragility(entries, measure="pga", limit=level)
         except ValueError as exc:
             summary.append(FRAGILITY_SUMMARY_COLUMNS.row({**base, "median_scale": None, "beta_scale": None,
                                                           "median_pga_g": None, "beta_pga": None,

@@ -45,6 +45,8 @@ class Options:
     cap_mass_ratio: float = 0.0
     fragility: bool = False
     up_to: float = 10.0
+    #: the performance level (``--limit`` R: max|theta|/alpha <= R); None: overturning
+    limit: float | None = None
     #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
     vertical: str = "auto"
 

@@ -6,8 +6,9 @@ vertical of the same station.  With ``--vertical auto`` (the default) the three 
 on one time axis (:func:`pulses.check_triplet`: cut to the shortest, the vertical made upward by
 its stated polarity), and for every column as it stands the response with the vertical is computed
 beside the horizontal-only one (:data:`VERTICAL_COLUMNS`), by the compiled engine
-(``rocking.simulate(..., vertical=)``, model ``fast-vertical``); the verified width and the design
-rules stay those of the horizontal motion alone.  A
+(``rocking.simulate(..., vertical=)``, model ``fast-vertical``); the design width is the wider of
+the horizontal motion's and the one with the vertical (:func:`design`; ``design_governed_by``),
+the design rules (Eq. 31, envelope) stay those of the horizontal motion alone.  A
 vertical whose polarity is not stated is not used, and the row's ``warnings`` says why.
 """
 from __future__ import annotations
@@ -139,9 +140,24 @@ def scaled(task, up):
     return up.scaled(task.scale) if (up is not None and task.scale != 1.0) else up
 
 
-def fields(block, record, up, shown_file, height=None, cap_mass_ratio=0.0) -> dict:
-    """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical); ``height`` (m) of the
-    column whose verified width with the vertical is computed (None: not computed)."""
+def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None):
+    """The design width of a column ``height`` (m) tall: ``horizontal`` (the horizontal motion's
+    answer) where there is no vertical or it reaches -g, else the wider of it and the answer with
+    the vertical (``rocking.required_width(..., vertical=)``, ``governed_by`` set)."""
+    import numpy as np
+
+    import rocking
+    from pulses import G
+
+    if up is None or float(np.min(1.0 + up.acc / G)) <= 0.0:
+        return horizontal
+    return rocking.required_width(height, record, rule="exact", vertical=up, horizontal=horizontal,
+                                  cap_mass_ratio=cap_mass_ratio, limit=limit)
+
+
+def fields(block, record, up, shown_file, designed=None) -> dict:
+    """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical); ``designed``: the
+    answer of :func:`design` (its ``vertical_width`` is the verified width with the vertical)."""
     import numpy as np
 
     import rocking
@@ -155,9 +171,8 @@ def fields(block, record, up, shown_file, height=None, cap_mass_ratio=0.0) -> di
               "vertical_min_effective_gravity": float(np.min(1.0 + up.acc / G)),
               "vertical_overturns": None, "vertical_max_theta_ratio": None, "vertical_lifts_off": None,
               "vertical_t_lift_off_s": None, "vertical_model": None, "vertical_verified_width_m": None}
-    if height is not None and values["vertical_min_effective_gravity"] > 0.0:
-        values["vertical_verified_width_m"] = float(rocking.required_width(
-            height, record, rule="exact", vertical=up, cap_mass_ratio=cap_mass_ratio).width)
+    if designed is not None and designed.vertical_width is not None:
+        values["vertical_verified_width_m"] = float(designed.vertical_width)
     if block is not None:
         res = rocking.simulate(block, record, vertical=up, history=False)
         values.update(vertical_overturns=bool(res.overturned), vertical_max_theta_ratio=float(res.max_rotation_ratio),

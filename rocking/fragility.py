@@ -25,7 +25,7 @@ from pulses import G
 
 from . import scan
 from .block import Block
-from .search import _peak
+from .search import _failed, _peak, check_limit
 
 #: default largest scale factor examined
 UP_TO = 10.0
@@ -68,6 +68,9 @@ class CriticalScale:
         The scan settings used (see :func:`critical_scale`).
     runs, calls : int
         Solver runs, and batch-solver calls.
+    limit : float or None
+        The performance level R (None: overturning): :attr:`scale` is then the smallest factor at
+        which ``max|theta|/alpha`` exceeds R (or the block overturns).
 
     Examples
     --------
@@ -95,6 +98,9 @@ class CriticalScale:
     runs: int
     calls: int
     transitions: tuple = field(default=(), repr=False)
+    #: the performance level: the scale at which ``max|theta|/alpha`` first exceeds it (None:
+    #: overturning)
+    limit: float | None = None
 
     @property
     def overturns(self) -> bool:
@@ -108,8 +114,10 @@ class CriticalScale:
 
 
 def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
-                   resolution=RESOLUTION, near=NEAR, rtol=RTOL, model="fast") -> CriticalScale:
-    """Smallest factor ``k <= up_to`` for which ``k`` times ``record`` overturns ``block``.
+                   resolution=RESOLUTION, near=NEAR, rtol=RTOL, model="fast",
+                   limit=None) -> CriticalScale:
+    """Smallest factor ``k <= up_to`` for which ``k`` times ``record`` overturns ``block`` (or,
+    with ``limit`` R, makes ``max|theta|/alpha`` exceed R).
 
     Parameters
     ----------
@@ -135,6 +143,9 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
         Relative width to which the first fail bracket is bisected.
     model : {"fast", "linear"}
         Solver model of :func:`rocking.simulate_many`.
+    limit : float, optional
+        Performance level R in (0, 1]: a factor fails where ``max|theta|/alpha > R`` (or the block
+        overturns); ``near`` is then a share of R.  None (default): overturning.
 
     Returns
     -------
@@ -163,13 +174,15 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
         raise TypeError("critical_scale: block must be a rocking.Block")
     up_to = float(up_to)
     _check_settings(up_to, n_scan, step, resolution, near, rtol)
+    limit = check_limit(limit)
     pga = _peak(record)
     uplift = block.uplift_acceleration / pga if pga > 0 else math.inf
     settings = dict(up_to=up_to, uplift_scale=uplift, pga=pga, n_scan=int(n_scan),
-                    step=float(step), resolution=float(resolution), near=float(near), rtol=float(rtol))
+                    step=float(step), resolution=float(resolution), near=float(near), rtol=float(rtol),
+                    limit=limit)
     if not up_to > uplift:
         return CriticalScale(None, [], runs=0, calls=0, **settings)
-    pts = scan.Points(_verdicts(block, record, model), uplift)
+    pts = scan.Points(_verdicts(block, record, model, limit), uplift)
     # 1. the scan (the uplift factor itself is known: at |ug''| = g tan(alpha) nothing moves)
     pts.add(np.geomspace(uplift, up_to, int(n_scan) + 1)[1:])
     # 2. halve the gaps below the first failure (or everywhere, if none): to `step` where the
@@ -198,15 +211,16 @@ def _check_settings(up_to, n_scan, step, resolution, near, rtol) -> None:
             raise ValueError(f"critical_scale: {name} must lie in ({lo:g}, {hi:g}], got {value!r}")
 
 
-def _verdicts(block, record, model):
-    """``run(scales) -> (overturned, nearness)`` of ``block`` under ``scales`` times ``record``,
-    in one batch; a failing run counts as near tipping (nearness inf), else ``max|theta|/alpha``."""
+def _verdicts(block, record, model, limit=None):
+    """``run(scales) -> (failed, nearness)`` of ``block`` under ``scales`` times ``record``, in
+    one batch: failed is overturned (or ``max|theta|/alpha > limit``); a failing run counts as
+    near (nearness inf), else ``max|theta|/alpha`` over the level (1 for overturning)."""
     import rocking
 
     def run(scales):
         res = rocking.simulate_many(block, record, scales, model=model)
-        f = np.asarray(res.overturned, dtype=bool)
-        return f, np.where(f, np.inf, np.asarray(res.max_rotation_ratio, dtype=float))
+        f = _failed(res, "overturn", limit)
+        return f, np.where(f, np.inf, np.asarray(res.max_rotation_ratio, dtype=float) / (limit or 1.0))
 
     return run
 
@@ -264,6 +278,9 @@ class Fragility:
         ``up_to``: right-censored there).
     censored_at : ndarray
         For each censored record, the largest intensity examined.
+    limit : float or None
+        The performance level of the critical scales (``max|theta|/alpha`` exceeding it; None:
+        overturning): ``P(max|theta|/alpha > limit | x)``.
 
     Examples
     --------
@@ -280,6 +297,7 @@ class Fragility:
     measure: str
     values: np.ndarray = field(repr=False)
     censored_at: np.ndarray = field(repr=False)
+    limit: float | None = None
 
     @property
     def n(self) -> int:
@@ -303,7 +321,7 @@ class Fragility:
         return x, np.arange(1, x.size + 1) / self.values.size
 
 
-def fragility(critical, *, measure="scale", up_to=None) -> Fragility:
+def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility:
     """Lognormal fragility fitted by maximum likelihood to the critical scales of a suite.
 
     Parameters
@@ -317,6 +335,9 @@ def fragility(critical, *, measure="scale", up_to=None) -> Fragility:
         :attr:`CriticalScale.critical_pga`; needs :class:`CriticalScale` entries).
     up_to : float, optional
         For numeric entries that did not overturn: the largest intensity examined.
+    limit : float, optional
+        The performance level the critical scales were found for (``critical_scale(...,
+        limit=)``; None: overturning); a :class:`CriticalScale` entry of another level is refused.
 
     Returns
     -------
@@ -335,8 +356,12 @@ def fragility(critical, *, measure="scale", up_to=None) -> Fragility:
     """
     if measure not in ("scale", "pga"):
         raise ValueError(f"fragility: measure must be 'scale' or 'pga', got {measure!r}")
+    limit = check_limit(limit)
     values, limits = [], []
     for item in critical:
+        if isinstance(item, CriticalScale) and item.limit != limit:
+            raise ValueError(f"fragility: a critical scale for limit {item.limit!r} among those "
+                             f"for limit {limit!r} (max|theta|/alpha; None: overturning)")
         if isinstance(item, CriticalScale):
             unit = 1.0 if measure == "scale" else item.pga / G
             values.append(math.inf if item.scale is None else item.scale * unit)
@@ -368,7 +393,7 @@ def fragility(critical, *, measure="scale", up_to=None) -> Fragility:
         mu, beta = _censored_mle(logs, cens, mu, max(beta, 1e-3))
     if not beta > 0:
         raise ValueError("fragility: every record has the same critical intensity (beta = 0)")
-    return Fragility(math.exp(mu), beta, measure, values, limits[~done])
+    return Fragility(math.exp(mu), beta, measure, values, limits[~done], limit)
 
 
 def _censored_mle(logs, cens, mu0, beta0):

@@ -69,6 +69,14 @@ class SearchSettings:
     while the bin's spread is among the span's largest).  0 runs switch the check off.  The
     sizes were chosen from
     ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
+
+    The design width: where the check finds a failing width above the search's answer, the
+    bracket above the widest failing width (up to the next width run, which survived) is bisected
+    to ``design_rtol`` relative, and its surviving end is the design width
+    (:attr:`rocking.widths.RequiredWidth.width`).  The check runs in ``check_rounds`` rounds sharing
+    ``check_runs``, each above the design width the rounds before it left (its span starts
+    there).  ``check_seed``: the check's seed (None: made
+    from the record's samples and the column, so a re-run gives the same widths).
     """
 
     n_scan: int = 64
@@ -99,6 +107,9 @@ class SearchSettings:
     check_stages: int = 5
     check_bins: int = 100
     check_power: float = 3.0
+    design_rtol: float = 1e-6
+    check_seed: int | None = None
+    check_rounds: int = 2
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -117,6 +128,10 @@ class SearchSettings:
             raise ValueError("SearchSettings.check_follow must be in [0, 1), check_bins and "
                              f"check_stages at least 1, got {self.check_follow!r}, "
                              f"{self.check_bins!r}, {self.check_stages!r}")
+        if self.check_rounds < 1:
+            raise ValueError(f"SearchSettings.check_rounds must be at least 1, got {self.check_rounds!r}")
+        if not 0.0 < self.design_rtol < 1.0:
+            raise ValueError(f"SearchSettings.design_rtol must be in (0, 1), got {self.design_rtol!r}")
         if not self.rtol > 0:
             raise ValueError(f"SearchSettings.rtol must be positive, got {self.rtol!r}")
         if self.record_spacing not in ("geometric", "uniform"):
@@ -161,7 +176,25 @@ def _batch(blocks, excitation, scales=None, *, grid=False, model="fast"):
     return res
 
 
-def _failed(result, criterion):
+def check_limit(limit):
+    """``limit`` as a float in (0, 1], or None (overturning); ValueError otherwise."""
+    if limit is None:
+        return None
+    try:
+        value = float(limit)
+    except (TypeError, ValueError):
+        raise ValueError(f"limit must be a number in (0, 1] (max|theta|/alpha), got {limit!r}") from None
+    if not 0.0 < value <= 1.0:
+        raise ValueError(f"limit must lie in (0, 1] (max|theta|/alpha), got {limit!r}")
+    return value
+
+
+def _failed(result, criterion, limit=None):
+    """Failure verdicts of a batch: ``limit`` R (a performance level) fails a run whose
+    ``max|theta|/alpha`` exceeds R (or that overturned); without it, ``criterion`` decides."""
+    if limit is not None:
+        return (np.asarray(result.overturned, dtype=bool)
+                | (np.asarray(result.max_rotation_ratio, dtype=float) > limit))
     if criterion == "overturn":
         return np.asarray(result.overturned, dtype=bool)
     return np.asarray(result.exceeded_alpha, dtype=bool) | np.asarray(result.overturned, dtype=bool)

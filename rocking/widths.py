@@ -3,6 +3,7 @@
 (the *verified width*, under a pulse or a whole record)."""
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from dataclasses import dataclass, field
@@ -16,7 +17,7 @@ from .block import Block
 from .frame import check_cap_mass_ratio, frame_p
 from .closed_forms import envelope_rule, eq20, eq31
 from .search import (DEFAULT_SETTINGS, _batch, _check_criterion, _failed, _peak, _scan_points,
-                     _scan_refine)
+                     _scan_refine, check_limit)
 
 
 @dataclass
@@ -30,6 +31,12 @@ class RequiredWidth:
     Under a record, failing slivers thinner than the scan's resolution can lie above it (the
     response is chaotic near the verge of overturning): a check of jittered widths above it
     reports what it finds (:attr:`failing_share`, :attr:`widest_failing_width`; docs/slivers.md).
+
+    :attr:`width` is the *design width*: at least every width the search and the check found to
+    fail, refined just above the widest of them (:attr:`search_width` is the search's first
+    transition, a diagnostic); with a vertical record, the wider of the designs for the horizontal
+    motion alone and with the vertical (:attr:`governed_by`).  With a performance level
+    :attr:`limit` R, a width fails where ``max|theta|/alpha`` exceeds R (or the column overturns).
 
     Examples
     --------
@@ -65,6 +72,30 @@ class RequiredWidth:
     #: the widths checked (m, ascending) and whether each failed (for the barcode figure)
     check_widths: np.ndarray | None = field(default=None, repr=False, compare=False)
     check_failed: np.ndarray | None = field(default=None, repr=False, compare=False)
+    #: the performance level: a width fails where ``max|theta|/alpha > limit`` (None: overturning,
+    #: or :attr:`criterion`)
+    limit: float | None = None
+    #: the search's answer (m): the smallest width above which every width the search examined
+    #: survives (the former "verified width"); :attr:`width` is at least this
+    search_width: float | None = None
+    #: solver runs of the refinement above the widest failing width (on top of :attr:`runs` and
+    #: :attr:`check_runs`)
+    refine_runs: int = 0
+    #: with a vertical record: ``"horizontal"`` where the horizontal motion alone asks for the
+    #: wider design, ``"with vertical"`` where the horizontal motion together with the vertical
+    #: does (ties: ``"horizontal"``); None without a vertical
+    governed_by: str | None = None
+    #: with a vertical record: the design widths (m) for the horizontal motion alone and with the
+    #: vertical (:attr:`width` is the larger)
+    horizontal_width: float | None = None
+    vertical_width: float | None = None
+    #: with a vertical record: the answer of the other motion, whole (a RequiredWidth)
+    other: "RequiredWidth | None" = field(default=None, repr=False, compare=False)
+
+    @property
+    def total_runs(self) -> int:
+        """Solver runs of the search, the check and the refinement together."""
+        return int(self.runs) + int(self.check_runs) + int(self.refine_runs)
 
     @property
     def tan_alpha(self) -> float:
@@ -93,7 +124,8 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
                    shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
-                   settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None):
+                   settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None, limit=None,
+                   horizontal=None):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -108,22 +140,21 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         iteration count is reported).  ``"exact"``: time-history analysis across widths (the
         *verified width*, see :class:`RequiredWidth`); works for pulses and records.
     criterion : {"overturn", "exceed"}
-        Failure criterion of ``rule="exact"``.
+        Failure criterion of ``rule="exact"`` (``limit`` takes precedence).
     eta : float, optional
         Restitution for the exact rule (default Eq. 5 at each width).
-    shape : str, optional
-        Shape whose envelope factor to use with ``rule="envelope"`` (default: every shape).
-    lam : float
-        The lambda of Eq. 20 for ``rule="eq20"``.
+    limit : float, optional
+        ``rule="exact"``: the performance level R in (0, 1]: the design keeps
+        ``max|theta|/alpha <= R`` (a width fails where it exceeds R or the column overturns);
+        None (default): overturning, the paper's question (docs/design.md, "Performance levels").
+    shape, lam : str (optional), float
+        ``rule="envelope"``: the shape whose factor to use (default every shape); Eq. 20's lambda.
     n_scan, n_zone, rtol : int, int, float, optional
-        ``rule="exact"``: scan points up to the no-uplift width ``H peak/g`` (pulse:
-        ``settings.n_scan`` uniform; record: ``settings.record_scan`` geometric), points of the
-        dense zone just above the widest failing width (pulse: ``settings.zone_points`` uniform,
-        0 switches it off; record: an optional extra zone of ``settings.record_zone_points``
-        geometric widths, off by default, next to the fine zone, see :func:`_record_width`), and
-        the relative width of the final bracket; each overrides its field of ``settings``.  For a record only the top transition is refined
-        (its verdicts may change hundreds of times with the width) and the widths scanned are
-        chosen adaptively; the answer holds at the resolution stated in :func:`_record_width`.
+        ``rule="exact"``: scan points up to the no-uplift width ``H peak/g`` (pulse: uniform;
+        record: geometric), points of the dense zone just above the widest failing width (0
+        switches it off; for a record an extra zone, off by default) and the relative width of
+        the final bracket; each overrides its field of ``settings``.  For a record only the top
+        transition is refined, on adaptively chosen widths (resolution: :func:`_record_width`).
     settings : rocking.search.SearchSettings
         Settings of the exact searches (default :data:`rocking.search.DEFAULT_SETTINGS`).
     cap_mass_ratio : float
@@ -131,10 +162,8 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         total mass (docs/theory.md section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
     vertical : pulses.Record, optional
         ``rule="exact"`` under a record: its upward vertical acceleration on the same time axis
-        (docs/theory.md section 10); every run of the search and of the check above it is the
-        compiled engine with the vertical, and the no-uplift width is ``H max|ag|/(g + av)``.  A
-        vertical that reaches -g (the block would leave the ground, which the model does not
-        describe) is refused.
+        (docs/theory.md section 10): every run uses the compiled engine with it; the no-uplift
+        width is ``H max|ag|/(g + av)``; a vertical reaching -g (free flight) is refused.
 
     Returns
     -------
@@ -145,21 +174,22 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     --------
     >>> import pulses, rocking
     >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
-    >>> round(rocking.required_width(7.5, pulse, rule="eq31").width, 3)
-    2.17
-    >>> round(rocking.required_width(7.5, pulse, rule="exact").width, 3)
-    1.736
+    >>> [round(rocking.required_width(7.5, pulse, rule=r).width, 3) for r in ("eq31", "exact")]
+    [2.17, 1.736]
     """
     height = float(height)
     if not (math.isfinite(height) and height > 0):
         raise ValueError(f"height must be positive, got {height!r} m")
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
-    gamma = check_cap_mass_ratio(cap_mass_ratio)
+    gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
     if rule == "exact":
-        return _exact_width(height, excitation, criterion=criterion, eta=eta, n_scan=n_scan,
-                            rtol=rtol, model=model, n_zone=n_zone, settings=settings, gamma=gamma,
-                            vertical=vertical)
+        kw = dict(criterion=criterion, eta=eta, n_scan=n_scan, rtol=rtol, model=model,
+                  n_zone=n_zone, settings=settings, gamma=gamma, limit=limit)
+        if vertical is None:
+            return _exact_width(height, excitation, **kw)
+        return governing(horizontal or _exact_width(height, excitation, **kw),
+                         _exact_width(height, excitation, vertical=vertical, **kw))
     if vertical is not None:
         raise ValueError("a vertical record goes with rule='exact' under a record")
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
@@ -193,6 +223,21 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
                                 f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
 
 
+def governing(horizontal, with_vertical):
+    """The answer of the two designs (horizontal motion alone, and with the vertical) that asks
+    for the wider column, with :attr:`RequiredWidth.governed_by`, both widths and the other answer
+    (:attr:`RequiredWidth.other`) set.  Ties go to the horizontal motion."""
+    vertical_governs = with_vertical.width > horizontal.width
+    res, other = (with_vertical, horizontal) if vertical_governs else (horizontal, with_vertical)
+    return dataclasses.replace(
+        res, governed_by="with vertical" if vertical_governs else "horizontal",
+        horizontal_width=float(horizontal.width), vertical_width=float(with_vertical.width),
+        other=other,
+        method=res.method + (f"; governed by the {'horizontal motion with the vertical' if vertical_governs else 'horizontal motion alone'}"
+                             f" ({horizontal.width:.6g} m alone, {with_vertical.width:.6g} m "
+                             f"with the vertical)"))
+
+
 def _uplift_ratio(record, vertical) -> float:
     """``max |ag| / (g + av)`` over the record's samples (``tan(alpha)`` of the widest column that
     uplifts with the vertical); RockingInputError where ``g + av`` reaches 0."""
@@ -212,13 +257,13 @@ def _uplift_ratio(record, vertical) -> float:
 
 
 def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None,
-                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None):
+                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None, limit=None):
     _check_criterion(criterion)
     # wider than this the column never uplifts
     top = height * (_peak(excitation) / G if vertical is None else _uplift_ratio(excitation, vertical))
     if top <= 0:
         return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion,
-                             cap_mass_ratio=gamma)
+                             cap_mass_ratio=gamma, limit=limit, search_width=0.0)
 
     def run_widths(widths):  # not `runs`: that name counts the runs below
         blocks = [Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma) for b in widths]
@@ -228,26 +273,38 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
             return rocking.simulate_many(blocks, excitation, vertical=vertical)
         return _batch(blocks, excitation, None, model=model)
 
-    def evaluate(idx, widths):
-        return _failed(run_widths(widths), criterion)
-
     is_pulse = getattr(excitation, "shape", "record") in SHAPES
     if not is_pulse:
         def evaluate_record(widths):
+            # max|theta|/alpha over the level (1 for overturning): the search's and the check's
+            # "near failure" thresholds then hold for any level
             res = run_widths(widths)
-            return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
+            return (_failed(res, criterion, limit),
+                    np.asarray(res.max_rotation_ratio, dtype=float) / (limit or 1.0))
 
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
         res, seen = _record_search(height, top, evaluate_record, criterion=criterion, eta=eta,
                                    settings=settings)
-        res.cap_mass_ratio = gamma
+        res.cap_mass_ratio, res.limit, res.search_width = gamma, limit, res.width
         if vertical is not None:
             res.method += "; with the vertical record (compiled engine, fast-vertical)"
+        if limit is not None:
+            res.method += f"; a width fails where max|theta|/alpha > {limit:g}"
         if not res.below_scan and settings.check_runs > 0:
-            _add_check(res, top, evaluate_record, settings,
-                       _record_seed(excitation, height, criterion, eta, gamma), seen)
+            seed = settings.check_seed
+            if seed is None:
+                seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
+            _check_rounds(res, top, evaluate_record, settings, seed, seen)
         return res
-    settings = settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol)
+    res = _pulse_width(height, top, lambda idx, widths: _failed(run_widths(widths), criterion, limit),
+                       settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol))
+    res.criterion, res.eta, res.cap_mass_ratio, res.limit = criterion, eta, gamma, limit
+    res.search_width = res.width
+    return res
+
+
+def _pulse_width(height, top, evaluate, settings):
+    """A pulse's verified width (scan and refinement of every verdict change)."""
     x = _scan_points(np.array([top]), settings.n_scan, settings.n_tail)
     known = np.zeros(x.shape, dtype=bool)
     known[:, -1] = True
@@ -284,8 +341,8 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                 f"{scan.calls} batches)"
                 + ("; no width examined failed: the answer is at most this width"
                    if below_scan else "")),
-        criterion=criterion, transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br),
-        runs=runs, eta=eta, below_scan=below_scan, cap_mass_ratio=gamma)
+        transitions=tuple(0.5 * (lo + hi) for lo, hi, _, _ in br), runs=runs,
+        below_scan=below_scan)
 
 
 def _first_runs(settings) -> int:
@@ -363,18 +420,54 @@ def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTING
     return np.sort(np.concatenate(x))
 
 
-def _record_seed(record, height, criterion, eta, gamma) -> int:
+def _record_seed(record, height, criterion, eta, gamma, limit=None) -> int:
     """A seed made from the record's samples and the column (the same run, the same check)."""
     h = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes())
-    h.update(repr((float(record.dt), float(height), criterion, eta, float(gamma))).encode())
+    key = (float(record.dt), float(height), criterion, eta, float(gamma))
+    h.update(repr(key if limit is None else key + (float(limit),)).encode())
     return int.from_bytes(h.digest()[:8], "little")
 
 
-def _add_check(res, top, evaluate, settings, seed, seen=None) -> None:
-    """Run the check above ``res.width`` (``evaluate(widths)``: verdicts and max|theta|/alpha,
-    one batch per stage) and store its outcome in ``res``.  ``seen``: ``(widths, failed,
-    ratio)`` already run by the search; those above the verified width (all survived) join the
-    later stages' measure of the spread at no cost."""
+def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
+    """The check above the search's answer in ``settings.check_rounds`` rounds sharing
+    ``settings.check_runs``: each checks above the design width so far (its span starts there)
+    and raises it above the widest failing width found (:func:`_raise_to_failures`); the later
+    rounds measure the spread over every width run before them.  Stores the outcome in ``res``."""
+    rounds = int(settings.check_rounds)
+    left = int(settings.check_runs)
+    xs, fs, rs = (np.asarray(v) for v in seen)
+    cx, cf = np.zeros(0), np.zeros(0, dtype=bool)
+    base_method, notes = res.method, []
+    for k in range(rounds):
+        n = left // (rounds - k)
+        left -= n
+        x, f, r = _add_check(res, top, evaluate, settings.replace(check_runs=n), seed + k,
+                             (xs, fs, rs))
+        notes.append(f"{x.size} widths from {res.width:.6g} m up to "
+                     f"{min(settings.check_span * res.width, top):.6g} m, {int(f.sum())} failed")
+        cx, cf = np.concatenate([cx, x]), np.concatenate([cf, f])
+        xs, fs, rs = np.concatenate([xs, x]), np.concatenate([fs, f]), np.concatenate([rs, r])
+        res.check_widths, res.check_failed = cx, cf
+        _raise_to_failures(res, evaluate, (xs, fs), settings)
+    order = np.argsort(cx, kind="stable")
+    res.check_widths, res.check_failed = cx[order], cf[order]
+    res.check_runs = int(cx.size)
+    res.check_top = float(min(settings.check_span * res.width, top))
+    res.failing_share = float(cf.mean()) if cx.size else 0.0
+    known = np.concatenate([xs[fs.astype(bool)], [res.widest_failing_width or 0.0]])
+    above = known[known > res.search_width]
+    res.widest_failing_width = float(above.max()) if above.size else None
+    res.method = base_method + (f"; check above it in {rounds} round(s): " + "; ".join(notes)
+                                + (f"; design width {res.width:.6g} m, just above the widest "
+                                   f"failing width {res.widest_failing_width:.6g} m"
+                                   if res.widest_failing_width else ""))
+
+
+def _add_check(res, top, evaluate, settings, seed, seen=None):
+    """One round of the check above ``res.width`` (``evaluate(widths)``: verdicts and
+    max|theta|/alpha, one batch per stage): ``(widths, failed, ratio)`` in the order run.
+    ``seen``: ``(widths, failed, ratio)`` already run; those above ``res.width`` join the later
+    stages' measure of the spread at no cost."""
     x = check_widths(res.width, top, settings, seed)
     f, r = evaluate(x) if x.size else (np.zeros(0, dtype=bool), np.zeros(0))
     f, r = np.asarray(f, dtype=bool), np.asarray(r, dtype=float)
@@ -393,16 +486,25 @@ def _add_check(res, top, evaluate, settings, seed, seen=None) -> None:
             fy, ry = evaluate(y)
             x, f, r = (np.concatenate([x, y]), np.concatenate([f, np.asarray(fy, dtype=bool)]),
                        np.concatenate([r, np.asarray(ry, dtype=float)]))
-    order = np.argsort(x, kind="stable")
-    x, f = x[order], f[order]
-    res.check_top = float(min(settings.check_span * res.width, top))
-    res.check_runs = int(x.size)
-    res.failing_share = float(f.mean()) if x.size else 0.0
-    res.widest_failing_width = float(x[f].max()) if f.any() else None
-    res.check_widths, res.check_failed = x, f
-    res.method += (f"; check above it: {x.size} jittered widths up to {res.check_top:.4g} m "
-                   f"in {stages + 1} stages, {int(f.sum())} failed"
-                   + (f" (widest {res.widest_failing_width:.4g} m)" if f.any() else ""))
+    return x, f, r
+
+
+def _raise_to_failures(res, evaluate, seen, settings) -> None:
+    """Raise ``res.width`` above every width found to fail: where one of ``seen`` (``(widths,
+    failed)``, every width run) failed above it, bisect the bracket from the widest failing width
+    up to the next width run (which survived) to ``settings.design_rtol`` relative and take its
+    surviving end; widths found failing by the bisection move the bracket up."""
+    x, f = np.asarray(seen[0], dtype=float), np.asarray(seen[1], dtype=bool)
+    if not (f & (x > res.width)).any():
+        return
+    lo = float(x[f].max())
+    hi = float(np.min(x[x > lo]))           # run, and survived (lo is the widest failure)
+    while hi - lo > settings.design_rtol * hi:
+        mid = 0.5 * (lo + hi)
+        failed = bool(np.asarray(evaluate(np.array([mid]))[0])[0])
+        res.refine_runs += 1
+        lo, hi = (mid, hi) if failed else (lo, mid)
+    res.width, res.widest_failing_width = hi, lo
 
 
 #: how far below the scan's narrowest width (in halvings) the verified width looks for a failure

@@ -3,21 +3,23 @@ verdict with the vertical, from rows of summary.csv."""
 from pipeline.design_table import design_rows, excess_text, failing_text, metadata_text, table_text
 
 
-def _row(direction, verified, failing, overturns=False, vertical=None):
+def _row(direction, verified, failing, overturns=False, vertical=None, search=None):
     return {"record": f"p@{direction}", "pair": "p", "column": "7.5x1.8", "column_kind": "block",
             "direction_deg": direction, "verified_width_m": verified, "widest_failing_width_m": failing,
             "overturns": overturns, "vertical_overturns": vertical, "width_m": 1.8,
-            "verified_adequate": True, "max_theta_ratio": 0.5}
+            "verified_adequate": True, "max_theta_ratio": 0.5, "search_width_m": search,
+            "check_runs": 1500}
 
 
-def test_a_pairs_widest_failing_width_is_one_above_its_governing_verified_width():
-    # direction 0 governs (1.0 m); a sliver of direction 90 at 0.9 m fails no column of 1.0 m or wider
-    d, = design_rows([_row(0, 1.0, None), _row(90, 0.8, 0.9)])
+def test_a_pairs_widest_failing_width_is_one_above_its_governing_search_width():
+    # direction 0 governs (design 1.0 m, search 0.95 m); a sliver of direction 90 at 0.9 m lies
+    # below the governing search width: no failure of the design's direction
+    d, = design_rows([_row(0, 1.0, None, search=0.95), _row(90, 0.8, 0.9, search=0.7)])
     assert d["direction_deg"] == 0 and d["verified_width_m"] == 1.0
-    assert d["widest_failing_width_m"] is None
-    # one at 1.1 m does: a column of 1.05 m fails in that direction
-    d, = design_rows([_row(0, 1.0, None), _row(90, 0.8, 1.1)])
-    assert d["widest_failing_width_m"] == 1.1
+    assert d["widest_failing_width_m"] is None and d["search_width_m"] == 0.95
+    # one at 0.99 m (the governing direction's own, just below its design width) is reported
+    d, = design_rows([_row(0, 1.0, 0.99, search=0.95), _row(90, 0.8, None, search=0.7)])
+    assert d["widest_failing_width_m"] == 0.99 < d["verified_width_m"]
 
 
 def test_the_verdict_with_the_vertical_covers_every_direction():
@@ -55,19 +57,42 @@ def test_excess_above_the_verified_width_is_shown_in_percent():
     assert failing_text(0.608, None) == "0.608 m" and failing_text(None, 0.593) is None
 
 
-def test_the_printed_table_says_how_far_above_the_verified_width_a_column_fails():
-    far = dict(_row(0, 0.593, 0.608), record="far", pair="far")
-    tiny = dict(_row(0, 0.593, 0.593 * 1.00012), record="tiny", pair="tiny")
-    none = dict(_row(0, 0.593, None), record="none", pair="none")
+def test_the_printed_table_says_how_far_the_design_width_lies_above_the_search():
+    far = dict(_row(0, 0.608, 0.6079, search=0.593), record="far", pair="far")
+    tiny = dict(_row(0, 0.593 * 1.00012, 0.593 * 1.0001, search=0.593), record="tiny", pair="tiny")
+    none = dict(_row(0, 0.593, None, search=0.593), record="none", pair="none")
     text = table_text(design_rows([far, tiny, none]))
-    lines = {line.split()[0]: line for line in text.splitlines()[2:]}
-    assert "0.593 m  0.608 m (+2.5 %)" in lines["far"]
-    # the two read equal to 3 decimals; the percentage says the failing one is above
+    lines = {line.split()[0]: line for line in text.splitlines()[2:] if line}
+    assert "0.608 m  0.593 m (+2.5 %)" in lines["far"]
+    # the two read equal to 3 decimals; the percentage says the design width is above the search's
     assert "0.593 m  0.593 m (+0.01 %)" in lines["tiny"]
-    assert "0.593 m" in lines["none"] and "%" not in lines["none"]
+    assert "0.593 m  0.593 m" in lines["none"] and "%" not in lines["none"]
     # the metres line up on the decimal point, the percentages start in one column
     assert lines["far"].index("(+") == lines["tiny"].index("(+")
-    # none found: a dash where the metres end, and the verdict where the others have it
-    assert lines["none"].split("0.593 m")[1].split()[0] == "-"
-    assert lines["none"].rindex("-") == lines["far"].index(" m (") + 1
     assert lines["none"].index("yes") == lines["far"].index("yes")
+    # the fine print says what was tested above the width, with the docs on slivers
+    assert "the check ran 1500 widths per record" in text and "docs/slivers.md" in text
+
+
+def test_eq31_safe_island_and_the_suite_answer():
+    """Eq. 31 below the design width is flagged and counted; a column on a safe island reads NO;
+    the run ends with the width covering every record."""
+    base = dict(_row(0, 1.0, None, search=1.0), eq31_width_m=0.8, eq31_width_overturns=True)
+    rows = [dict(base, record="a", pair="a"),                                   # Eq. 31 below, overturns
+            dict(base, record="b", pair="b", verified_width_m=2.2, search_width_m=2.0,
+                 verified_adequate=False, eq31_width_m=2.5, eq31_width_overturns=False),
+            dict(base, record="c", pair="c", eq31_width_m=1.2, eq31_width_overturns=False)]
+    d = design_rows(rows)
+    assert [r["eq31_below_design"] for r in d] == [True, False, False]
+    assert [r["verdict"] for r in d] == ["survives", "NO: safe island", "survives"]
+    text = table_text(d)
+    lines = {line.split()[0]: line for line in text.splitlines()[2:5]}
+    assert "0.800 m BELOW, overturns" in lines["a"] and "BELOW" not in lines["c"]
+    assert lines["b"].rstrip().endswith("NO: safe island")
+    assert ("Suite, column 7.5x1.8: the design width covering all 3 record(s) is 2.200 m (set by b); "
+            "as it stands (1.800 m) it FAILS: 0 record(s) overturn it, 1 leave it on a safe island") in text
+    assert "Eq. 31 is below the design width on 1 of 3 record(s); its design overturns under 1." in text
+    # a level: a column that stands but exceeds R fails it
+    lv = design_rows([dict(base, record="a", pair="a", design_limit=0.4)])[0]
+    assert lv["survives"] is False and lv["verdict"] == "NO"
+    assert "for max theta/alpha <= 0.4" in table_text([lv])

@@ -56,30 +56,37 @@ def test_printed_table_and_design_csv(demo):
     assert len(ids) == 5
     rows = list(csv.DictReader(io.StringIO((out / "design.csv").read_text())))
     summary = list(csv.DictReader(io.StringIO((out / "summary.csv").read_text())))
-    assert len(next(iter(rows)).keys()) <= 20
+    assert len(next(iter(rows)).keys()) <= 26
     assert [r["record"] for r in rows] == ids  # one column: a row per record, input order
     # every value comes from summary.csv unchanged (a single component: its only direction)
     for d, s in zip(rows, summary):
         for key in ("pulse_like", "governing_shape", "governing_ap_g", "governing_tp_s", "eq31_width_m",
-                    "verified_width_m", "width_m", "verified_adequate", "max_theta_ratio"):
+                    "verified_width_m", "width_m", "verified_adequate", "max_theta_ratio",
+                    "search_width_m", "check_runs"):
             assert d[key] == s[key], key
         assert d["survives"] == str(s["overturns"] == "False")
-    # the printed table: a header, a rule and one line per record and column, before the last line
+        # the design width is above every failing width found, and at least the search's
+        assert float(d["verified_width_m"]) >= float(d["search_width_m"])
+        if d["widest_failing_width_m"]:   # above it by at most design_rtol 1e-6: equal to 6 digits
+            assert float(d["verified_width_m"]) >= float(d["widest_failing_width_m"])
+        assert d["eq31_below_design"] == str(float(d["eq31_width_m"]) < float(d["verified_width_m"]))
+    # the printed table: a header, a rule and one line per record and column, then the verdict
+    # lines, before the last line
     lines = proc.stdout.splitlines()
     assert lines[-1].startswith("pipeline run: 5 of 5 records processed")
     head = lines.index(next(l for l in lines if l.startswith("record ")))
-    body = lines[head + 2:-1]
-    assert len(body) == len(rows)
+    body = lines[head + 2:head + 2 + len(rows)]
+    assert lines[head + 2 + len(rows)] == ""
     for line, row in zip(body, rows):
         assert line.startswith(row["record"])
         assert f"{float(row['verified_width_m']):.3f} m" in line
         assert f"{float(row['eq31_width_m']):.3f} m" in line
-        # the widest failing width with its excess over the verified width, or a dash
-        if row["widest_failing_width_m"]:
-            fail, verified = float(row["widest_failing_width_m"]), float(row["verified_width_m"])
-            m = re.search(re.escape(f"{fail:.3f} m (") + r"(<?)\+([\d.]+) %\)", line)
+        # the search width with the design width's excess over it, or no percentage
+        design, search = float(row["verified_width_m"]), float(row["search_width_m"])
+        if design > search:
+            m = re.search(re.escape(f"{search:.3f} m (") + r"(<?)\+([\d.]+) %\)", line)
             assert m, line
-            pct = 100 * (fail - verified) / verified
+            pct = 100 * (design - search) / search
             if m.group(1):
                 assert pct < 0.01
             else:  # the percentage shown is the excess rounded to its last digit
@@ -87,8 +94,15 @@ def test_printed_table_and_design_csv(demo):
                 assert abs(float(m.group(2)) - pct) <= 0.5 * 10 ** -decimals + 1e-9, (m.group(0), pct)
         else:
             assert "%)" not in line
-        assert line.rstrip().endswith({"True": "yes" if row["verified_adequate"] == "True" else "yes, safe island",
+        assert line.rstrip().endswith({"True": "yes" if row["verified_adequate"] == "True" else "NO: safe island",
                                        "False": "NO"}[row["survives"]])
+    widest = max(rows, key=lambda r: float(r["verified_width_m"]))
+    assert (f"the design width covering all 5 record(s) is {float(widest['verified_width_m']):.3f} m "
+            f"(set by {widest['record']})") in proc.stdout
+    below = sum(r["eq31_below_design"] == "True" for r in rows)
+    over = sum(r["eq31_width_overturns"] == "True" for r in rows)
+    assert f"Eq. 31 is below the design width on {below} of 5 record(s); its design overturns under {over}." in proc.stdout
+    assert "the check ran 1500 widths per record" in proc.stdout
     # the files are the run's own: listed in the manifest (so a re-run may replace them)
     manifest = (out / "pipeline-manifest.txt").read_text()
     assert "  design.csv\n" in manifest and "  report.html\n" in manifest
@@ -165,32 +179,46 @@ def test_design_rows_of_a_pair():
     assert d["record"] == "A+B" and d["direction_deg"] == 90.0 and d["verified_width_m"] == 1.9
     assert d["n_directions"] == 3 and d["n_directions_failed"] == 1
     assert d["survives"] is False and d["verified_adequate"] is False and d["max_theta_ratio"] == 5.0
-    assert design_table.survives_text(d) == "NO"
+    assert design_table.survives_text(d) == "NO" and d["verdict"] == "NO"
     text = design_table.table_text([d])
     assert "A+B @90deg" in text and "1.900 m" in text
 
 
-def test_report_html_says_how_far_above_the_verified_width_a_column_fails():
-    """The batch table's widest failing width and each record's check line carry its excess over
-    the verified width in percent: far above, a hair above (equal to 3 decimals), none found."""
+def test_report_html_says_how_far_above_the_search_width_a_column_fails():
+    """The batch table's design width, search width and widest failing width, each record's check
+    line (what was tested above the width), the verdict lines at the top, a safe island flagged
+    like a failure and an overturned row saying so."""
     base = dict(column="7.5x1.8", column_kind="block", width_m=1.8, scale=1.0, pulse_like=True,
                 velocity_tp_s=1.2, governing_shape="sine", governing_ap_g=0.5, governing_tp_s=0.8,
                 eq31_width_m=2.0, eq31_width_overturns=False, direction_deg=None, overturns=False,
-                verified_adequate=True, max_theta_ratio=0.3, verified_width_m=0.593, check_runs=40)
-    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05),
-            dict(base, record="tiny", widest_failing_width_m=0.593 * 1.00012, failing_share=0.025),
-            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0)]
+                verified_adequate=True, max_theta_ratio=0.3, search_width_m=0.593, check_runs=40)
+    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05, verified_width_m=0.6081),
+            dict(base, record="tiny", widest_failing_width_m=0.593 * 1.00012, failing_share=0.025,
+                 verified_width_m=0.593 * 1.00013),
+            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0, verified_width_m=0.593),
+            dict(base, record="island", widest_failing_width_m=None, failing_share=0.0, verified_width_m=2.1,
+                 search_width_m=2.1, verified_adequate=False, eq31_width_m=1.5),
+            dict(base, record="over", widest_failing_width_m=None, failing_share=0.0, verified_width_m=2.2,
+                 search_width_m=2.2, verified_adequate=False, overturns=True, max_theta_ratio=5.36)]
+    ids = [r["record"] for r in rows]
     design = design_table.design_rows(rows)
-    page = html_report.report_html(design, rows, [], ["far", "tiny", "none"], {})
-    cells = {r: re.search(rf'<tr><td data-v="{r}">.*?</tr>', page).group(0) for r in ("far", "tiny", "none")}
-    # the cell shows metres and percent, and sorts by the number in metres
+    page = html_report.report_html(design, rows, [], ids, {})
+    cells = {r: re.search(rf'<tr[^>]*><td data-v="{r}">.*?</tr>', page).group(0) for r in ids}
+    # the widest failing cell shows metres and percent over the search width, sorts by metres
     assert '<td class="n" data-v="0.608">0.608 (+2.5 %)</td>' in cells["far"]
     assert re.search(r'<td class="n" data-v="0\.593\d+">0\.593 \(\+0\.01 %\)</td>', cells["tiny"])
     assert '<td class="n" data-v="">-</td>' in cells["none"] and "%)" not in cells["none"]
-    assert "5 % overturn, the widest at 0.608 m (+2.5 %)" in page
-    assert "2.5 % overturn, the widest at 0.593 m (+0.01 %)" in page
-    assert "check above it: 40 widths, none overturns" in page
-    assert html_report.report_html(design, rows, [], ["far", "tiny", "none"], {}) == page
+    assert "5 % fail, the widest at 0.608 m (+2.5 %) (the design width lies just above it)" in page
+    assert "check above the search width: 40 widths up to twice it (or the no-uplift width), none fails" in page
+    # Eq. 31 below the design width, the safe island flagged, the overturned row
+    assert "1.500 BELOW" in cells["island"] and 'class="island"' in cells["island"]
+    assert ">NO: safe island<" in cells["island"]
+    assert ">overturned</td>" in cells["over"] and ">5.36<" not in cells["over"]   # sorts by the ratio
+    # the verdict lines come first, before the table
+    top = page.index('<p class="verdict">')
+    assert top < page.index('<table') and "the design width covering all 5 record(s) is 2.200 m" in page
+    assert "Eq. 31 is below the design width on 2 of 5 record(s); its design overturns under 0." in page
+    assert html_report.report_html(design, rows, [], ids, {}) == page
 
 
 # -- in a real browser -----------------------------------------------------------------------------
@@ -211,7 +239,7 @@ _PROBE = """<script>
       return {src: i.getAttribute("src"), ok: i.complete && i.naturalWidth > 0, width: i.naturalWidth};
     });
     var heads = table.tHead.rows[0].cells, col = -1;
-    for (var k = 0; k < heads.length; k++) { if (heads[k].textContent.indexOf("verified width") === 0) { col = k; } }
+    for (var k = 0; k < heads.length; k++) { if (heads[k].textContent.indexOf("design width") === 0) { col = k; } }
     heads[col].click();
     var sorted = Array.prototype.map.call(table.tBodies[0].rows, function (r) { return parseFloat(r.cells[col].getAttribute("data-v")); });
     heads[col].click();

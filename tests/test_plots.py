@@ -160,7 +160,7 @@ def test_record_figure_velocity_pulse_and_verified_width(tmp_path):
     task, = make_tasks([str(path)], [Column(7.5, 1.8)], Options())
     rows, (record, fit, fitting, histories), _verified = _process(task)
     (label, curves), = histories
-    assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "verified width"]
+    assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "design width"]
     _, block_v, res_v = curves[2]
     assert block_v.width == pytest.approx(rows[0]["verified_width_m"], rel=1e-12)
     assert not res_v.overturned  # the verified width survives the record

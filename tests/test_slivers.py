@@ -146,11 +146,13 @@ def test_check_against_dense_scan_real_record():
     height = 7.5
     rec = pulses.read_record(shared_record("RSN879_LANDERS_LCN345.AT2"))
     res = rocking.required_width(height, rec, rule="exact")
-    assert res.width == pytest.approx(0.593261, rel=1e-5)      # the verified width of today's search
-    x = np.linspace(res.width, min(2.0 * res.width, height * rec.pga / G), 4001)[1:]
+    w = res.search_width
+    assert w == pytest.approx(0.593261, rel=1e-5)      # the search's first transition
+    x = np.linspace(w, min(2.0 * w, height * rec.pga / G), 4001)[1:]
     f = _verdicts(height, rec, x)
-    assert f.any() and x[f].max() > 1.01 * res.width
-    assert res.widest_failing_width is not None and res.widest_failing_width >= 1.01 * res.width
+    assert f.any() and x[f].max() > 1.01 * w
+    assert res.widest_failing_width is not None and res.widest_failing_width >= 1.01 * w
+    assert res.width > res.widest_failing_width          # the design width lies above it
     assert 0.0 < res.failing_share < 0.2
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
                            model="reference", history=False)
@@ -174,7 +176,7 @@ def test_pipeline_reports_the_check(tmp_path):
     # failing widths (0.878 m verified, failing widths up to ~0.885 m)
     ver = rocking.required_width(7.5, pulses.read_record(path), rule="exact")
     width = math.ceil(ver.width * 1000) / 1000
-    assert ver.width <= width < ver.widest_failing_width
+    assert ver.search_width <= width < ver.widest_failing_width < ver.width
     assert main(["run", str(path), "--block", f"7.5x{width}", "--out", str(out), "-q"]) == 0
     row = next(csv.DictReader(open(out / "chaotic.csv")))
     assert float(row["verified_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
@@ -211,11 +213,11 @@ def test_check_uses_the_search_widths():
     first = check_widths(w, top, s, seed=3)
     for known, expect in ((seen, n_later), (None, n_later / k)):
         res = rocking.RequiredWidth(w, 7.5, "exact", 0, "test")
-        _add_check(res, top, flat, s, 3, known)
-        later = res.check_widths[~np.isin(res.check_widths, first)]
-        assert later.size == n_later and res.check_runs == s.check_runs
+        x, f, _ = _add_check(res, top, flat, s, 3, known)
+        later = x[~np.isin(x, first)]
+        assert later.size == n_later and x.size == s.check_runs
         in_bin = int(np.sum((later > edges[j]) & (later <= edges[j + 1])))
         # all later widths in that bin (the widths below w and above the span are left out);
         # without the search's widths, the even share of one bin (within one: largest remainders)
         assert abs(in_bin - expect) <= 1.0, (known is None, in_bin, expect)
-    assert res.widest_failing_width is None and res.failing_share == 0.0
+    assert not f.any()

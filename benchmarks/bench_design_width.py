@@ -1,0 +1,207 @@
+"""The design width against an independent dense grid, performance levels, and its sensitivity.
+
+    python benchmarks/bench_design_width.py                 # ~15 min on 2 busy cores; needs ../shared
+    python benchmarks/bench_design_width.py --heights 7.5   # one column height
+    python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
+
+For every real record of ../shared/records (``raw/`` and its sub-folders, and the horizontal
+components of ``peer_download/`` that are not in ``raw/``: the check was sized on ``raw/`` at
+7.5 m, so those and the other heights are records and columns it was not tuned on), and each
+column height, ``rocking.required_width(H, record, rule="exact")`` gives the search's first
+transition ``w`` (``search_width``, the former verified width) and the design width ``W``
+(``width``).  An independent dense grid of ``DENSE`` linear widths in ``(w, min(SPAN w, top)]``
+(``top``: the no-uplift width) counts the records with a failing width more than 1 % above ``w``
+(today's answer) and more than 1 % above ``W``.  With ``limit=0.5``: the design width ``W_R`` is
+run again (``rocking.simulate``): max|theta|/alpha <= 0.5, and ``W_R >= W``.  Runs per design
+width (search + check + refinement) are printed for both.
+
+``--sensitivity``: the design width with the check's seed changed (``SearchSettings.check_seed``,
+``SEEDS``) and with the restitution ``ETA_FACTORS`` times Eq. 5 at each width (capped at 1), for
+overturning and ``limit=0.5``: the spread of ``W`` relative to the package's own answer.
+"""
+from __future__ import annotations
+
+import os
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+SHARED = pathlib.Path(os.environ.get("ROCKING_RECORDS", ROOT.parent / "shared" / "records" / "raw"))
+HEIGHTS = (7.5, 6.0)
+DENSE = 6000
+#: the dense grid spans (w, min(SPAN w, top)], the same whatever the design width
+SPAN = 3.0
+LEVEL = 0.5
+SEEDS = (1, 2, 3, 4)
+ETA_FACTORS = (0.95, 0.975, 1.025, 1.05)
+
+
+def record_paths():
+    """The records: raw/*.AT2, raw/*/*.AT2 and the horizontal peer_download components not in raw."""
+    paths = sorted(SHARED.glob("*.AT2")) + sorted(SHARED.glob("*/*.AT2"))
+    have = {p.name for p in paths}
+    peer = SHARED.parent / "peer_download"
+    extra = [p for p in sorted(peer.glob("*.AT2"))
+             if p.name not in have and not any(k in p.stem for k in ("UP", "DWN"))]
+    return paths + extra
+
+
+def _verdicts(height, record, widths):
+    import rocking
+
+    res = rocking.simulate_many([rocking.Block.from_dimensions(height, float(b)) for b in widths], record)
+    return np.asarray(res.overturned, dtype=bool)
+
+
+def measure(paths, heights, settings=None):
+    import pulses
+    import rocking
+    from pulses import G
+    from rocking.search import DEFAULT_SETTINGS
+
+    settings = settings or DEFAULT_SETTINGS
+
+    rows = []
+    for path in paths:
+        record = pulses.read_record(str(path))
+        for H in heights:
+            t = time.perf_counter()
+            over = rocking.required_width(H, record, rule="exact", settings=settings)
+            t_over = time.perf_counter() - t
+            t = time.perf_counter()
+            half = rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
+            t_half = time.perf_counter() - t
+            w, W = over.search_width, over.width
+            top = H * record.pga / G
+            x = np.linspace(w, min(SPAN * w, top), DENSE + 1)[1:]
+            f = _verdicts(H, record, x)
+            widest = float(x[f].max()) if f.any() else None
+            ratio = rocking.simulate(rocking.Block.from_dimensions(H, half.width), record,
+                                     history=False).max_rotation_ratio
+            fx = x[f]
+            row = dict(record=path.stem, height=H, w=w, W=W, widest_dense=widest,
+                       far_old=bool(widest and widest > 1.01 * w),
+                       far_new=bool(widest and widest > 1.01 * W),
+                       # within the span the check covers: (w, 2 w] today, (W, 2 W] now
+                       far_old_2=bool(np.any((fx > 1.01 * w) & (fx <= 2.0 * w))),
+                       far_new_2=bool(np.any((fx > 1.01 * W) & (fx <= 2.0 * W))),
+                       runs=over.total_runs, runs_today=over.runs + over.check_runs,
+                       W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
+                       t_over=t_over, t_half=t_half)
+            rows.append(row)
+            print(f"{path.stem:28s} H {H:4.1f}: w {w:.4f} W {W:.4f} (+{(W / w - 1) * 100:5.2f} %) "
+                  f"dense widest {'-' if widest is None else f'{widest:.4f}'} | R=0.5 {half.width:.4f} "
+                  f"ratio {ratio:.3f} | runs {over.total_runs}/{half.total_runs} "
+                  f"{t_over:.1f}/{t_half:.1f} s", flush=True)
+    return rows
+
+
+def table(rows):
+    n = len(rows)
+    old = sum(r["far_old"] for r in rows)
+    new = sum(r["far_new"] for r in rows)
+    raised = sum(r["W"] > r["w"] for r in rows)
+    bad_half = [r for r in rows if r["ratio_half"] > LEVEL]
+    below = [r for r in rows if r["W_half"] < r["W"]]
+    runs = np.array([r["runs"] for r in rows])
+    today = np.array([r["runs_today"] for r in rows])
+    runs_h = np.array([r["runs_half"] for r in rows])
+    up = np.array([r["W"] / r["w"] - 1 for r in rows]) * 100
+    return [
+        f"{n} cases (records x heights); dense grid {DENSE} linear widths in (w, min({SPAN:g} w, top)].",
+        f"- failing widths more than 1 % above the search's answer w (today's width): {old} cases; "
+        f"more than 1 % above the design width W: {new} cases",
+        f"- within the check's span: failing widths in (1.01 w, 2 w]: "
+        f"{sum(r['far_old_2'] for r in rows)} cases; in (1.01 W, 2 W]: "
+        f"{sum(r['far_new_2'] for r in rows)} cases ("
+        + ", ".join(f"{r['record']} {r['height']:g} m" for r in rows if r["far_new_2"]) + ")",
+        f"- W above w on {raised} cases (median +{np.median(up[up > 0]) if raised else 0:.2f} %, "
+        f"max +{up.max():.2f} %)",
+        f"- limit {LEVEL}: max|theta|/alpha at W_R above {LEVEL} on {len(bad_half)} cases "
+        f"({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W on {len(below)}",
+        f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
+        f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
+        f"limit {LEVEL} median {np.median(runs_h):.0f} (max {runs_h.max()})",
+    ]
+
+
+class _ScaledEta:
+    """A stand-in for ``rocking.Block`` whose ``from_dimensions`` gives ``factor`` times Eq. 5's
+    restitution (capped at 1): the sensitivity to the restitution, measured without a new API."""
+
+    def __init__(self, block_cls, factor):
+        self.cls, self.factor = block_cls, factor
+
+    def from_dimensions(self, height, width, eta=None, **kw):
+        from rocking.block import eta_housner
+        import math
+
+        eta = min(1.0, self.factor * eta_housner(math.atan2(width, height))) if eta is None else eta
+        return self.cls.from_dimensions(height, width, eta, **kw)
+
+
+def sensitivity(paths, heights):
+    import pulses
+    import rocking
+    from rocking import widths as rw
+    from rocking.search import DEFAULT_SETTINGS
+
+    lines = ["| record | H (m) | level | W (m) | seeds: W / W0 - 1 (%) | restitution x "
+             + ", ".join(f"{f:g}" for f in ETA_FACTORS) + ": W / W0 - 1 (%) |", "|---|---|---|---|---|---|"]
+    for path in paths:
+        record = pulses.read_record(str(path))
+        for H in heights:
+            for level in (None, LEVEL):
+                base = rocking.required_width(H, record, rule="exact", limit=level).width
+                by_seed = [rocking.required_width(H, record, rule="exact", limit=level,
+                                                  settings=DEFAULT_SETTINGS.replace(check_seed=s)).width
+                           for s in SEEDS]
+                by_eta = []
+                for factor in ETA_FACTORS:
+                    real = rw.Block
+                    rw.Block = _ScaledEta(real, factor)
+                    try:
+                        by_eta.append(rocking.required_width(H, record, rule="exact", limit=level).width)
+                    finally:
+                        rw.Block = real
+                pct = lambda v: " ".join(f"{(x / base - 1) * 100:+.2f}" for x in v)
+                lines.append(f"| {path.stem} | {H:g} | {'overturn' if level is None else level} | "
+                             f"{base:.4f} | {pct(by_seed)} | {pct(by_eta)} |")
+                print(lines[-1], flush=True)
+    return lines
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    heights = HEIGHTS
+    if "--heights" in argv:
+        heights = tuple(float(h) for h in argv[argv.index("--heights") + 1].split(","))
+    if not SHARED.is_dir():
+        print(f"no records at {SHARED} (set $ROCKING_RECORDS)")
+        return 1
+    paths = record_paths()
+    if "--only" in argv:
+        only = set(argv[argv.index("--only") + 1].split(","))
+        paths = [p for p in paths if p.stem in only]
+    if "--sensitivity" in argv:
+        print("\n".join(sensitivity(paths, heights)))
+        return 0
+    settings = None
+    if "--settings" in argv:       # e.g. --settings check_rounds=3,check_runs=1500
+        from rocking.search import DEFAULT_SETTINGS
+
+        pairs = (kv.split("=") for kv in argv[argv.index("--settings") + 1].split(","))
+        settings = DEFAULT_SETTINGS.replace(**{k: type(getattr(DEFAULT_SETTINGS, k))(v) for k, v in pairs})
+    print("\n".join(table(measure(paths, heights, settings))))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

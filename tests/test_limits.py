@@ -1,0 +1,102 @@
+"""The design width (no width the package found failing lies above it) and performance levels
+(``limit``: max|theta|/alpha <= R) of ``rocking.required_width`` and ``rocking.critical_scale``,
+checked against independent runs of ``rocking.simulate``."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import pulses
+import rocking
+from rocking import Block
+from rocking.search import DEFAULT_SETTINGS, check_limit
+
+from .conftest import shared_record
+from .vertical_cases import DOWNLOAD
+
+
+def _ratio(height, width, record, vertical=None):
+    res = rocking.simulate(Block.from_dimensions(height, width), record, vertical=vertical,
+                           history=False)
+    return bool(res.overturned), float(res.max_rotation_ratio)
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.5, 1.01, float("nan"), "half"])
+def test_limit_out_of_range_is_refused(bad):
+    with pytest.raises(ValueError, match="limit"):
+        check_limit(bad)
+    with pytest.raises(ValueError, match="limit"):
+        rocking.required_width(7.5, pulses.Record(np.zeros(10), 0.01), rule="exact", limit=bad)
+
+
+def test_design_width_is_above_every_failing_width():
+    """Kern County, Taft 021 (real, 7.5 m): the check finds a failing width 10 % above the
+    search's first transition (0.5836 m against 0.6427 m); the design width lies just above it
+    (bisected to design_rtol), survives, and its own failing end overturns."""
+    rec = pulses.read_record(shared_record("RSN15_KERN_TAF021.AT2"))
+    res = rocking.required_width(7.5, rec, rule="exact")
+    assert res.widest_failing_width is not None
+    assert res.widest_failing_width > 1.05 * res.search_width       # far above the search's answer
+    assert res.widest_failing_width < res.width
+    # refined just above it: within design_rtol (plus one bisection step)
+    assert res.width - res.widest_failing_width <= 2 * DEFAULT_SETTINGS.design_rtol * res.width
+    assert not _ratio(7.5, res.width, rec)[0]
+    assert _ratio(7.5, res.widest_failing_width, rec)[0]
+    # every width the check ran above the design width survived
+    assert not res.check_failed[res.check_widths > res.width].any()
+    assert 0 < res.refine_runs <= 25 and res.total_runs == res.runs + res.check_runs + res.refine_runs
+
+
+def test_level_half():
+    """limit=0.5 on Pacoima Dam 164 (real, 7.5 m): the design width keeps max|theta|/alpha <= 0.5
+    under the record (an independent run), a width 0.1 % narrower exceeds it or a failing width
+    found lies just below, and it is at least the overturning design width."""
+    rec = pulses.read_record(shared_record("RSN77_SFERN_PUL164.AT2"))
+    over = rocking.required_width(7.5, rec, rule="exact")
+    half = rocking.required_width(7.5, rec, rule="exact", limit=0.5)
+    assert half.limit == 0.5 and over.limit is None
+    toppled, ratio = _ratio(7.5, half.width, rec)
+    assert not toppled and ratio <= 0.5
+    assert half.width >= over.width
+    assert _ratio(7.5, half.search_width * (1 - 1e-6), rec)[1] > 0.5 or half.widest_failing_width
+    # the same budget of runs as overturning (search + check + refinement)
+    assert half.total_runs <= 2100 and over.total_runs <= 2100
+
+
+def test_vertical_governs_the_design():
+    """With a vertical (the PEER download's Pacoima Dam, 7.5 m): the answer is the wider of the
+    horizontal-only and the with-vertical designs, and says which; passing the horizontal answer
+    gives the same result without recomputing it."""
+    h1 = pulses.read_record(str(DOWNLOAD / "RSN77_SFERN_PUL164.AT2")) if DOWNLOAD.is_dir() else None
+    if h1 is None:
+        pytest.skip(f"the PEER download is absent: {DOWNLOAD}")
+    h2 = pulses.read_record(str(DOWNLOAD / "RSN77_SFERN_PUL254.AT2"))
+    v = pulses.read_record(str(DOWNLOAD / "RSN77_SFERN_PULDWN.AT2"))
+    h1, h2, up = pulses.check_triplet(h1, h2, v, "RSN77_SFERN_PULDWN.AT2")
+    for rec in (h1, h2):
+        alone = rocking.required_width(7.5, rec, rule="exact")
+        both = rocking.required_width(7.5, rec, rule="exact", vertical=up, horizontal=alone)
+        assert both.horizontal_width == alone.width
+        assert both.width == max(both.horizontal_width, both.vertical_width)
+        assert both.governed_by == ("with vertical" if both.vertical_width > alone.width else "horizontal")
+        assert not _ratio(7.5, both.width, rec, vertical=up)[0]
+        assert not _ratio(7.5, both.width, rec)[0]
+
+
+@pytest.mark.parametrize("limit", [0.5, 0.1])
+def test_critical_scale_for_a_level(limit):
+    """The scale at which max|theta|/alpha first exceeds R (Pacoima Dam 164 on a 7.5 x 1.8 m
+    column): just below it the ratio is at most R, at it above R (independent runs); below the
+    overturning scale."""
+    rec = pulses.read_record(shared_record("RSN77_SFERN_PUL164.AT2"))
+    block = Block.from_dimensions(7.5, 1.8)
+    cs = rocking.critical_scale(block, rec, limit=limit)
+    assert cs.limit == limit and cs.scale is not None
+    below = rocking.simulate(block, rec.scaled(cs.scale * (1 - 1e-5)), history=False)
+    at = rocking.simulate(block, rec.scaled(cs.scale), history=False)
+    assert below.max_rotation_ratio <= limit < at.max_rotation_ratio
+    assert cs.scale < rocking.critical_scale(block, rec).scale
+    with pytest.raises(ValueError, match="limit"):
+        rocking.fragility([cs, cs], limit=None)
+    assert rocking.fragility([cs, rocking.critical_scale(block, rec.scaled(0.8), limit=limit)],
+                             limit=limit).limit == limit
