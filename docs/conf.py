@@ -54,6 +54,7 @@ numpydoc_xref_param_type = False
 autodoc_member_order = "bysource"
 autodoc_default_options = {"members": True, "undoc-members": False}
 autosummary_generate = True
+autodoc_preserve_defaults = True  # settings=DEFAULT_SETTINGS, not its long repr
 autosummary_imported_members = False
 
 # the examples: the doctest directives of the pages and the Examples sections of the docstrings
@@ -72,6 +73,9 @@ sphinx_gallery_conf = {
     "matplotlib_animations": False,
     "image_scrapers": ("matplotlib",),
     "show_memory": False,
+    # each API page shows the gallery examples that use its name (docs/_templates/autosummary)
+    "doc_module": ("pulses", "rocking", "pipeline"),
+    "backreferences_dir": "api/backrefs",
 }
 
 # intersphinx to the libraries the package builds on, only where the inventory answers: offline
@@ -102,7 +106,8 @@ if intersphinx_mapping:
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"rocking-columns {release}"
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["wide.css"]
 html_theme_options = {
     "show_toc_level": 2,
     "navigation_with_keys": False,

@@ -136,6 +136,9 @@ def test_docs_build_without_warnings(site):
         page = (html / "gallery" / f"{ex.stem}.html").read_text(encoding="utf-8")
         assert f"sphx_glr_{ex.stem}_001.png" in page, ex.stem
         assert (html / "_images" / f"sphx_glr_{ex.stem}_001.png").is_file(), ex.stem
+    # an API page shows the gallery's examples that use its name, with their figures
+    page = (html / "api" / "generated" / "rocking.required_width.html").read_text(encoding="utf-8")
+    assert "Gallery examples using it" in page and "sphx_glr_plot_width_vs_height_thumb.png" in page
     # the maths comes with the site, not from a CDN
     theory = (html / "theory.html").read_text(encoding="utf-8")
     assert "_static/mathjax/tex-chtml.js" in theory and "cdn" not in theory.lower()
