@@ -171,7 +171,13 @@ def parse_block(text: str) -> tuple[float, float]:
         height, width = float(parts[0]), float(parts[1])
     except ValueError:
         raise ArgumentError(f"--block expects HEIGHTxWIDTH in m, such as 7.5x1.8; got {text!r}") from None
-    return _size(height, "block height (m)"), _size(width, "block width (m)")
+    height, width = _size(height, "block height (m)"), _size(width, "block width (m)")
+    if width > height:  # a column wider than high is allowed, but likelier the two swapped
+        import sys
+
+        print(f"pipeline: warning: --block {text} is {width:g} m wide and {height:g} m high (HEIGHTxWIDTH); "
+              f"did you mean {parts[1]}x{parts[0]}?", file=sys.stderr)
+    return height, width
 
 
 def parse_length(text: str, what: str = "length (m)") -> float:

@@ -407,17 +407,19 @@ def _verified_fields(col: Column, ver) -> dict:
 
 
 CHECK_COLUMNS = Columns(
-    ("failing_share", "-", "Resolution of the verified width (docs/slivers.md): the verified width is the "
-                           "smallest width above which every width the search examined survives; near "
-                           "it the response is chaotic and failing slivers thinner than the search's "
-                           "0.05 % grid may lie above it. After the search, a check runs `check_runs` "
-                           "jittered widths (seeded from the record, off the search's grid) from the "
-                           "verified width up to twice it or the no-uplift width (height x PGA / g), "
-                           "whichever is smaller, half of them log-spaced just above it: this is the "
-                           "share of them that overturn (0: none did; blank: no check)."),
-    ("widest_failing_width_m", "m", "The widest width the check found to overturn (a failing sliver "
-                                    "above the verified width; blank where none was found, which "
-                                    "does not prove there is none)."),
+    ("failing_share", "-", "What the check above the search width found (docs/slivers.md): near the "
+                           "search's first transition (`search_width_m`) the response is chaotic and "
+                           "failing slivers thinner than the search's 0.05 % grid may lie above it. "
+                           "After the search, a check runs `check_runs` jittered widths (seeded from "
+                           "the record, off the search's grid) in two rounds, each from the design "
+                           "width so far up to twice it or the no-uplift width (height x PGA / g), "
+                           "whichever is smaller: this is the share of them that fail (0: none did; "
+                           "blank: no check). The design width `verified_width_m` lies just above the "
+                           "widest failing width found."),
+    ("widest_failing_width_m", "m", "The widest width the search or the check found to fail above "
+                                    "the search width (a failing sliver; blank where none was found, "
+                                    "which does not prove there is none); the design width lies just "
+                                    "above it."),
     ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width."),
 )
 

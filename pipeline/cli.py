@@ -16,8 +16,38 @@ COMMANDS = ["simulate", "fit", "convert", "design", "spectrum", "chart", "run", 
 
 
 class _Parser(argparse.ArgumentParser):
+    #: every option string of the command and its sub-commands, for the suggestions of :func:`suggestion`
+    known_options: set = set()
+
+    def add_argument(self, *names, **kwargs):
+        _Parser.known_options.update(n for n in names if isinstance(n, str) and n.startswith("--"))
+        return super().add_argument(*names, **kwargs)
+
     def error(self, message):  # one line and exit status 2, as argparse does, without usage noise
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {message}{suggestion(message, _Parser.known_options)}\n")
+
+
+def suggestion(message: str, options) -> str:
+    """``; did you mean 'run'?`` for a mistyped sub-command, or ``--block`` for a mistyped option
+    (among ``options``); blank when nothing is close."""
+    import difflib
+    import re
+
+    m = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+    if m:
+        choices = re.findall(r"'([^']*)'", m.group(2))
+        close = difflib.get_close_matches(m.group(1), choices, n=1, cutoff=0.6)
+        return f"; did you mean {close[0]!r}?" if close else ""
+    m = re.search(r"unrecognized arguments: (.*)", message)
+    if not m:
+        return ""
+    out = []
+    for word in m.group(1).split():
+        if word.startswith("--"):
+            close = difflib.get_close_matches(word.split("=", 1)[0], sorted(options), n=1, cutoff=0.7)
+            if close:
+                out.append(f"{close[0]} for {word}")
+    return f"; did you mean {', '.join(out)}?" if out else ""
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -34,8 +34,23 @@ def add_parser(subparsers):
     p.add_argument("--lam", default="1.0", help="lambda of Eq. 20 (default 1)")
     p.add_argument("--criterion", default="overturn", choices=["overturn", "exceed"],
                    help="exact answer: failure is overturning (default) or |theta| > alpha")
+    p.add_argument("--limit", metavar="R", default=None,
+                   help="also the exact width for the performance level max|theta|/alpha <= R, "
+                        "0 < R <= 1 (docs/design.md)")
     p.add_argument("--json", action="store_true", help="print the results as JSON")
     p.set_defaults(func=run)
+
+
+def _limit(args):
+    if args.limit is None:
+        return None
+    try:
+        value = float(args.limit)
+    except ValueError:
+        raise ArgumentError(f"--limit: expected a number in (0, 1], got {args.limit!r}") from None
+    if not 0.0 < value <= 1.0:
+        raise ArgumentError(f"--limit (max|theta|/alpha) must lie in (0, 1], got {args.limit!r}")
+    return value
 
 
 def _pulse(args):
@@ -65,6 +80,7 @@ def run(args) -> int:
 
     pulse, origin = _pulse(args)
     lam = parse_positive(args.lam, "--lam")
+    limit = _limit(args)
     if args.block is not None:
         height, width = parse_block(args.block)
         block = rocking.Block.from_dimensions(height, width)
@@ -100,6 +116,14 @@ def run(args) -> int:
         rules.setdefault(name, {})
         rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
                             "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
+    names = ["eq31", "eq20", "envelope", "exact"]
+    if limit is not None:
+        w = rocking.required_width(height, pulse, rule="exact", limit=limit)
+        rules["level"] = {"limit": limit, "required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
+                          "p_at_width": w.p, "iterations": w.iterations, "method": w.method}
+        if block is not None:
+            rules["level"].update(min_tan_alpha=w.tan_alpha, adequate=bool(width >= w.width))
+        names.append("level")
     out["rules"] = rules
     if args.json:
         json.dump(out, sys.stdout, indent=2)
@@ -114,13 +138,14 @@ def run(args) -> int:
               f"pTp = {b['pTp']:.4g}")
     labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})",
               "envelope": f"envelope ({pulse.shape})",
-              "exact": f"exact ({args.criterion})"}
+              "exact": f"exact ({args.criterion})",
+              "level": f"exact (level {limit:g})" if limit is not None else ""}
     head = f"{'rule':<22}"
     if block is not None:
         head += f"{'min tan(alpha)':>15}  {'adequate':>8}"
     head += f"  {'required width (m)':>19} for H = {height:g} m"
     print(head)
-    for name in ("eq31", "eq20", "envelope", "exact"):
+    for name in names:
         r = rules[name]
         line = f"{labels[name]:<22}"
         if block is not None:
@@ -131,7 +156,8 @@ def run(args) -> int:
         isl = ", ".join(f"{lo:.4f}-{hi:.4f}" for lo, hi in out["exact_safe_islands"])
         print(f"safe islands below the exact minimum (tan alpha): {isl}")
     print("Required widths solve B = H tan(alpha_min(p(B))), p depending on B; "
-          "exact: smallest width surviving at it and every larger width.")
+          "exact: smallest width surviving at it and every larger width"
+          + (f"; level: max|theta|/alpha <= {limit:g} there." if limit is not None else "."))
     lo, hi = rocking.design.ENVELOPE_RANGE["ap/g"]
     ptp_lo, ptp_hi = rocking.design.ENVELOPE_RANGE["pTp"]
     ptps = [rules["envelope"]["p_at_width"] * pulse.tp]

@@ -48,6 +48,10 @@ def add_parser(subparsers) -> None:
                    help="record files (any format pulses.read_record reads: SAC, AT2, MiniSEED, text "
                         "...), folders of them, or PEER NGA-West2 downloads (a .zip, or a folder "
                         "holding _SearchResults.csv; see docs/peer.md)")
+    p.add_argument("--glob", metavar="PATTERN",
+                   help="folders given: take exactly their files whose names match this shell pattern "
+                        "(e.g. '*.AT2'); by default every file but those plainly not records "
+                        "(README, documents, images), which are named in one line")
     p.add_argument("--block", action="append", default=[], metavar="HxW",
                    help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
@@ -114,14 +118,29 @@ def main(args) -> int:
     args.pair = list(args.pair) + [[a, b] for a, b in triplets]  # a triplet's horizontals are a pair
     if not args.records and not args.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
-    downloads, others = peer_inputs.split_inputs(args.records)
-    paths = [p for p in expand_inputs(others) if p not in set(triplets.values())]
+    downloads, others = peer_inputs.split_inputs(args.records, args.format)
+    skipped = []
+    paths = [p for p in expand_inputs(others, skipped, args.glob) if p not in set(triplets.values())]
+    if skipped and not args.quiet:
+        import sys
+
+        from .report import display
+
+        shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
+        print(f"pipeline run: note: {len(skipped)} file(s) of the folders skipped, plainly not records "
+              f"({shown}); name a file to read it as a record, or choose files with --glob", file=sys.stderr)
     if not paths and not args.pair and not downloads:
         from .report import display
 
         raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
                             "(a folder gives the files directly in it)")
-    tasks = pairs.tasks_from_args(args, downloads, paths, columns, options)
+    if paths and not downloads and not args.pair and not any(os.path.lexists(p) for p in paths):
+        from .report import display
+
+        shown = ", ".join(map(display, paths[:3])) + (f" and {len(paths) - 3} more" if len(paths) > 3 else "")
+        raise ArgumentError(f"none of the inputs exists ({shown}): nothing to do, nothing written")
+    absent = [] if downloads else None  # the search's records not in the download: listed, not failed
+    tasks = pairs.tasks_from_args(args, downloads, paths, columns, options, absent)
     if tasks is not None and args.vertical == "auto":
         found = {}
         if args.pairs == "auto":
@@ -132,5 +151,6 @@ def main(args) -> int:
             found = vertical.auto_verticals(rest, _ro(args), say)
         tasks = vertical.attach(tasks, {**found, **triplets})
     summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
-                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log)
+                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log,
+                  lists={peer_inputs.NOT_DOWNLOADED: peer_inputs.not_downloaded_text(absent)})
     return summary.exit_code

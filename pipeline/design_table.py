@@ -46,7 +46,9 @@ DESIGN_COLUMNS = Columns(
                                     "after the search (over the directions; docs/slivers.md); blank where "
                                     "none was found, which does not prove there is none."),
     ("survives_vertical", "-", "The column as it stands does not overturn with the record's vertical "
-                               "component too (in any direction of a pair); blank without a vertical."),
+                               "component too (in any direction of a pair); blank without a vertical. "
+                               "False also where the block lifts off (`vertical_lift_off_s`): the "
+                               "response stops there, and nothing shows that the column survives."),
     ("search_width_m", "m", "Diagnostic: the search's first transition in the governing direction, "
                             "before the check above it (docs/slivers.md); the design width is at least this."),
     ("design_governed_by", "-", "`horizontal` or `with vertical`: which motion sets the design width "
@@ -58,6 +60,10 @@ DESIGN_COLUMNS = Columns(
                      "R), `NO: safe island` (it survives but is narrower than the design width: a "
                      "wider column fails); blank for `--height`."),
     ("check_runs", "-", "Widths the check ran above the search width in the governing direction."),
+    ("vertical_lift_off_s", "s", "Earliest time at which g + av < 0 before the response ended, over "
+                                 "the directions: the block leaves the ground, which the rocking model "
+                                 "does not describe (its own verdict, `lifts off at t s`); blank when "
+                                 "it never does."),
 )
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
 
@@ -138,13 +144,17 @@ def design_rows(rows, failed=None) -> list[dict]:
             "widest_failing_width_m": _widest([r.get("widest_failing_width_m") for r in group],
                                               above=number(gov.get("search_width_m"))),
             "survives_vertical": (None if not block else _bool_all(
-                [None if r.get("vertical_overturns") is None else not r["vertical_overturns"] for r in group])),
+                [None if r.get("vertical_overturns") is None else not (r["vertical_overturns"] or r.get("vertical_lifts_off"))
+                 for r in group])),
             "search_width_m": gov.get("search_width_m"), "design_governed_by": gov.get("design_governed_by"),
             "design_limit": limit,
             "eq31_below_design": None if (w31 is None or wd is None) else w31 < wd,
             "check_runs": gov.get("check_runs"),
             "verdict": None if survives is None else verdict_text({"survives": survives,
                                                                    "verified_adequate": adequate}),
+            "vertical_lift_off_s": (None if not block else min(
+                [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
+                 if t is not None], default=None)),
         })
         out.append(row)
     return out
@@ -261,7 +271,12 @@ def search_text(row) -> str:
     return f"{w:.3f} m" + (f" ({excess})" if excess else "")
 
 
-def _vertical_text(row) -> str:
+def vertical_text(row) -> str:
+    """The verdict with the vertical: ``yes``, ``NO``, ``lifts off at 2.31 s`` (never ``yes``: the
+    rocking model stops where the block leaves the ground) or ``-``."""
+    t = number(row.get("vertical_lift_off_s"))
+    if t is not None:
+        return f"lifts off at {t:.2f} s"
     return _yes(row.get("survives_vertical"), no="NO")
 
 
@@ -318,7 +333,7 @@ def table_text(rows, failures=(), summary=()) -> str:
             if w is not None:
                 widths[key] = max(w, widths.get(key, w))
         headers = HEADERS + (VERTICAL_HEADER,)
-        body = [c + (_vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
+        body = [c + (vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
                                           if (r["record"], r.get("column")) in widths else ""),)
                 for c, r in zip(body, rows)]
     body = _align_failing(body, FAILS_COLUMN)

@@ -17,7 +17,7 @@ import urllib.parse
 
 from . import report
 from .design_table import (eq31_text, failing_text, metadata_text, pulse_text, search_text,
-                           survives_text, verdict_lines, fine_print)
+                           survives_text, verdict_lines, fine_print, vertical_text)
 from .design_table import number as _num
 from .report import FIT_TOLERANCE
 
@@ -115,7 +115,8 @@ def _href(rel: str) -> str:
 
 
 def _anchor(record_id) -> str:
-    return "r-" + urllib.parse.quote(report.display(record_id), safe="").replace("%", "_")
+    # "_" escaped too: "a+b" (a%2Bb) and "a_2Bb" were one anchor
+    return "r-" + urllib.parse.quote(report.display(record_id), safe="").replace("_", "%5F").replace("%", "_")
 
 
 def _batch_table(design, anchors) -> list[str]:
@@ -151,7 +152,7 @@ def _batch_table(design, anchors) -> list[str]:
                     failing_text(r.get("widest_failing_width_m"), r.get("search_width_m"), unit=""), numeric=True)
             + _cell(r["width_m"], _fixed(r["width_m"]), numeric=True)
             + _cell(surv if r["survives"] is not None else None, surv)
-            + (_cell(r.get("survives_vertical"), _yes(r.get("survives_vertical"))) if vertical else "")
+            + (_cell(r.get("survives_vertical"), vertical_text(r)) if vertical else "")
             + _cell(r["max_theta_ratio"], "overturned" if r.get("survives") is False and r.get("verdict") == "NO"
                     and (_num(r["max_theta_ratio"]) or 0) > 1 else _fixed(r["max_theta_ratio"]), numeric=True)
             + "</tr>")
@@ -217,10 +218,13 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                 parts.append(f"as it stands: {verdict.get(surv, surv)}"
                              + ("" if r.get("overturns") else f", max theta/alpha {_fixed(r.get('max_theta_ratio')) or '-'}"))
                 if r.get("vertical_overturns") is not None:
-                    parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): "
-                                 + ("overturns" if r["vertical_overturns"] else "survives")
-                                 + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}"
-                                 + (" (the block lifts off the ground)" if r.get("vertical_lifts_off") else ""))
+                    lift = _num(r.get("vertical_t_lift_off_s")) if r.get("vertical_lifts_off") else None
+                    said = ("overturns" if r["vertical_overturns"] else
+                            "survives" if lift is None else
+                            f"lifts off at {lift:.2f} s (the ground falls faster than gravity: the rocking "
+                            "model stops there, no verdict)")
+                    parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): {said}"
+                                 + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}")
             out.append(f"<li>{_e('; '.join(parts))}</li>")
         out.append("</ul>")
     if failure:

@@ -79,9 +79,25 @@ def _same(path, others) -> str | None:
     return None
 
 
+def special_file(path) -> str | None:
+    """What ``path`` is when it is a FIFO, a device or a socket (by :func:`os.stat`, following
+    links, without opening it: opening a FIFO blocks until a writer comes), else None."""
+    import stat
+
+    from pulses.io import special_kind
+
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None
+    return None if stat.S_ISREG(mode) or stat.S_ISDIR(mode) else special_kind(mode)
+
+
 def is_ours(path, kind: str) -> bool:
     """Whether the existing file at ``path`` may be replaced (appended to, for a log) by an output
     of ``kind``: empty, or marked as this package writes that kind."""
+    if special_file(path):
+        return False
     test = KINDS[kind]
     if test is None:
         return True
@@ -106,6 +122,9 @@ def check_output_file(path, what: str, kind: str, *, inputs=(), reserved=(), com
     path = pathlib.Path(text)
     if path.is_dir():
         raise ArgumentError(f"{what} {display(path)} is a folder; name a file")
+    special = special_file(path)
+    if special:
+        raise ArgumentError(f"{what} {display(path)} is {special}, not a file: name a regular file")
     same = _same(path, inputs)
     if same is not None:
         raise ArgumentError(f"{what} {display(path)} is one of the input records ({display(same)}); "

@@ -28,7 +28,7 @@ MAX_DIRECTIONS = 180
 
 
 # -- the command line --------------------------------------------------------------------------------
-def tasks_from_args(args, downloads, paths, columns, options):
+def tasks_from_args(args, downloads, paths, columns, options, absent: list | None = None):
     """Every task of ``pipeline run``: the files' (one per file, or pairs), then the PEER downloads';
     None when there are no pairs, scales or downloads (the runner's own tasks, one per file)."""
     if not downloads:
@@ -45,7 +45,8 @@ def tasks_from_args(args, downloads, paths, columns, options):
         others = _file_tasks(args, paths, columns, options)
         if others is None:
             others = make_tasks(paths, columns, options)
-    return combine(others, peer_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say))
+    return combine(others, peer_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say,
+                                      absent))
 
 
 def _file_tasks(args, paths, columns, options):
@@ -228,15 +229,17 @@ def _both_readable(a, b, opts) -> bool:
 
 
 # -- PEER downloads ---------------------------------------------------------------------------------
-def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_scales: bool, say):
+def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_scales: bool, say,
+               absent: list | None = None):
     """The tasks of the PEER downloads: each complete record a pair in every direction
     (:func:`directions`), each incomplete one a task that fails when read, with the
-    reason.  Indices and record ids are set by :func:`combine`."""
+    reason; the records not downloaded at all go to ``absent``, when given
+    (:func:`pipeline.peer_inputs.record_units`).  Indices and record ids are set by :func:`combine`."""
     from pulses import RecordError, check_pair
 
     tasks = []
     for download in downloads:
-        for entry, src in peer_inputs.record_units(download, peer_scales, say):
+        for entry, src in peer_inputs.record_units(download, peer_scales, say, absent):
             if entry is None:  # the download itself cannot be read: one failure for it
                 tasks.append(Task(0, _download_stem(download) + ".zip", download, tuple(columns), options,
                                   peer=src))
@@ -244,7 +247,7 @@ def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_sc
             d = peer_inputs.open_download(download)
             path1, path2 = d.display(src.h1), d.display(src.h2) if src.h2 else None
             pname = pair_name(path1, path2 or path1)
-            k = float(entry.metadata.get("scale_factor") or 1.0) if peer_scales else 1.0
+            k = peer_inputs.scale_of(entry) if (peer_scales and not src.missing) else 1.0
             names = [path1, pname, f"RSN{entry.rsn}", src.h1 or ""]
             if scales is not None:
                 k *= _scale_for(scales, 1.0, names)
@@ -272,9 +275,33 @@ def _download_stem(path) -> str:
     return os.path.splitext(os.path.basename(os.path.normpath(str(path))))[0] or "download"
 
 
+def _distinct_pairs(tasks) -> list:
+    """``tasks`` with one pair name per pair of files: two pairs of the same file names (two PEER
+    downloads holding ``A000.AT2`` and ``A090.AT2``) were one pair of reports, one download's
+    metadata with the other's numbers; the later one becomes ``NAME-2``."""
+    owner, renamed = {}, {}
+    for t in tasks:
+        if t.pair is None or (t.pair, t.path, t.path2) in renamed:
+            continue
+        name, k = t.pair, 1
+        while owner.get(name.lower(), (t.path, t.path2)) != (t.path, t.path2):
+            k += 1
+            name = f"{t.pair}-{k}"
+        owner[name.lower()] = (t.path, t.path2)
+        renamed[(t.pair, t.path, t.path2)] = name
+    out = []
+    for t in tasks:
+        new = renamed.get((t.pair, t.path, t.path2), t.pair) if t.pair is not None else None
+        if new != t.pair:
+            rid = new + t.record_id[len(t.pair):] if t.record_id.startswith(t.pair) else t.record_id
+            t = dataclasses.replace(t, pair=new, record_id=rid)
+        out.append(t)
+    return out
+
+
 def combine(*groups) -> list:
     """Tasks of several sources as one batch: indices in order, record ids unique over all."""
-    tasks = [t for g in groups for t in g]
+    tasks = _distinct_pairs([t for g in groups for t in g])
     # a PEER task's id is still its name with an extension (``.dir``); the others' are final
     names = [t.record_id if t.peer is not None else t.record_id + ".id" for t in tasks]
     ids = record_ids(names)

@@ -53,7 +53,8 @@ class PeerSource:
     """Where a task's ground motion comes from in a PEER download (plain, picklable data).
 
     ``download`` is the zip or folder as given; ``h1``, ``h2``, ``vertical`` the file names the
-    report lists; ``missing`` why the record cannot be read (blank when it can); ``fields`` the
+    report lists (``vertical`` None when it is not in the download, ``vertical_note`` then says
+    so); ``missing`` why the record cannot be read (blank when it can); ``fields`` the
     :data:`PEER_COLUMNS` values and ``tp`` PEER's pulse period.
     """
 
@@ -64,6 +65,7 @@ class PeerSource:
     missing: str = ""
     fields: tuple = ()
     tp: float | None = None
+    vertical_note: str = ""
 
     def inputs(self) -> list[str]:
         """The files whose content the record's results depend on (for :mod:`pipeline.resume`)."""
@@ -79,13 +81,15 @@ def add_options(parser) -> None:
                              "(_SearchResults.csv); by default records are designed as recorded")
 
 
-def split_inputs(items) -> tuple[list[str], list[str]]:
-    """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``."""
+def split_inputs(items, format: str | None = None) -> tuple[list[str], list[str]]:
+    """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``.
+    With ``--format`` given, every file is a record of that format (a zip is no download)."""
     from pulses.peer import is_peer_download
 
     downloads, others = [], []
     for item in items:
-        (downloads if is_peer_download(str(item)) else others).append(str(item))
+        plain_file = format is not None and not os.path.isdir(item)
+        (downloads if not plain_file and is_peer_download(str(item)) else others).append(str(item))
     return downloads, others
 
 
@@ -114,8 +118,67 @@ def _fields(entry, scaled: bool) -> tuple:
     return tuple(PEER_COLUMNS.row(values).items())
 
 
-def record_units(download, scaled: bool, say) -> list[tuple]:
-    """``(entry, PeerSource)`` for every record the report lists, in its order."""
+def scale_of(entry) -> float:
+    """The search's scale factor of ``entry``, checked by the one rule of every scale
+    (:func:`pipeline.args.parse_scale`); :class:`ArgumentError` when it is missing or outside it
+    (a factor of 1e6, 0 or nan was applied, or silently taken as 1)."""
+    from .args import ArgumentError, parse_scale
+
+    factor = entry.metadata.get("scale_factor")
+    what = f"RSN {entry.rsn}: --peer-scales: the search's scale factor (_SearchResults.csv, line {entry.line})"
+    if factor is None:
+        raise ArgumentError(f"{what} is missing (blank, '-' or not finite): the record is not "
+                            "designed rather than designed unscaled")
+    return parse_scale(repr(float(factor)), what)
+
+
+def _why_not(d, e, scaled: bool) -> str:
+    """Why the record ``e`` of download ``d`` cannot be designed (blank: it can)."""
+    from .args import ArgumentError
+
+    if e.h1 is None or e.h2 is None:
+        return f"RSN {e.rsn}: the search report lists no {'Horizontal-1' if e.h1 is None else 'Horizontal-2'} file"
+    lacking = [f for f in (e.h1, e.h2) if d.find(f) is None]
+    if lacking:
+        reasons = [d.refusal(f) for f in lacking]
+        named = ", ".join(f + (f" ({r})" if r else "") for f, r in zip(lacking, reasons))
+        return f"RSN {e.rsn}: listed in _SearchResults.csv (line {e.line}) but not in the download: {named}"
+    if d.find(e.h1) == d.find(e.h2) or e.h1.casefold() == e.h2.casefold():
+        return (f"RSN {e.rsn}: _SearchResults.csv (line {e.line}) names one file, {e.h1}, as both "
+                "horizontal components: a pair is two components (it would double the record in one "
+                "direction and cancel it in the other)")
+    if scaled:
+        try:
+            scale_of(e)
+        except ArgumentError as exc:
+            return str(exc)
+    return ""
+
+
+#: the list, in ``--out``, of the records a search report lists that are not in the download
+NOT_DOWNLOADED = "peer-not-downloaded.csv"
+NOT_DOWNLOADED_FIELDS = ["download", "peer_rsn", "line", "peer_event", "peer_station", "h1", "h2", "vertical"]
+
+
+def not_downloaded_text(rows) -> str | None:
+    """The text of :data:`NOT_DOWNLOADED` (None when no download was given)."""
+    from .report import csv_text
+
+    return None if rows is None else csv_text(NOT_DOWNLOADED_FIELDS, rows)
+
+
+def _absent(d, e) -> bool:
+    """Not one file of record ``e`` is in download ``d`` (none refused either): a record of the
+    search that was not downloaded, the usual case (PEER's zip holds the records ticked)."""
+    return bool(e.files) and all(d.find(f) is None and d.refusal(f) is None for f in e.files)
+
+
+def record_units(download, scaled: bool, say, absent: list | None = None) -> list[tuple]:
+    """``(entry, PeerSource)`` for every record the report lists, in its order; a record line the
+    report's parser set aside is ``(None, PeerSource)`` failing with its reason.  A vertical
+    that is not in the download is no reason to fail the record: it is not used (the row says why).
+    With ``absent`` (a list), the records none of whose files is in the download are appended to
+    it as rows of :data:`NOT_DOWNLOADED` instead of being failures."""
     from pulses import RecordError
 
     try:
@@ -123,37 +186,47 @@ def record_units(download, scaled: bool, say) -> list[tuple]:
     except RecordError as exc:
         return [(None, PeerSource(download, None, None, missing=str(exc)))]
     entries = d.search.entries
-    units = []
-    n_missing = 0
+    units = [(None, PeerSource(download, None, None, missing=why)) for _, why in d.search.rejected]
+    n_missing = len(units)
+    n_absent = 0
     for e in entries:
-        lacking = d.missing(e)
-        why = ""
-        if e.h1 is None or e.h2 is None:
-            why = f"RSN {e.rsn}: the search report lists no {'Horizontal-1' if e.h1 is None else 'Horizontal-2'} file"
-        elif lacking:
-            reasons = [d.refusal(f) for f in lacking]
-            named = ", ".join(f + (f" ({r})" if r else "") for f, r in zip(lacking, reasons))
-            why = (f"RSN {e.rsn}: listed in _SearchResults.csv (line {e.line}) but not in the "
-                   f"download: {named}")
+        if absent is not None and _absent(d, e):
+            n_absent += 1
+            absent.append({"download": d.path, "peer_rsn": e.rsn, "line": e.line, "h1": e.h1, "h2": e.h2,
+                           "vertical": e.vertical, "peer_event": e.metadata.get("event"),
+                           "peer_station": e.metadata.get("station")})
+            continue
+        why = _why_not(d, e, scaled)
         n_missing += bool(why)
+        vertical = d.find(e.vertical) if e.vertical else None
         units.append((e, PeerSource(download, d.find(e.h1) or e.h1 if e.h1 else None,
-                                    d.find(e.h2) or e.h2 if e.h2 else None,
-                                    d.find(e.vertical) or e.vertical if e.vertical else None,
-                                    missing=why, fields=_fields(e, scaled),
-                                    tp=e.metadata.get("tp_s"))))
+                                    d.find(e.h2) or e.h2 if e.h2 else None, vertical,
+                                    missing=why, fields=_fields(e, scaled), tp=e.metadata.get("tp_s"),
+                                    vertical_note=_vertical_note(d, e, vertical))))
     scaling = "scaled by the search's factors (--peer-scales)" if scaled else \
         "as recorded, unscaled (--peer-scales applies the search's factors)"
     for member, why in d.refused.items():
         say(f"pipeline run: note: {d.path}: {why}")
-    say(f"pipeline run: PEER download {d.path}: {len(entries)} records listed, "
-        f"{len(entries) - n_missing} complete, {n_missing} incomplete (failures); designed {scaling}")
+    listed = len(entries) + len(d.search.rejected)
+    not_here = f", {n_absent} not in the download (listed in {NOT_DOWNLOADED})" if n_absent else ""
+    say(f"pipeline run: PEER download {d.path}: {listed} records listed, "
+        f"{listed - n_missing - n_absent} complete{not_here}, {n_missing} incomplete (failures); "
+        f"designed {scaling}")
     return units
 
 
+def _vertical_note(d, e, found) -> str:
+    """Why the vertical ``e`` lists is not used although listed (blank: used, or none listed)."""
+    if not e.vertical or found is not None:
+        return ""
+    why = d.refusal(e.vertical) or "listed in _SearchResults.csv but not in the download"
+    return f"vertical not used: {d.display(e.vertical)}: {why}"
+
+
 # -- in the worker -----------------------------------------------------------------------------------
-def read_components(task, vertical: bool = True):
-    """``(first, second, vertical or None, vertical's name)`` of a PEER task, as read (unscaled,
-    not yet checked as a pair); a record with files missing raises :class:`pulses.RecordError`."""
+def read_components(task):
+    """``(first, second, the vertical's name or None)`` of a PEER task, as read (unscaled, not yet
+    checked as a pair); a record with files missing raises :class:`pulses.RecordError`."""
     from pulses import RecordError
 
     src = task.peer
@@ -161,15 +234,29 @@ def read_components(task, vertical: bool = True):
         raise RecordError(src.missing)
     d = open_download(src.download)
     first, second = d.read_component(src.h1), d.read_component(src.h2)
-    vert = d.read_component(src.vertical) if (vertical and src.vertical) else None
-    return first, second, vert, (d.display(src.vertical) if src.vertical else None)
+    return first, second, (d.display(src.vertical) if src.vertical else None)
+
+
+def read_vertical(task):
+    """``(the vertical of a PEER task as read, or None; why it is not used, or "")``: a vertical
+    that is absent or cannot be read (a damaged member, a constant, NaN samples ...) is not used,
+    and the horizontals are designed as they are through ``--triplet``."""
+    from pulses import RecordError
+
+    src = task.peer
+    if not src.vertical:
+        return None, src.vertical_note
+    try:
+        return open_download(src.download).read_component(src.vertical), ""
+    except RecordError as exc:
+        return None, f"vertical not used: {exc}"
 
 
 def read_task(task):
     """The ground motion of a PEER task: the pair's component in the task's direction, scaled."""
     from pulses import check_pair, component
 
-    first, second, _, _ = read_components(task, vertical=False)
+    first, second, _ = read_components(task)
     first, second = check_pair(first, second)
     record = component(first, second, task.direction or 0.0)
     return record.scaled(task.scale) if task.scale != 1.0 else record

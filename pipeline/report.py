@@ -425,11 +425,11 @@ def columns_markdown(columns, failure_columns) -> str:
         "- `report.html`: the batch to review in a browser, opened from this folder (no server, no network).",
         "- `plots/<record>.png`: the record with its fitted pulses (paper's Fig. 4), its velocity with the "
         "extracted velocity pulse, and the rotation histories of each column as it stands, of its Eq. 31 "
-        "design and at its verified width under the full record (Figs. 9, 11); `plots/summary.png`: "
+        "design and at its design width under the full record (Figs. 9, 11); `plots/summary.png`: "
         "required against actual tan(alpha) across records.",
-        "- `plots/widths/<record>.png` (only where the check above a verified width found failing "
-        "widths): the verdict against the width above the verified width, a barcode of the widths "
-        "that overturn (`failing_share`, `widest_failing_width_m`; docs/slivers.md).",
+        "- `plots/widths/<record>.png` (only where the check above a search width found failing "
+        "widths): the verdict against the width above the search width, a barcode of the widths "
+        "that fail, with the design width (`failing_share`, `widest_failing_width_m`; docs/slivers.md).",
         "- `columns.md`: this file.",
         f"- `{MANIFEST}`: the files `pipeline run` wrote here (with a hash of their content). A later "
         "run into this folder replaces or removes only those, and only while their content is still "

@@ -106,13 +106,15 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
 # -- the whole run -----------------------------------------------------------------------------------
 def run(paths, columns, out, *, options: Options = Options(), jobs: int | None = 1, dask: str | None = None,
         quiet: bool = False, progress: bool | None = None, tasks=None, force: bool = False,
-        log=None) -> RunSummary:
+        log=None, lists=None) -> RunSummary:
     """Process ``paths`` for ``columns`` and write every report into ``out``.
 
     A record whose report in ``out`` was made by an earlier run from the same file content, options
     and package version is kept, not computed again (:mod:`pipeline.resume`), unless ``force``;
     ``summary.csv``, ``failures.csv`` and the plots are rebuilt from every record's report.
-    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.joblog`).
+    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.joblog`).  ``lists``: files the
+    inputs add to the reports, ``{name: text}`` (None: a file of that name from an earlier run is
+    removed), such as :data:`pipeline.peer_inputs.NOT_DOWNLOADED`.
 
     Raises
     ------
@@ -129,10 +131,10 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         tasks = make_tasks(paths, columns, options)
     with outlock.locked(out):  # one run at a time in one folder
         return _run_locked(out, tasks, options=options, jobs=jobs, dask=dask, quiet=quiet,
-                           progress=progress, force=force, log=log)
+                           progress=progress, force=force, log=log, lists=lists or {})
 
 
-def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log) -> RunSummary:
+def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log, lists) -> RunSummary:
     """:func:`run`, the folder locked."""
     outputs = prepare_output(out, tasks, options.plots, options)
     if log is not None:  # never onto an input or one of this run's own files (pipeline.outpaths)
@@ -204,6 +206,14 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log)
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts
+    for rel, listed in lists.items():  # e.g. the records of a PEER search not in its download
+        try:
+            if listed is not None:
+                outputs.write(rel, listed)
+            elif outputs.owned(rel):
+                outputs.remove(rel)
+        except report.NotOurs as exc:
+            say(f"pipeline run: note: {exc}")
     design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)

@@ -5,6 +5,7 @@ Plain, picklable data: a task runs the same in this process, in a process pool o
 """
 from __future__ import annotations
 
+import fnmatch
 import glob
 import hashlib
 import os
@@ -111,9 +112,40 @@ def make_tasks(paths, columns, options: Options) -> list[Task]:
 
 
 # -- inputs ----------------------------------------------------------------------------------------
-def expand_inputs(items) -> list[str]:
-    """File arguments as given; folders give their entries (sorted; not hidden ones, not folders);
-    unexpanded wildcards are globbed.
+#: extensions of files that are plainly no record (documents, images, web pages, spreadsheets)
+NOT_RECORDS = frozenset({".md", ".rst", ".pdf", ".doc", ".docx", ".odt", ".xls", ".xlsx", ".ods",
+                         ".png", ".jpg", ".jpeg", ".gif", ".svg", ".bmp", ".tif", ".tiff", ".webp",
+                         ".html", ".htm", ".json", ".yaml", ".yml", ".py", ".ipynb"})
+_README = re.compile(r"^(readme|license|licence|changelog)(\.(txt|md|rst))?$", re.IGNORECASE)
+
+
+def plainly_not_a_record(path) -> bool:
+    """A file of a folder that is plainly no record: a document, an image or a page by its
+    extension (:data:`NOT_RECORDS`), a README, LICENSE or CHANGELOG, or a ``.txt`` file without a digit in
+    its first 64 kB.  Only regular files are looked into; anything else is left to the reader."""
+    import stat
+
+    name = os.path.basename(path)
+    ext = os.path.splitext(name)[1].lower()
+    if ext in NOT_RECORDS or _README.match(name):
+        return True
+    if ext != ".txt":
+        return False
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return False
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except OSError:
+        return False  # fails as a record, with the reason
+    return bool(head.strip()) and re.search(rb"[0-9]", head) is None
+
+
+def expand_inputs(items, skipped: list | None = None, pattern: str | None = None) -> list[str]:
+    """File arguments as given; folders give their entries (sorted; not hidden ones, not folders,
+    not files that are plainly no record, :func:`plainly_not_a_record`, which are appended to
+    ``skipped`` when given; with ``pattern``, a shell pattern such as ``*.AT2``, exactly the
+    entries whose names match it); unexpanded wildcards are globbed.
 
     A path that does not exist stays in the list: it is reported as a failed record, not an argument
     error, so one missing file does not stop a batch.  So are a folder's entries that cannot be
@@ -141,8 +173,17 @@ def expand_inputs(items) -> list[str]:
                 full = os.path.join(item, name)
                 # every entry but hidden ones and folders: a broken link, a link loop or a file
                 # that cannot be looked at is a failed record with the reason, never skipped
-                if not name.startswith(".") and not os.path.isdir(full):
-                    add(full)
+                if name.startswith(".") or os.path.isdir(full):
+                    continue
+                if pattern is not None:  # chosen by name: nothing else is looked at
+                    if fnmatch.fnmatchcase(name, pattern):
+                        add(full)
+                    continue
+                if plainly_not_a_record(full):
+                    if skipped is not None:
+                        skipped.append(full)
+                    continue
+                add(full)
         elif not os.path.exists(item) and glob.has_magic(item):
             matches = sorted(glob.glob(item))
             if not matches:

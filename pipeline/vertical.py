@@ -103,8 +103,11 @@ def read_task(task):
 
     want = task.options.vertical != "none"
     src = getattr(task, "peer", None)
+    note = None
     if src is not None:
-        first, second, vert, vname = peer_inputs.read_components(task, vertical=want)
+        first, second, vname = peer_inputs.read_components(task)
+        vert, note = peer_inputs.read_vertical(task) if want else (None, "")
+        note = note or None
     elif want and getattr(task, "vertical", None) and task.path2 is not None:
         o = task.options
         kw = dict(format=o.format, units=o.units, dt=o.dt, column=o.column, trace=o.trace)
@@ -117,7 +120,6 @@ def read_task(task):
             return _directed(task, first, second, None), None, f"vertical not used: {exc}"
     else:
         return site.read_task(task), None, None
-    note = None
     up = None
     if vert is not None:
         try:

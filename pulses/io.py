@@ -123,7 +123,8 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
 
 def _check_entry(path) -> None:
     """A :class:`RecordError` saying why ``path`` is no file that can be read, if it is not: missing,
-    a symbolic link to nothing or in a loop, in a folder without search permission, a folder."""
+    a symbolic link to nothing or in a loop, in a folder without search permission, a folder, a
+    FIFO, a device or a socket (by :func:`os.stat`, before anything opens it)."""
     import errno
     import stat
 
@@ -144,6 +145,19 @@ def _check_entry(path) -> None:
         except OSError as exc:
             raise RecordError(f"{path}: a folder whose files cannot be listed: {exc.strerror or exc}") from None
         raise RecordError(f"{path}: is a directory, not a record file")
+    if not stat.S_ISREG(st.st_mode):  # reading a FIFO or /dev/zero would block or never end
+        raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
+
+
+def special_kind(mode: int) -> str:
+    """What a file that is neither a regular file nor a folder is, in words (``a FIFO`` ...)."""
+    import stat
+
+    for test, what in ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return what
+    return "not a regular file"
 
 
 def _read(path, format, units, dt, column, trace, name, max_samples) -> Record:
@@ -171,9 +185,21 @@ def record_from_reading(path: str, reading, units=None, dt=None, name=None, *,
         unit_factor(units)
     meta = reading.metadata
     meta.setdefault("warnings", [])
-    used_units, units_source = _units(path, reading, units)
+    # units and time step both looked at before either is refused: all of a file's missing
+    # settings in one message, not one per run
+    problems = []
+    try:
+        used_units, units_source = _units(path, reading, units)
+    except RecordError as exc:
+        problems.append(str(exc))
+    try:
+        dt = _time_step(path, reading, dt)
+    except RecordError as exc:
+        problems.append(str(exc))
+    if problems:
+        prefix = f"{path}: "
+        raise RecordError(prefix + "; and ".join(p[len(prefix):] if p.startswith(prefix) else p for p in problems))
     acc = np.asarray(reading.values, dtype=float) * unit_factor(used_units)
-    dt = _time_step(path, reading, dt)
     meta.update(units=used_units, units_source=units_source, source=path, dt=dt)
     for key in ("station", "component", "event"):
         meta.setdefault(key, "")

@@ -32,7 +32,9 @@ import math
 import os
 import posixpath
 import re
+import stat
 import zipfile
+import zlib
 from dataclasses import dataclass, field
 
 from .errors import RecordError
@@ -51,6 +53,17 @@ MAX_MEMBER_BYTES = 20 * MAX_SAMPLES + 4096
 MAX_REPORT_BYTES = 64 << 20
 #: a zip with more members than this is refused (a PEER download of 100 records holds 601)
 MAX_MEMBERS = 100_000
+#: a member unpacking to more than this many times its compressed size (plus :data:`RATIO_SLACK`)
+#: is refused, by its stated sizes before it is read and while it is read (a zip's stated size may
+#: lie): PEER's AT2 members deflate 2.7 to 3.0 times (measured on the shared download), a member of
+#: zeros about 20 times; a "zip bomb" hundreds of times
+MAX_RATIO = 100
+#: bytes any member may unpack to whatever its ratio (a tiny member, a stored one)
+RATIO_SLACK = 1 << 20
+#: what reading a damaged zip member raises: a corrupted deflate stream is a ``zlib.error``, a bad
+#: checksum ``BadZipFile``, a cut file ``EOFError``, an unknown compression ``NotImplementedError``
+ZIP_READ_ERRORS = (OSError, zipfile.BadZipFile, zlib.error, RuntimeError, EOFError, NotImplementedError,
+                   ValueError)
 
 #: the report's columns for the grouping: (name in the report, key)
 _FILE_COLUMNS = {"Horizontal-1 Acc. Filename": "h1", "Horizontal-2 Acc. Filename": "h2",
@@ -99,13 +112,15 @@ class PeerEntry:
 @dataclass
 class SearchResults:
     """A parsed ``_SearchResults.csv``: ``entries`` in the report's order, the search's
-    ``scaling`` (``Scaling Method``, e.g. ``No Scaling``) and ``notes`` (lines such as ``These
-    records are UNSCALED, AS RECORDED``)."""
+    ``scaling`` (``Scaling Method``, e.g. ``No Scaling``), ``notes`` (lines such as ``These
+    records are UNSCALED, AS RECORDED``) and ``rejected``, ``(line number, reason)`` of the record
+    lines that cannot be used."""
 
     entries: list
     scaling: str = ""
     notes: list = field(default_factory=list)
     source: str = ""
+    rejected: list = field(default_factory=list)
 
 
 def _value(text: str, kind):
@@ -113,11 +128,11 @@ def _value(text: str, kind):
     if text.lower() in _ABSENT:
         return None
     if kind is str:
-        return text
+        return _printable(text)
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"{text!r} is not a number") from None
+        raise ValueError(f"{_printable(text)[:40]!r} is not a number") from None
     if not math.isfinite(value):
         return None
     if kind is int:
@@ -127,57 +142,62 @@ def _value(text: str, kind):
     return value
 
 
+def _printable(text: str) -> str:
+    """``text`` with its control characters written as escapes (``\\x1b``): a station or event
+    name of the report reaches terminals, CSV files and pages as text, never as a terminal command."""
+    if text.isprintable():
+        return text
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+
+
+def _fields(line: str, source: str, lineno: int) -> list[str]:
+    """The fields of one line of the report (:class:`RecordError` for a line the csv module refuses:
+    a field longer than its limit, a stray quote ...)."""
+    try:
+        return next(csv.reader([line], skipinitialspace=True), [])
+    except csv.Error as exc:
+        raise RecordError(f"{source}, line {lineno}: not a line of the table: {exc}") from None
+
+
 def parse_search_results(text: str, source: str = SEARCH_RESULTS) -> SearchResults:
     """Parse the text of a PEER ``_SearchResults.csv``.
+
+    A record line that cannot be used (the wrong number of fields, a value that is not a number
+    where the report has numbers, no record number, a record number listed twice, a file name
+    that is not a plain name, a line the csv module refuses) is set aside in
+    :attr:`SearchResults.rejected` with its reason; the other records are read.
 
     Raises
     ------
     RecordError
         Naming ``source`` and the line: no metadata section, a header without the record number or
-        the file columns, a record line with the wrong number of fields or a value that is not a
-        number where the report has numbers, or a record number listed twice.
+        the file columns, or no record line that can be used.
     """
     lines = text.splitlines()
     start = next((i for i, ln in enumerate(lines) if ln.strip() == METADATA_SECTION), None)
     if start is None or start + 1 >= len(lines):
         raise RecordError(f"{source}: not a PEER search report: no line {METADATA_SECTION!r}")
-    header = [h.strip() for h in next(csv.reader([lines[start + 1]], skipinitialspace=True))]
+    header = [h.strip() for h in _fields(lines[start + 1], source, start + 2)]
     col = {h: i for i, h in enumerate(header) if h}
     needed = [METADATA["rsn"][0], *_FILE_COLUMNS]
     lacking = [h for h in needed if h not in col]
     if lacking:
         raise RecordError(f"{source}, line {start + 2}: the metadata table has no column "
                           f"{', '.join(map(repr, lacking))}")
-    entries, seen = [], {}
+    entries, rejected, seen = [], [], {}
     n = start + 2
     while n < len(lines) and lines[n].strip():
-        lineno = n + 1
-        row = next(csv.reader([lines[n]], skipinitialspace=True))
         n += 1
-        if len(row) < len(header):
-            raise RecordError(f"{source}, line {lineno}: {len(row)} fields, the table's header has {len(header)}")
-        meta = {}
-        for key, (name, kind) in METADATA.items():
-            if name not in col:
-                meta[key] = None
-                continue
-            try:
-                meta[key] = _value(row[col[name]], kind)
-            except ValueError as exc:
-                raise RecordError(f"{source}, line {lineno}: {name}: {exc}") from None
-        if meta["rsn"] is None:
-            raise RecordError(f"{source}, line {lineno}: no record sequence number")
-        if meta["rsn"] in seen:
-            raise RecordError(f"{source}, line {lineno}: RSN {meta['rsn']} is listed twice "
-                              f"(also line {seen[meta['rsn']]})")
-        seen[meta["rsn"]] = lineno
-        files = {key: _value(row[col[name]], str) for name, key in _FILE_COLUMNS.items()}
-        for f in files.values():
-            if f is not None and not _safe_name(f):
-                raise RecordError(f"{source}, line {lineno}: file name {f!r} is not a plain file name")
-        entries.append(PeerEntry(meta["rsn"], files["h1"], files["h2"], files["vertical"], meta, lineno))
+        try:
+            entry = _entry(lines[n - 1], n, header, col, seen, source)
+        except RecordError as exc:
+            rejected.append((n, str(exc)))
+            continue
+        seen[entry.rsn] = n
+        entries.append(entry)
     if not entries:
-        raise RecordError(f"{source}: the metadata table lists no record")
+        why = f": {rejected[0][1]}" if rejected else ""
+        raise RecordError(f"{source}: the metadata table lists no record that can be read{why}")
     scaling = ""
     notes = []
     for ln in lines[:start]:
@@ -189,7 +209,33 @@ def parse_search_results(text: str, source: str = SEARCH_RESULTS) -> SearchResul
             break
         if "SCALED" in ln.upper():
             notes.append(ln.strip())
-    return SearchResults(entries, scaling, notes, source)
+    return SearchResults(entries, scaling, notes, source, rejected)
+
+
+def _entry(line: str, lineno: int, header, col, seen, source) -> PeerEntry:
+    """One record line of the metadata table (:class:`RecordError` naming the line otherwise)."""
+    row = _fields(line, source, lineno)
+    if len(row) < len(header):
+        raise RecordError(f"{source}, line {lineno}: {len(row)} fields, the table's header has {len(header)}")
+    meta = {}
+    for key, (name, kind) in METADATA.items():
+        if name not in col:
+            meta[key] = None
+            continue
+        try:
+            meta[key] = _value(row[col[name]], kind)
+        except ValueError as exc:
+            raise RecordError(f"{source}, line {lineno}: {name}: {exc}") from None
+    if meta["rsn"] is None:
+        raise RecordError(f"{source}, line {lineno}: no record sequence number")
+    if meta["rsn"] in seen:
+        raise RecordError(f"{source}, line {lineno}: RSN {meta['rsn']} is listed twice "
+                          f"(also line {seen[meta['rsn']]})")
+    files = {key: _value(row[col[name]], str) for name, key in _FILE_COLUMNS.items()}
+    for f in files.values():
+        if f is not None and not _safe_name(f):
+            raise RecordError(f"{source}, line {lineno}: file name {f!r} is not a plain file name")
+    return PeerEntry(meta["rsn"], files["h1"], files["h2"], files["vertical"], meta, lineno)
 
 
 def _safe_name(name: str) -> bool:
@@ -241,6 +287,8 @@ class PeerDownload:
         self.refused: dict[str, str] = {}
         self._files: dict[str, str] = {}  # file name -> member name (zip) or path (folder)
         self._sizes: dict[str, int] = {}
+        self._packed: dict[str, int] = {}  # zip members' compressed sizes
+        self._folded: dict | None = None
         if os.path.isdir(self.path):
             self.kind = "folder"
             self._scan_folder()
@@ -291,6 +339,7 @@ class PeerDownload:
                 name = posixpath.basename(info.filename)
                 self._files[name] = info.filename
                 self._sizes[name] = info.file_size
+                self._packed[name] = info.compress_size
 
     # -- reading ---------------------------------------------------------------------------------
     def display(self, name: str) -> str:
@@ -303,7 +352,11 @@ class PeerDownload:
         """The download's file of that name: exactly, else the only one equal but for case."""
         if name in self._files:
             return name
-        folded = [n for n in self._files if n.casefold() == name.casefold()]
+        if self._folded is None:  # built once: a lookup per listed file must not scan every member
+            self._folded = {}
+            for n in self._files:
+                self._folded.setdefault(n.casefold(), []).append(n)
+        folded = self._folded.get(name.casefold(), [])
         return folded[0] if len(folded) == 1 else None
 
     def missing(self, entry: PeerEntry) -> list[str]:
@@ -316,27 +369,57 @@ class PeerDownload:
                 return why
         return None
 
-    def read_bytes(self, name: str, limit: int = MAX_MEMBER_BYTES) -> bytes:
-        """The bytes of one file, at most ``limit`` (a larger file is refused unread)."""
+    def _bound(self, found: str, limit: int) -> int:
+        """The bytes the file ``found`` may unpack to: ``limit``, and for a zip member at most
+        :data:`MAX_RATIO` times its compressed size (plus :data:`RATIO_SLACK`); a member whose stated
+        size exceeds either is refused unread."""
+        size = self._sizes[found]
+        if size > limit:
+            raise RecordError(f"{self.display(found)}: {size} bytes, larger than the {limit} accepted")
+        packed = self._packed.get(found)
+        if packed is None:
+            return limit
+        bound = min(limit, MAX_RATIO * packed + RATIO_SLACK)
+        if size > bound:
+            raise RecordError(f"{self.display(found)}: unpacks to {size} bytes from {packed}, more than "
+                              f"{MAX_RATIO} times its compressed size: refused unread (a damaged or "
+                              "hostile zip)")
+        return bound
+
+    def _open_member(self, name: str, limit: int):
+        """``(name found, a binary stream of the file bounded to what it may hold)``."""
         found = self.find(name)
         if found is None:
             why = self.refusal(name)
             raise RecordError(f"{self.display(name)}: " + (why or f"listed in {SEARCH_RESULTS} but not in the download"))
-        size = self._sizes[found]
-        if size > limit:
-            raise RecordError(f"{self.display(found)}: {size} bytes, larger than the {limit} accepted")
+        bound = self._bound(found, limit)
         try:
             if self.kind == "folder":
-                with open(self._files[found], "rb") as fh:
-                    data = fh.read(limit + 1)
+                fh = _open_regular(self._files[found])
             else:
-                with zipfile.ZipFile(self.path) as zf, zf.open(self._files[found]) as fh:
-                    data = fh.read(limit + 1)  # bounded even if the zip's stated size lies
-        except (OSError, zipfile.BadZipFile, RuntimeError, EOFError) as exc:
+                zf = zipfile.ZipFile(self.path)
+                try:
+                    fh = _Closing(zf.open(self._files[found]), zf)
+                except BaseException:
+                    zf.close()
+                    raise
+        except RecordError:
+            raise
+        except ZIP_READ_ERRORS as exc:
             raise RecordError(f"{self.display(found)}: cannot read: {exc}") from None
-        if len(data) > limit:
-            raise RecordError(f"{self.display(found)}: larger than the {limit} bytes accepted")
-        return data
+        return found, _Bounded(fh, bound, self.display(found))
+
+    def read_bytes(self, name: str, limit: int = MAX_MEMBER_BYTES) -> bytes:
+        """The bytes of one file, at most ``limit`` (a larger file is refused unread; a zip member
+        also within :data:`MAX_RATIO` of its compressed size, checked as it unpacks)."""
+        found, fh = self._open_member(name, limit)
+        with fh:
+            try:
+                return fh.read()
+            except RecordError:
+                raise
+            except ZIP_READ_ERRORS as exc:
+                raise RecordError(f"{self.display(found)}: cannot read: {exc}") from None
 
     def _read_text(self, name: str, limit: int) -> str:
         data = self.read_bytes(name, limit)
@@ -347,23 +430,106 @@ class PeerDownload:
 
     def read_component(self, name: str, **options) -> Record:
         """One AT2 file of the download as a :class:`pulses.Record` (m/s^2), with every check of
-        :func:`pulses.read_record`; ``metadata["source"]`` is :meth:`display`."""
+        :func:`pulses.read_record`; ``metadata["source"]`` is :meth:`display`.  The file is
+        streamed (a zip member is unpacked as it is parsed, never held whole in memory), and a
+        damaged member fails with a message naming it."""
         from . import at2
         from .io import record_from_reading
 
-        found = self.find(name)
-        label = self.display(found or name)
-        text = self._read_text(name, MAX_MEMBER_BYTES)
-        values, dt, header = at2.read_at2_stream(io.StringIO(text), label)
+        found, fh = self._open_member(name, MAX_MEMBER_BYTES)
+        label = self.display(found)
+        with fh:
+            text = io.TextIOWrapper(fh, encoding="utf-8-sig", errors="replace")  # as a plain AT2 file
+            try:
+                values, dt, header = at2.read_at2_stream(text, label)
+            except RecordError:
+                raise
+            except ZIP_READ_ERRORS as exc:
+                raise RecordError(f"{label}: cannot read: {exc}") from None
+            finally:
+                text.detach()
         reading = at2.reading_of(label, values, dt, header)
-        return record_from_reading(label, reading, options.get("units"), options.get("dt"),
-                                   name=found or name)
+        return record_from_reading(label, reading, options.get("units"), options.get("dt"), name=found)
+
+
+class _Closing(io.RawIOBase):
+    """A zip member's stream that closes its archive with it."""
+
+    def __init__(self, member, archive):
+        self._member, self._archive = member, archive
+
+    def readable(self):
+        return True
+
+    def readinto(self, buf):
+        data = self._member.read(len(buf))
+        buf[:len(data)] = data
+        return len(data)
+
+    def close(self):
+        if not self.closed:
+            self._member.close()
+            self._archive.close()
+        super().close()
+
+
+class _Bounded(io.RawIOBase):
+    """A binary stream that raises :class:`RecordError` once more than ``limit`` bytes came out of
+    it: a file (or a zip member whose stated size lies) is never read beyond what it may hold."""
+
+    def __init__(self, raw, limit: int, label: str):
+        self._raw, self._left, self._limit, self._label = raw, limit, limit, label
+
+    def readable(self):
+        return True
+
+    def readinto(self, buf):
+        n = self._raw.readinto(memoryview(buf)[:min(len(buf), self._left + 1)])
+        self._left -= n
+        if self._left < 0:
+            raise RecordError(f"{self._label}: unpacks to more than the {self._limit} bytes accepted "
+                              f"(at most {MAX_RATIO} times a zip member's compressed size)")
+        return n
+
+    def close(self):
+        if not self.closed:
+            self._raw.close()
+        super().close()
+
+
+def _open_regular(path):
+    """``path`` opened for reading if it is a regular file; a FIFO, a device or a socket (which
+    would block or never end) is refused before anything opens it."""
+    from .io import special_kind
+
+    st = os.stat(path)
+    if not stat.S_ISREG(st.st_mode):
+        raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):  # replaced between the two looks
+        os.close(fd)
+        raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
+    return io.FileIO(fd, "r")
+
+
+#: how a zip archive starts: a local file header (or the end record of an empty archive)
+_ZIP_STARTS = (b"PK\x03\x04", b"PK\x05\x06")
 
 
 def is_peer_zip(path) -> bool:
-    """A regular file that is a zip archive (its content says so, not its name)."""
+    """A regular file that is a zip archive (its content says so, not its name): it starts as a
+    zip starts, and :func:`zipfile.is_zipfile` finds its end record.  The end record alone is not
+    enough: a SAC or text record whose last bytes happen to hold a zip signature is a record."""
     path = os.fspath(path)
-    return os.path.isfile(path) and zipfile.is_zipfile(path)
+    if not os.path.isfile(path):
+        return False
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4)
+    except OSError:
+        return False
+    return head in _ZIP_STARTS and zipfile.is_zipfile(path)
 
 
 def is_peer_download(path) -> bool:

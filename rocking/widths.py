@@ -438,9 +438,14 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
     xs, fs, rs = (np.asarray(v) for v in seen)
     cx, cf = np.zeros(0), np.zeros(0, dtype=bool)
     base_method, notes = res.method, []
+    # the last refinement's runs come out of the check's budget too (a bracket up to 1.6 % of the
+    # width bisected to design_rtol), so that search + check + refinement stay within today's
+    reserve = max(0, math.ceil(math.log2(0.016 / settings.design_rtol)))
+    left = max(left - reserve, 0)
     for k in range(rounds):
         n = left // (rounds - k)
         left -= n
+        before = res.refine_runs
         x, f, r = _add_check(res, top, evaluate, settings.replace(check_runs=n), seed + k,
                              (xs, fs, rs))
         notes.append(f"{x.size} widths from {res.width:.6g} m up to "
@@ -449,6 +454,7 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
         xs, fs, rs = np.concatenate([xs, x]), np.concatenate([fs, f]), np.concatenate([rs, r])
         res.check_widths, res.check_failed = cx, cf
         _raise_to_failures(res, evaluate, (xs, fs), settings)
+        left = max(left - (res.refine_runs - before), 0)     # a round's refinement: from the rest
     order = np.argsort(cx, kind="stable")
     res.check_widths, res.check_failed = cx[order], cf[order]
     res.check_runs = int(cx.size)

@@ -11,9 +11,25 @@ differ in the last bit: single steps agree to ~1e-16.  Rocking under a record am
 differences along the motion (measured: 8e-10 rad after 9 s of a record scaled to overturning,
 2e-14 on the peaks), so histories and times are compared at 1e-8 (rad, s), peaks at 1e-9
 relative, and every verdict (overturning, uplift, model, which rule decided) must be the same.
-Impact counts must be equal, except in the 300 s record's batch, where the count of the tiny hops
-of a block coming to rest is itself chaotic (measured: 884 against 857 for one width, with the
-same peak to the last bit): 5 %.  Critical amplitudes, slenderness transitions and islands are
+Impact counts must be equal, except in the 300 s record's batch (below).
+
+How these hold on other machines (builds with or without AVX2 and FMA round each step's last bit
+differently) was measured by the conditioning of every case: each run again with every sample of
+its record moved by a random -1, 0 or +1 ulp (8 draws) and with the block's p moved by one ulp
+(up, down).  Every history and time moved by at most 7.7e-10 (rad, s; the Imperial Valley record
+scaled 1.5, which overturns at 8.9 s), 13 times inside 1e-8; every peak but one by less than 1e-12.
+The one exception is the 300 s record's batch (``batch/long_lanes``): 60,000 steps of rocking at
+rest amplify the last bits, its peaks are conditioned at about 1.7e5 (record samples perturbed by a
+relative 1e-12, 1e-11 move the peak by 1.7e-7, 1.7e-6; down to a floor of 1e-9 for one ulp), and
+the compiled core differs from the numba engine by 6.2e-8 on one peak (0.1119391667 against
+0.1119391736; an effective perturbation of about 4e-13 of the record, accumulated over the steps).
+(A build with ``ROCKING_NATIVE=1``, ``-march=native`` on a processor with AVX2 and FMA, gave the
+same 4,238 values as the default build to the last bit: ``-ffp-contract=off`` keeps the
+arithmetic's order; the differences come from the numba engine's fused steps and from libm.)
+Its peaks are compared at 2e-6 relative (a build whose rounding differs as much as 1e-11 of the
+record, 25 times the engines' difference), its verdicts exactly (no flip in 36 perturbed runs up
+to 1e-11), and its impact counts, those of the tiny hops of blocks coming to rest, within 50 %
+(measured: up to 27 % apart between perturbed runs, 7 % between the engines).  Critical amplitudes, slenderness transitions and islands are
 bisected on the same verdicts: 1e-9 relative.  Verified widths and critical scales of real
 records: the issue's 0.5 % (measured: identical), with the same number of transitions.  The
 demo's summary: 2e-5 relative (6 significant digits printed).
@@ -62,9 +78,10 @@ def _single(want, got, key):
 def _batch(want, got, key):
     assert got["overturned"] == want["overturned"], key
     assert got["uplifted"] == want["uplifted"], key
+    long = key.startswith("batch/long")  # conditioned at 1.7e5: see the module's docstring
     for a, b in zip(want["max_rotation"], got["max_rotation"]):
-        assert _close(a, b, rel=1e-9), key
-    slack = 0.05 if key.startswith("batch/long") else 0.0
+        assert _close(a, b, rel=2e-6 if long else 1e-9), (key, a, b)
+    slack = 0.5 if long else 0.0
     for a, b in zip(want["n_impacts"], got["n_impacts"]):
         assert abs(a - b) <= slack * a, key
 
@@ -110,9 +127,14 @@ def test_demo_summary_same_as_the_numba_engine(current):
         for col in a:
             if col in ("file", "file2"):
                 continue  # where the package's data sits
+            # the numba engine's verified width was the search's first transition, now
+            # search_width_m (verified_width_m is the design width above every failing width, issue 33)
+            if col == "verified_tan_alpha" and "search_width_m" in b:
+                continue  # the tangent of that width
+            got = b["search_width_m"] if (col == "verified_width_m" and "search_width_m" in b) else b[col]
             try:
-                x, y = float(a[col]), float(b[col])
+                x, y = float(a[col]), float(got)
             except ValueError:
-                assert a[col] == b[col], (a["record"], col)
+                assert a[col] == got, (a["record"], col)
                 continue
-            assert _close(x, y, rel=2e-5), (a["record"], col, a[col], b[col])
+            assert _close(x, y, rel=2e-5), (a["record"], col, a[col], got)
