@@ -307,3 +307,31 @@ def test_each_record_file_has_one_verified_width_across_the_docs():
                         (page, row["name in these pages"], stated, sentence)
                     checked += 1
     assert checked >= 8  # the demo's five rows in two pages and the Rinaldi sentences were read
+
+
+@pytest.mark.slow
+def test_the_records_table_is_a_real_run():
+    """The design widths of docs/records.md's table, computed again: the bundled records, and the
+    real ones where ../shared is beside the checkout (text files read as their comments say)."""
+    import importlib.resources
+
+    import pulses
+    import rocking
+
+    text_options = {"units": "cm/s2", "dt": 0.005, "column": 1}
+    checked = 0
+    for row in _records_table():
+        file, stated = row["file"].strip("`"), row["design width, 7.5 m"]
+        if stated == "-":
+            continue
+        bundled = importlib.resources.files("pipeline.data") / file
+        path = bundled if bundled.is_file() else ROOT.parent / "shared" / "records" / "raw" / file
+        if not path.is_file():
+            continue
+        rec = pulses.read_record(str(path), **(text_options if file.endswith(".txt") else {}))
+        width = rocking.required_width(7.5, rec, rule="exact").width
+        number = stated.split()[0]
+        # the table prints 3 decimals: the width rounds to it
+        assert abs(width - float(number)) <= 0.5 * 10 ** -len(number.split(".")[1]) + 1e-9, (file, width, number)
+        checked += 1
+    assert checked >= 5  # at least the bundled records
