@@ -136,6 +136,9 @@ def test_docs_build_without_warnings(site):
         page = (html / "gallery" / f"{ex.stem}.html").read_text(encoding="utf-8")
         assert f"sphx_glr_{ex.stem}_001.png" in page, ex.stem
         assert (html / "_images" / f"sphx_glr_{ex.stem}_001.png").is_file(), ex.stem
+    # getting started shows figures (the gallery's, drawn at build)
+    start = (html / "getting-started.html").read_text(encoding="utf-8")
+    assert start.count("_images/sphx_glr_plot_") >= 2
     # an API page shows the gallery's examples that use its name, with their figures
     page = (html / "api" / "generated" / "rocking.required_width.html").read_text(encoding="utf-8")
     assert "Gallery examples using it" in page and "sphx_glr_plot_width_vs_height_thumb.png" in page
