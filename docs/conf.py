@@ -125,6 +125,12 @@ html_context = {"default_mode": "light"}
 _ABS = re.compile(r"(?<![\\`|])\|([^|`\s][^|`]*?)\|(?![|_`])")
 
 
+# "Eq. 31" and "Fig. 8" are not ends of sentences: a word joiner after the period keeps the
+# summaries of the API tables (their first sentence) whole, and the text reads the same
+_NUMBERED = re.compile(r"\b(Eqs?|Figs?)\. (?=\d)")
+_KEEP = "\\1.\u2060\u00a0"
+
+
 def _plain_docstring(app, what, name, obj, options, lines):
     joined, in_example = [], False
     for line in lines:
@@ -137,7 +143,7 @@ def _plain_docstring(app, what, name, obj, options, lines):
         else:
             joined.append((line, False))
     # only outside inline literals: split at ``, the odd parts are literals
-    lines[:] = [line if code else "``".join(part if k % 2 else _ABS.sub(r"\\|\1\\|", part)
+    lines[:] = [line if code else "``".join(part if k % 2 else _NUMBERED.sub(_KEEP, _ABS.sub(r"\\|\1\\|", part))
                                             for k, part in enumerate(line.split("``")))
                 for line, code in joined]
 
