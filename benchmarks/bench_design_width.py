@@ -92,7 +92,7 @@ def measure(paths, heights, settings=None):
                        # within the span the check covers: (w, 2 w] today, (W, 2 W] now
                        far_old_2=bool(np.any((fx > 1.01 * w) & (fx <= 2.0 * w))),
                        far_new_2=bool(np.any((fx > 1.01 * W) & (fx <= 2.0 * W))),
-                       runs=over.total_runs, runs_today=over.runs + over.check_runs,
+                       runs=over.total_runs, runs_today=over.runs + settings.check_runs,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
                        t_over=t_over, t_half=t_half)
             rows.append(row)
@@ -198,7 +198,9 @@ def main(argv=None):
         from rocking.search import DEFAULT_SETTINGS
 
         pairs = (kv.split("=") for kv in argv[argv.index("--settings") + 1].split(","))
-        settings = DEFAULT_SETTINGS.replace(**{k: type(getattr(DEFAULT_SETTINGS, k))(v) for k, v in pairs})
+        settings = DEFAULT_SETTINGS.replace(**{k: (int if getattr(DEFAULT_SETTINGS, k) is None
+                                                   else type(getattr(DEFAULT_SETTINGS, k)))(v)
+                                               for k, v in pairs})
     print("\n".join(table(measure(paths, heights, settings))))
     return 0
 

@@ -33,13 +33,6 @@ def _g(x):
     return None if x is None else float(x) / G
 
 
-def _fits(candidate, best) -> bool:
-    b = float(best.score)
-    if not math.isfinite(b) or b <= 0.0:
-        return candidate is best
-    return float(candidate.score) >= FIT_TOLERANCE * b
-
-
 def _sim(block, record, history):
     import rocking
 
@@ -449,7 +442,7 @@ def _process(task: Task):
     fit = _stage("fit", _fit, record, opts.shapes, opts.weighting)
     best = fit.best
     candidates = list(fit.candidates)
-    fitting = [c for c in candidates if _fits(c, best)]
+    fitting = rocking.fitting_candidates(fit)
     by_shape = {}
     for c in candidates:  # candidates are ranked: keep the best of each shape
         by_shape.setdefault(c.shape, c)
@@ -479,14 +472,9 @@ def _process(task: Task):
         curves = []
 
         # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
-        def eq31_widths():
-            return [(float(rocking.required_width(H, c.pulse, rule="eq31", cap_mass_ratio=gamma).width), c)
-                    for c in fitting]
-
-        if H not in eq31_cache:
-            eq31_cache[H] = _stage("design", eq31_widths)
-        widths = eq31_cache[H]
-        w31, gov = max(widths, key=lambda wc: wc[0])  # ties: the better fit (ranked first)
+        if H not in eq31_cache:  # rocking.governing_pulse: pipeline run's rule, in public
+            eq31_cache[H] = _stage("design", rocking.governing_pulse, fit, H, cap_mass_ratio=gamma)
+        widths, w31, gov = eq31_cache[H].widths, eq31_cache[H].width, eq31_cache[H].candidate
 
         # -- the column as it stands: design rules, then the full record ---------------------------
         def design():

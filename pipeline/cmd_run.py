@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from . import pairs, peer_inputs, site, vertical
+from . import peer_inputs, site, vertical
 from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
                    parse_shapes, record_options)
 
@@ -107,50 +107,18 @@ def options_from(args, **overrides):
 
 
 def main(args) -> int:
-    from .runner import run
-    from .tasks import expand_inputs
+    """``pipeline run``: its arguments parsed into the values of :func:`pipeline.design`, which runs
+    the batch (the same plan, so the same tasks and numbers)."""
+    from . import api
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
     options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
                            vertical=args.vertical, **record_options(args), **site.options_from_args(args))
-    triplets = {(str(a), str(b)): str(v) for a, b, v in args.triplet}
-    args.pair = list(args.pair) + [[a, b] for a, b in triplets]  # a triplet's horizontals are a pair
-    if not args.records and not args.pair:
-        raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
-    downloads, others = peer_inputs.split_inputs(args.records, args.format)
-    skipped = []
-    paths = [p for p in expand_inputs(others, skipped, args.glob) if p not in set(triplets.values())]
-    if skipped and not args.quiet:
-        import sys
-
-        from .report import display
-
-        shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
-        print(f"pipeline run: note: {len(skipped)} file(s) of the folders skipped, plainly not records "
-              f"({shown}); name a file to read it as a record, or choose files with --glob", file=sys.stderr)
-    if not paths and not args.pair and not downloads:
-        from .report import display
-
-        raise ArgumentError(f"no record files in {', '.join(map(display, args.records))} "
-                            "(a folder gives the files directly in it)")
-    if paths and not downloads and not args.pair and not any(os.path.lexists(p) for p in paths):
-        from .report import display
-
-        shown = ", ".join(map(display, paths[:3])) + (f" and {len(paths) - 3} more" if len(paths) > 3 else "")
-        raise ArgumentError(f"none of the inputs exists ({shown}): nothing to do, nothing written")
-    absent = [] if downloads else None  # the search's records not in the download: listed, not failed
-    tasks = pairs.tasks_from_args(args, downloads, paths, columns, options, absent)
-    if tasks is not None and args.vertical == "auto":
-        found = {}
-        if args.pairs == "auto":
-            from .args import record_options as _ro
-
-            say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=__import__("sys").stderr))
-            rest = [p for p in paths if p not in {q for ab in args.pair for q in ab}]
-            found = vertical.auto_verticals(rest, _ro(args), say)
-        tasks = vertical.attach(tasks, {**found, **triplets})
-    summary = run(paths, columns, args.out, options=options, jobs=jobs, dask=args.dask,
-                  quiet=args.quiet, tasks=tasks, force=args.force, log=args.log,
-                  lists={peer_inputs.NOT_DOWNLOADED: peer_inputs.not_downloaded_text(absent)})
-    return summary.exit_code
+    plan = api.Plan(records=list(args.records), columns=columns, options=options, record_opts=record_options(args),
+                    pairs=args.pairs, pair=list(args.pair),
+                    triplets={(str(a), str(b)): str(v) for a, b, v in args.triplet},
+                    directions=args.directions, scale=args.scale, scales=args.scales,
+                    peer_scales=args.peer_scales, jobs=jobs, out=args.out, force=args.force,
+                    quiet=args.quiet, dask=args.dask, log=args.log, glob=args.glob)
+    return api.run_plan(plan).exit_code

@@ -21,12 +21,11 @@ import stat
 import tempfile
 
 from pulses.shapes import AntisymmetricRicker, OneSine, Rectangular, SymmetricRicker
+from rocking.governing import FIT_TOLERANCE  # a shape "fits" a record: rocking.governing_pulse's rule
 
 #: shapes that get their own group of columns, in this order (``pulses.SHAPES`` names)
 SHAPE_NAMES = tuple(cls.shape for cls in (OneSine, SymmetricRicker, AntisymmetricRicker, Rectangular))
 
-#: a shape "fits" a record when its score is at least this fraction of the best score
-FIT_TOLERANCE = 0.7
 
 GOVERNING_RULE = (
     "Among the shapes that fit the record (score at least "

@@ -18,7 +18,7 @@ from .args import ArgumentError, output_folder
 from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV  # noqa: F401 (tests set it through the runner)
-from .tasks import Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
+from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
 
 
 @dataclass
@@ -28,6 +28,9 @@ class RunSummary:
     n_failed: int
     out: pathlib.Path
     n_reused: int = 0
+    #: the run's tables as row dicts (``design``, ``summary``, ``failures``, ``suite``): the rows the
+    #: CSV reports were written from (pipeline.api.DesignRun makes DataFrames of them)
+    tables: dict | None = dataclasses.field(default=None, repr=False)
 
     @property
     def exit_code(self) -> int:
@@ -126,6 +129,9 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         :func:`pipeline.interrupts.handling` is active): workers stopped, reports already written
         complete, no temporary file left.
     """
+    if tasks is None and not all(isinstance(c, Column) for c in columns):  # not an error per record
+        raise TypeError("columns: expected pipeline.tasks.Column objects; from Python, "
+                        "pipeline.design(records, blocks='7.5x1.8', heights=12.0) takes blocks and heights")
     out = output_folder(out)  # checked before the Path: pathlib makes "" the current folder
     if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)
@@ -217,7 +223,9 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused)
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
+                         {"design": design, "summary": rows, "failures": failures,
+                          "suite": site.suite_rows(rows) if rows else []})
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
         if any(t.direction is not None for t in tasks):  # a pair's directions are one task each

@@ -8,7 +8,7 @@ from .lazy import lazy_names
 
 #: public name -> the module of this package that defines it
 _WHERE = {
-    "RecordError": "errors",
+    "RecordError": "errors", "UnitsWarning": "errors",
     "G": "record", "Record": "record",
     "VP_TO_AP": "scenario", "design_pulse": "scenario", "pulse_period": "scenario",
     "read_record": "io",
@@ -22,6 +22,7 @@ _WHERE = {
     "read_pair": "pairs", "rotate_pair": "pairs",
     "PeerDownload": "peer",
     "check_triplet": "triplets",
+    "to_frame": "export", "from_stream": "traces",
 }
 #: submodules that are part of the public namespace
 _MODULES = ("peer",)

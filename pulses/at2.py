@@ -338,6 +338,8 @@ def _read_at2(filename, headonly=False, **kwargs):
     if headonly:
         tr.stats.npts = header["npts"]
     tr.stats.at2 = AttribDict({k: v for k, v in header.items() if k != "lines"})
+    if isinstance(filename, (str, os.PathLike)):  # the name pulses.Record.from_trace gives the record
+        tr.stats.at2.source = os.fspath(filename)
     return Stream([tr])
 
 

@@ -1,6 +1,20 @@
 """The one exception the readers raise for a record that cannot be used."""
 
 
+class UnitsWarning(UserWarning):
+    """Samples whose peak no accelerogram has in the units given (:class:`pulses.Record`).
+
+    Examples
+    --------
+    >>> import warnings, numpy as np, pulses
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     rec = pulses.Record(0.874 * np.sin(np.arange(100) / 7.0), 0.01, units="nm/s2")
+    >>> caught[0].category.__name__
+    'UnitsWarning'
+    """
+
+
 class RecordError(ValueError):
     """A record file that cannot be read as an accelerogram.
 
@@ -9,14 +23,10 @@ class RecordError(ValueError):
 
     Examples
     --------
-    >>> import os, tempfile
-    >>> import numpy as np
     >>> import pulses
-    >>> path = os.path.join(tempfile.mkdtemp(), "acc.txt")
-    >>> np.savetxt(path, [0.0, 0.1, -0.2])
     >>> try:
-    ...     pulses.read_record(path, dt=0.01)
-    ... except pulses.RecordError as err:
-    ...     print("units" in str(err))
-    True
+    ...     pulses.read_record("no-such-file.sac")
+    ... except pulses.RecordError as exc:
+    ...     print(exc)
+    no-such-file.sac: no such file
     """

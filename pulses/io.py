@@ -35,7 +35,7 @@ from .units import (
     PLAUSIBLE_MIN_G,
     WARN_PEAK_G,
     canonical_units,
-    plausible_units,
+    implausible_peak,
     unit_factor,
 )
 
@@ -103,13 +103,15 @@ def read_record(path, format=None, units=None, *, dt=None, column=None, trace=No
 
     Examples
     --------
-    >>> from importlib.resources import files
-    >>> import pulses
-    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
-    >>> rec
-    Record(name='synth_sine_055g_0.9s.sac', npts=2501, dt=0.01 s, PGA=0.634 g)
-    >>> rec.dt, rec.npts
-    (0.01, 2501)
+    >>> import importlib.resources, pulses
+    >>> path = importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"   # a bundled record
+    >>> rec = pulses.read_record(str(path))
+    >>> rec.dt, round(rec.pga / pulses.G, 3)
+    (0.01, 0.634)
+    >>> pulses.read_record("no-such-file.sac")
+    Traceback (most recent call last):
+    ...
+    pulses.errors.RecordError: no-such-file.sac: no such file
     """
     path = os.fsdecode(path)  # bytes too; bytes that are not UTF-8 kept as surrogates (PEP 383)
     shown = printable(path)
@@ -298,14 +300,8 @@ def _validate(path, acc, raw, units, units_source, meta):
     if peak_g == 0.0:
         raise RecordError(f"{path}: every sample is zero")
     if not PLAUSIBLE_MIN_G <= peak_g <= PLAUSIBLE_MAX_G:
-        raw_peak = float(np.max(np.abs(raw)))
-        options = [(u, pg) for u, pg in plausible_units(raw_peak) if u != units]
         where = "given" if units_source == "user" else "stated in the file"
-        listed = " or ".join(f"{u} (peak {pg:.2g} g)" for u, pg in options)
-        fix = (f"if the samples are in {listed}, pass units='{options[0][0]}' (--units {options[0][0]})"
-               if options else "no acceleration units make it plausible")
-        raise RecordError(f"{path}: peak {raw_peak:.4g} {units} ({where}) is {peak_g:.3g} g, implausible "
-                          f"for an accelerogram (outside {PLAUSIBLE_MIN_G:g} to {PLAUSIBLE_MAX_G:g} g); {fix}")
+        raise RecordError(f"{path}: {implausible_peak(float(np.max(np.abs(raw))), units, where)}")
     if peak_g > WARN_PEAK_G:
         meta["warnings"].append(f"peak acceleration {peak_g:.3g} g is above {WARN_PEAK_G:g} g: check the units")
     _check_offset(path, acc, meta)

@@ -75,13 +75,12 @@ def check_pair(first: Record, second: Record) -> tuple[Record, Record]:
 
     Examples
     --------
-    >>> import numpy as np
-    >>> import pulses
-    >>> a = pulses.Record(np.zeros(1000), dt=0.01, name="a")
-    >>> b = pulses.Record(np.zeros(998), dt=0.01, name="b")
-    >>> first, second = pulses.check_pair(a, b)
-    >>> first.npts, second.npts
-    (998, 998)
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> first = pulses.Record(3.0 * np.sin(t), 0.01, metadata={"azimuth": 0.0})
+    >>> second = pulses.Record(4.0 * np.cos(t[:-5]), 0.01, metadata={"azimuth": 90.0})
+    >>> [r.npts for r in pulses.check_pair(first, second)]      # cut to one length
+    [995, 995]
     """
     names = f"{_label(first)} and {_label(second)}"
     n = check_time_axis(first, second, names, "a pair", ("the first", "the second"))
@@ -194,10 +193,13 @@ def component(first, second, theta):
 
     Examples
     --------
-    >>> import numpy as np
-    >>> import pulses
-    >>> pulses.component(np.array([1.0, 0.0]), np.array([0.0, 1.0]), 90).round(12)
-    array([0., 1.])
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> first = pulses.Record(3.0 * np.sin(t), 0.01, metadata={"azimuth": 0.0})
+    >>> second = pulses.Record(4.0 * np.cos(t), 0.01, metadata={"azimuth": 90.0})
+    >>> along = pulses.component(first, second, 90.0)
+    >>> bool(np.allclose(along.acc, second.acc)), along.metadata["azimuth"]
+    (True, 90.0)
     """
     c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
     if not isinstance(first, Record):
@@ -218,14 +220,13 @@ def rotate_pair(first: Record, second: Record, theta: float) -> tuple[Record, Re
 
     Examples
     --------
-    >>> import numpy as np
-    >>> import pulses
-    >>> t = np.arange(0, 5, 0.01)
-    >>> ns = pulses.Record(np.sin(t), dt=0.01, name="N")
-    >>> ew = pulses.Record(np.zeros_like(t), dt=0.01, name="E")
-    >>> at45, at135 = pulses.rotate_pair(ns, ew, 45)
-    >>> round(at45.pga / ns.pga, 3), round(at135.pga / ns.pga, 3)
-    (0.707, 0.707)
+    >>> import numpy as np, pulses
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> first = pulses.Record(3.0 * np.sin(t), 0.01, metadata={"azimuth": 0.0})
+    >>> second = pulses.Record(4.0 * np.cos(t), 0.01, metadata={"azimuth": 90.0})
+    >>> a, b = pulses.rotate_pair(first, second, 30.0)
+    >>> round(a.pga, 3)
+    3.279
     """
     return component(first, second, theta), component(first, second, theta + 90.0)
 

@@ -27,8 +27,8 @@ def pulse_period(magnitude: float) -> float:
     Examples
     --------
     >>> import pulses
-    >>> round(pulses.pulse_period(7.0), 2)
-    1.82
+    >>> round(pulses.pulse_period(7.0), 3)     # s, for a magnitude 7 event
+    1.822
     """
     magnitude = float(magnitude)
     if not math.isfinite(magnitude):
@@ -64,9 +64,8 @@ def design_pulse(magnitude: float, shape: str = "sine", vp: float = 0.9, t0: flo
     Examples
     --------
     >>> import pulses
-    >>> pulse = pulses.design_pulse(7.0, shape="sine", vp=0.9)
-    >>> pulse.shape, round(pulse.tp, 2), round(pulse.ap / pulses.G, 2)
-    ('sine', 1.82, 0.16)
+    >>> pulses.design_pulse(7.0)               # the one-sine of a magnitude 7 event (vp = 0.9 m/s)
+    OneSine(ap=1.55173, tp=1.82212, t0=0)
     """
     cls = shape_class(shape)
     vp = float(vp)

@@ -59,12 +59,11 @@ class Pulse:
 
     Examples
     --------
-    >>> import pulses
-    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
-    >>> isinstance(pulse, pulses.Pulse), pulse.shape
-    (True, 'sine')
-    >>> round(float(pulse(0.25)) / pulses.G, 3)
-    0.5
+    >>> import numpy as np, pulses
+    >>> pulse = pulses.make_pulse("ricker-sym", 3.0, 1.0, 5.0)
+    >>> acc = pulse(np.arange(0.0, 10.0, 0.01))     # m/s^2 at any times (here a record's axis)
+    >>> round(float(acc.max()), 6), acc.size
+    (3.0, 1000)
     """
 
     ap: float
@@ -135,7 +134,8 @@ class Pulse:
 
     @classmethod
     def sampled(cls, tp: float, t0: float, t, dt: float) -> np.ndarray:
-        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support.
+        """Unit-amplitude pulse at sample times ``t`` (s), zero outside the support (the fitter's
+        shape; a pulse in m/s^2 on a record's axis is ``pulse(record.time)``, see :meth:`sample`).
 
         Point samples; a shape whose point samples do not locate it finer than ``dt`` (the
         rectangle) overrides this with cell averages over ``[t - dt/2, t + dt/2]``.
@@ -214,7 +214,24 @@ class Pulse:
         return type(self)(self.ap * factor, self.tp, self.t0)
 
     def sample(self, dt: float, name: str | None = None):
-        """Sample the pulse at step ``dt`` (s) over its support, as a :class:`pulses.Record`."""
+        """The pulse alone as a new :class:`pulses.Record`, sampled at step ``dt`` (s) over its own
+        support: it starts at ``t_start = support[0]`` and lasts as long as the pulse.
+
+        Not the pulse on a record's time axis: for that, evaluate it at the record's sample times,
+        ``pulse(record.time)`` (m/s^2, one value per sample).  Nor :meth:`sampled`, the fitter's
+        unit-amplitude shape.
+
+        Examples
+        --------
+        >>> import numpy as np, pulses
+        >>> pulse = pulses.OneSine(3.0, 1.0, t0=2.0)
+        >>> alone = pulse.sample(0.01)
+        >>> alone.t_start, alone.npts
+        (2.0, 101)
+        >>> on_axis = pulse(np.arange(0.0, 5.0, 0.01))   # a 5 s record's axis: 500 values
+        >>> on_axis.size, round(float(on_axis[225]), 6)   # 2.25 s: the crest, ap
+        (500, 3.0)
+        """
         from .record import Record
 
         start, end = self.support
@@ -239,9 +256,9 @@ class Rectangular(Pulse):
     Examples
     --------
     >>> import pulses
-    >>> pulse = pulses.Rectangular(ap=0.3 * pulses.G, tp=0.5)
-    >>> [float(pulse(t)) for t in (0.1, 0.6)]
-    [2.943, 0.0]
+    >>> pulse = pulses.Rectangular(3.0, 1.0)
+    >>> pulse.support, float(pulse(0.5))
+    ((0.0, 1.0), 3.0)
     """
 
     shape = "rect"
@@ -298,11 +315,10 @@ class OneSine(Pulse):
 
     Examples
     --------
-    >>> import numpy as np
     >>> import pulses
-    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
-    >>> np.round(pulse(np.array([0.25, 0.75, 1.5])) / pulses.G, 3)
-    array([ 0.5, -0.5,  0. ])
+    >>> pulse = pulses.OneSine(3.0, 1.0)       # ap = 3 m/s^2, Tp = 1 s, t0 = 0
+    >>> round(float(pulse(0.25)), 6), pulse.support      # the crest at Tp/4
+    (3.0, (0.0, 1.0))
     """
 
     shape = "sine"
@@ -349,9 +365,8 @@ class SymmetricRicker(_Ricker):
     Examples
     --------
     >>> import pulses
-    >>> pulse = pulses.SymmetricRicker(ap=0.4 * pulses.G, tp=1.2, t0=3.0)
-    >>> round(float(pulse(3.0)) / pulses.G, 3)
-    0.4
+    >>> pulses.SymmetricRicker(3.0, 1.0).support      # centred on t0 = 0
+    (-2.2, 2.2)
     """
 
     shape = "ricker-sym"
@@ -396,12 +411,9 @@ class AntisymmetricRicker(_Ricker):
 
     Examples
     --------
-    >>> import numpy as np
     >>> import pulses
-    >>> pulse = pulses.AntisymmetricRicker(ap=0.6 * pulses.G, tp=1.5, t0=3.0)
-    >>> t = np.linspace(0, 6, 6001)
-    >>> round(float(np.abs(pulse(t)).max()) / pulses.G, 3)
-    0.6
+    >>> pulses.AntisymmetricRicker(3.0, 1.0).support
+    (-2.8, 2.8)
     """
 
     shape = "ricker-anti"
@@ -453,10 +465,8 @@ def shape_class(shape: str) -> type[Pulse]:
     Examples
     --------
     >>> import pulses
-    >>> pulses.shape_class("sine")
-    <class 'pulses.shapes.OneSine'>
-    >>> sorted(pulses.SHAPES)
-    ['rect', 'ricker-anti', 'ricker-sym', 'sine']
+    >>> pulses.shape_class("ricker-sym").__name__
+    'SymmetricRicker'
     """
     try:
         return SHAPES[shape]
@@ -470,8 +480,8 @@ def make_pulse(shape: str, ap: float, tp: float, t0: float = 0.0) -> Pulse:
     Examples
     --------
     >>> import pulses
-    >>> pulse = pulses.make_pulse("ricker-sym", 0.45 * pulses.G, 1.2)
-    >>> type(pulse).__name__, pulse.shape
-    ('SymmetricRicker', 'ricker-sym')
+    >>> p = pulses.make_pulse("sine", 3.0, 1.0, 0.5)      # ap 3 m/s^2, Tp 1 s, from t0 = 0.5 s
+    >>> type(p).__name__, p.support
+    ('OneSine', (0.5, 1.5))
     """
     return shape_class(shape)(ap, tp, t0)

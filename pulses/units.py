@@ -60,6 +60,22 @@ def canonical_units(units: str) -> str:
     return str(units)
 
 
+def implausible_peak(raw_peak: float, units: str, where: str) -> str | None:
+    """Why a record whose largest sample is ``raw_peak`` in ``units`` is no accelerogram (its peak
+    outside :data:`PLAUSIBLE_MIN_G` to :data:`PLAUSIBLE_MAX_G`), naming the units that would make
+    it one; None where it is plausible.  ``where``: how the units came ("given", "stated in the
+    file", "assumed")."""
+    peak_g = raw_peak * unit_factor(units) / G
+    if PLAUSIBLE_MIN_G <= peak_g <= PLAUSIBLE_MAX_G:
+        return None
+    options = [(u, pg) for u, pg in plausible_units(raw_peak) if u != units]
+    listed = " or ".join(f"{u} (peak {pg:.2g} g)" for u, pg in options)
+    fix = (f"if the samples are in {listed}, pass units='{options[0][0]}' (--units {options[0][0]})"
+           if options else "no acceleration units make it plausible")
+    return (f"peak {raw_peak:.4g} {units} ({where}) is {peak_g:.3g} g, implausible for an accelerogram "
+            f"(outside {PLAUSIBLE_MIN_G:g} to {PLAUSIBLE_MAX_G:g} g); {fix}")
+
+
 def plausible_units(peak_raw: float) -> list[tuple[str, float]]:
     """Units under which a raw peak value would be a plausible accelerogram peak.
 

@@ -47,11 +47,10 @@ class RockingResult:
 
     Examples
     --------
-    >>> import pulses, rocking
-    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
-    >>> res = rocking.simulate(column, pulses.OneSine(ap=0.5 * pulses.G, tp=1.0))
-    >>> res.t.shape == res.theta.shape, bool(res.exceeded_alpha)
-    (True, False)
+    >>> import rocking, pulses
+    >>> res = rocking.simulate(rocking.Block.from_dimensions(7.5, 1.8), pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
+    >>> res.verdict_by in ("no uplift", "integration", "energy rule"), res.t.shape == res.theta.shape
+    (True, True)
     """
 
     overturned: bool
@@ -83,6 +82,35 @@ class RockingResult:
             "verdict_by": self.verdict_by,
         }
 
+    def as_dict(self) -> dict:
+        """The scalar results (:meth:`summary`; a vertical run's lift-off too) and the block's
+        ``p`` (rad/s) and ``alpha`` (rad): plain, JSON-safe numbers.
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> res = rocking.simulate(rocking.Block.from_dimensions(7.5, 1.8), pulses.make_pulse("sine", 3.0, 1.0))
+        >>> res.as_dict()["overturned"], res.as_dict()["model"]
+        (False, 'fast')
+        """
+        from pulses.export import plain
+
+        out = self.summary()
+        for name in ("lifts_off", "t_lift_off", "min_effective_gravity"):  # VerticalRockingResult's
+            if hasattr(self, name):
+                out[name] = getattr(self, name)
+        if self.block is not None:
+            out.update(p_rad_s=self.block.p, alpha_rad=self.block.alpha)
+        return plain(out)
+
+    def to_frame(self):
+        """The history as a :class:`pandas.DataFrame`: ``t_s``, ``theta_rad``, ``omega_rad_s``, one
+        row per grid node (empty where no history was kept)."""
+        import pandas as pd
+
+        return pd.DataFrame({"t_s": np.asarray(self.t, dtype=float), "theta_rad": np.asarray(self.theta, dtype=float),
+                             "omega_rad_s": np.asarray(self.omega, dtype=float)})
+
 
 @dataclass
 class BatchResult:
@@ -90,14 +118,11 @@ class BatchResult:
 
     Examples
     --------
-    >>> import pulses, rocking
-    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
-    >>> pulse = pulses.OneSine(ap=0.3 * pulses.G, tp=1.0)
-    >>> batch = rocking.simulate_many(column, pulse, scales=[1.0, 2.0, 4.0])
-    >>> batch.overturned.tolist()
-    [False, True, True]
-    >>> batch.max_rotation_ratio.round(2).tolist()
-    [0.1, 6.67, 6.67]
+    >>> import rocking, pulses
+    >>> columns = [rocking.Block.from_dimensions(7.5, w) for w in (1.0, 1.8)]
+    >>> many = rocking.simulate_many(columns, pulses.make_pulse("sine", 0.5 * pulses.G, 1.0))
+    >>> many.max_rotation_ratio.shape, many.model
+    ((2,), 'fast')
     """
 
     overturned: np.ndarray
@@ -111,6 +136,23 @@ class BatchResult:
     #: (``g + av < 0``; its verdict is then not a verdict) and when (nan where not); else None
     lifts_off: np.ndarray | None = None
     t_lift_off: np.ndarray | None = None
+
+    def to_frame(self):
+        """One row per run (:class:`pandas.DataFrame`), the arrays as columns and ``model``."""
+        import pandas as pd
+
+        cols = {name: np.ravel(getattr(self, name)) for name in
+                ("overturned", "exceeded_alpha", "max_rotation", "max_rotation_ratio", "n_impacts",
+                 "uplifted", "lifts_off", "t_lift_off") if getattr(self, name) is not None}
+        df = pd.DataFrame(cols)
+        df["model"] = self.model
+        return df
+
+    def as_dict(self) -> dict:
+        """Every run's results as lists (plain, JSON-safe)."""
+        from pulses.export import plain
+
+        return plain({"model": self.model, **self.to_frame().drop(columns="model").to_dict("list")})
 
 
 def _pulse_extrema(pulse: Pulse) -> list[float]:

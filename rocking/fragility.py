@@ -74,15 +74,12 @@ class CriticalScale:
 
     Examples
     --------
-    >>> from importlib.resources import files
-    >>> import pulses, rocking
-    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
-    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
-    >>> found = rocking.critical_scale(column, rec)
-    >>> round(found.scale, 2), round(found.uplift_scale, 3)
-    (1.11, 0.379)
-    >>> bool(found.scale < found.islands[0][0])
-    True
+    >>> import numpy as np, pulses, rocking
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.3 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> cs = rocking.critical_scale(rocking.Block.from_dimensions(7.5, 1.8), rec, up_to=3.0)
+    >>> round(cs.critical_pga / pulses.G, 3)       # the PGA that overturns the column
+    0.527
     """
 
     scale: float | None
@@ -111,6 +108,13 @@ class CriticalScale:
     def critical_pga(self) -> float | None:
         """PGA of the critically scaled record, m/s^2 (None when nothing overturned)."""
         return None if self.scale is None else self.scale * self.pga
+
+    def as_dict(self) -> dict:
+        """The fields (scale factors, PGA in m/s^2, islands as pairs) and ``critical_pga``: plain,
+        JSON-safe."""
+        from pulses.export import fields_dict
+
+        return fields_dict(self, properties=("overturns", "critical_pga"))
 
 
 def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
@@ -162,13 +166,12 @@ def critical_scale(block, record, up_to=UP_TO, *, n_scan=N_SCAN, step=STEP,
 
     Examples
     --------
-    >>> from importlib.resources import files
-    >>> import pulses, rocking
-    >>> rec = pulses.read_record(str(files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
-    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
-    >>> found = rocking.critical_scale(column, rec)
-    >>> round(found.scale, 2), round(found.uplift_scale, 3)
-    (1.11, 0.379)
+    >>> import numpy as np, pulses, rocking
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> rec = pulses.Record(pulses.make_pulse("sine", 0.3 * pulses.G, 1.0, 2.0)(t), 0.01)
+    >>> cs = rocking.critical_scale(rocking.Block.from_dimensions(7.5, 1.8), rec, up_to=3.0)
+    >>> round(cs.scale, 3), cs.overturns
+    (1.756, True)
     """
     if not isinstance(block, Block):
         raise TypeError("critical_scale: block must be a rocking.Block")
@@ -285,10 +288,8 @@ class Fragility:
     Examples
     --------
     >>> import rocking
-    >>> curve = rocking.fragility([1.2, 1.5, 1.9, 2.4, 3.1])
-    >>> round(curve.median, 3), round(curve.beta, 3)
-    (1.91, 0.335)
-    >>> round(float(curve.probability(curve.median)), 2)
+    >>> f = rocking.fragility([1.2, 1.5, 2.0, None], up_to=3.0)
+    >>> round(f.probability(f.median), 3)
     0.5
     """
 
@@ -313,6 +314,14 @@ class Fragility:
             z = np.log(x / self.median) / self.beta
         out = ndtr(z)
         return float(out) if out.ndim == 0 else out
+
+    def as_dict(self) -> dict:
+        """``median``, ``beta``, ``measure``, ``n`` and the fitted values (``None`` for censored
+        records): plain, JSON-safe."""
+        from pulses.export import plain
+
+        return plain({"median": self.median, "beta": self.beta, "measure": self.measure, "n": self.n,
+                      "values": self.values, "censored_at": self.censored_at})
 
     def empirical(self):
         """``(x, share)``: the sorted critical intensities and the share of records overturned at
@@ -350,9 +359,9 @@ def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility
     Examples
     --------
     >>> import rocking
-    >>> curve = rocking.fragility([1.2, 1.5, 1.9, 2.4, 3.1])
-    >>> round(curve.median, 3), round(curve.beta, 3)
-    (1.91, 0.335)
+    >>> f = rocking.fragility([1.2, 1.5, 2.0, None], up_to=3.0)   # critical scales; None: not up to 3
+    >>> round(f.median, 3), round(f.beta, 3), f.n
+    (1.921, 0.442, 4)
     """
     if measure not in ("scale", "pga"):
         raise ValueError(f"fragility: measure must be 'scale' or 'pga', got {measure!r}")

@@ -42,11 +42,9 @@ class MinSlenderness:
 
     Examples
     --------
-    >>> import pulses, rocking
-    >>> res = rocking.min_slenderness(pulses.OneSine(ap=0.5 * pulses.G, tp=1.0), 1.381)
-    >>> round(res.tan_alpha, 3), round(res.eq31, 3)
-    (0.231, 0.29)
-    >>> res.criterion, len(res.transitions) >= 1
+    >>> import rocking, pulses
+    >>> ms = rocking.min_slenderness(pulses.OneSine(0.71 * pulses.G, 0.8), 1.381)
+    >>> ms.criterion, ms.transitions[-1] <= ms.tan_alpha
     ('overturn', True)
     """
 
@@ -65,6 +63,20 @@ class MinSlenderness:
     def alpha(self) -> float:
         """``atan(tan_alpha)``, rad."""
         return math.atan(self.tan_alpha)
+
+    def as_dict(self) -> dict:
+        """The fields (not the excitation) and ``alpha``: plain, JSON-safe numbers.
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> m = rocking.min_slenderness(pulses.make_pulse("sine", 3.0, 1.0), p=1.5)
+        >>> sorted(m.as_dict())[:3]
+        ['alpha', 'criterion', 'eq31']
+        """
+        from pulses.export import fields_dict
+
+        return fields_dict(self, skip=("excitation",), properties=("alpha",))
 
     @property
     def safe_islands(self) -> list:
@@ -95,9 +107,9 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     Examples
     --------
     >>> import rocking
-    >>> results = rocking.min_slenderness_batch("sine", [1.0, 4.0], [0.5, 0.5])
-    >>> [round(r.tan_alpha, 3) for r in results]
-    [0.122, 0.421]
+    >>> res = rocking.min_slenderness_batch("sine", [1.0, 2.0], [0.5, 0.5])    # pTp, ap/g
+    >>> [round(r.tan_alpha, 4) for r in res]
+    [0.1221, 0.3383]
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -177,10 +189,10 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
 
     Examples
     --------
-    >>> import pulses, rocking
-    >>> res = rocking.min_slenderness(pulses.OneSine(ap=0.5 * pulses.G, tp=1.0), 1.381)
-    >>> round(res.tan_alpha, 3), round(res.eq31, 3)
-    (0.231, 0.29)
+    >>> import rocking, pulses
+    >>> ms = rocking.min_slenderness(pulses.OneSine(0.71 * pulses.G, 0.8), 1.381)
+    >>> round(ms.tan_alpha, 4)                 # exact; Eq. 31 asks for 0.3727
+    0.1989
     """
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
@@ -233,13 +245,9 @@ class CriticalAmplitudes(list):
     Examples
     --------
     >>> import rocking
-    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
-    >>> found = rocking.critical_amplitudes(column, "sine", 1.0)
-    >>> low, high = found[0]
-    >>> round(low / 9.81, 3)
-    0.526
-    >>> found.safe_islands
-    []
+    >>> amps = rocking.critical_amplitudes(rocking.Block.from_dimensions(7.5, 1.2), "sine", 1.0)
+    >>> len(amps), amps.shape
+    (1, 'sine')
     """
 
     def __init__(self, intervals, *, block, shape, tp, up_to, criterion, runs):
@@ -256,6 +264,20 @@ class CriticalAmplitudes(list):
     def safe_islands(self) -> list:
         """``(low, high)`` amplitude ranges (m/s^2) of survival above the smallest failing one."""
         return [(self[i][1], self[i + 1][0]) for i in range(len(self) - 1)]
+
+    def as_dict(self) -> dict:
+        """The intervals, islands and settings: plain, JSON-safe numbers (m/s^2, s)."""
+        from pulses.export import plain
+
+        return plain({"shape": self.shape, "tp": self.tp, "up_to": self.up_to, "criterion": self.criterion,
+                      "runs": self.runs, "minimum": self.minimum, "intervals": list(self),
+                      "safe_islands": self.safe_islands, "p": self.block.p, "alpha": self.block.alpha})
+
+    def to_frame(self):
+        """One row per failing interval: ``low_m_s2``, ``high_m_s2``."""
+        import pandas as pd
+
+        return pd.DataFrame(list(self), columns=["low_m_s2", "high_m_s2"])
 
 
 def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n_scan=400,
@@ -282,12 +304,10 @@ def critical_amplitudes(block, shape, tp, up_to=None, *, criterion="overturn", n
 
     Examples
     --------
-    >>> import rocking
-    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
-    >>> found = rocking.critical_amplitudes(column, "sine", 1.0)
-    >>> low, high = found[0]
-    >>> round(low / 9.81, 3)
-    0.526
+    >>> import rocking, pulses
+    >>> amps = rocking.critical_amplitudes(rocking.Block.from_dimensions(7.5, 1.2), "sine", 1.0)
+    >>> round(amps.minimum / pulses.G, 3), amps.safe_islands
+    (0.317, [])
     """
     _check_criterion(criterion)
     uplift = block.uplift_acceleration

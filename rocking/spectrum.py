@@ -28,13 +28,10 @@ class OverturningSpectrum:
 
     Examples
     --------
-    >>> import math
     >>> import rocking
-    >>> spec = rocking.overturning_spectrum(math.atan(0.25), "sine", [0.5, 4.0], [1.5, 3.0])
-    >>> spec.overturned.tolist()
-    [[True, True], [False, True]]
-    >>> spec.shape, spec.overturned.shape
-    ('sine', (2, 2))
+    >>> spec = rocking.overturning_spectrum(0.2, "sine", [2.0, 4.0], [1.0, 3.0])
+    >>> spec.minimum_overturning().tolist()
+    [3.0, 3.0]
     """
 
     alpha: float
@@ -59,6 +56,12 @@ class OverturningSpectrum:
         """Boolean grid: surviving points lying above an overturning point of the same ``omega_p/p``."""
         seen = np.cumsum(self.overturned, axis=1) > 0
         return seen & ~self.overturned
+
+    def as_dict(self) -> dict:
+        """The grid and its verdicts as nested lists (``[i][j]`` as the arrays): plain, JSON-safe."""
+        from pulses.export import fields_dict
+
+        return fields_dict(self)
 
     def to_frame(self):
         """Long-format :class:`pandas.DataFrame`, one row per grid point."""
@@ -131,11 +134,10 @@ def overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, *, eta=None, mod
 
     Examples
     --------
-    >>> import math
     >>> import rocking
-    >>> spec = rocking.overturning_spectrum(math.atan(0.25), "sine", [0.5, 4.0], [1.5, 3.0])
-    >>> spec.overturned.tolist()
-    [[True, True], [False, True]]
+    >>> spec = rocking.overturning_spectrum(0.2, "sine", [2.0, 4.0], [1.0, 3.0])
+    >>> spec.overturned.tolist()           # [omega_p/p][ap/(g tan alpha)]
+    [[False, True], [False, True]]
     """
     if shape not in SHAPES:
         raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}")

@@ -40,11 +40,10 @@ class RequiredWidth:
 
     Examples
     --------
-    >>> import pulses, rocking
-    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
-    >>> need = rocking.required_width(7.5, pulse, rule="exact")
-    >>> need.rule, need.height, round(need.width, 3), need.runs > 0
-    ('exact', 7.5, 1.736, True)
+    >>> import rocking, pulses
+    >>> w = rocking.required_width(7.5, pulses.OneSine(0.71 * pulses.G, 0.8), rule="eq31")
+    >>> w.rule, round(w.tan_alpha, 4) == round(w.width / 7.5, 4)
+    ('eq31', True)
     """
 
     width: float
@@ -100,6 +99,31 @@ class RequiredWidth:
     @property
     def tan_alpha(self) -> float:
         return self.width / self.height
+
+    def as_dict(self) -> dict:
+        """Every field but the check's arrays, with ``tan_alpha`` and ``p``: plain, JSON-safe
+        numbers (widths and heights in m, ``p`` in rad/s).
+
+        Examples
+        --------
+        >>> import rocking, pulses
+        >>> w = rocking.required_width(7.5, pulses.make_pulse("sine", 3.0, 1.0), rule="eq31")
+        >>> d = w.as_dict()
+        >>> d["rule"], round(d["width"], 3) == round(w.width, 3)
+        ('eq31', True)
+        """
+        from pulses.export import fields_dict
+
+        return fields_dict(self, properties=("tan_alpha", "p"))
+
+    def to_frame(self):
+        """The check above the verified width, one row per width checked (``width_m``,
+        ``failed``); empty where there was no check."""
+        import pandas as pd
+
+        widths = np.asarray(self.check_widths if self.check_widths is not None else [], dtype=float)
+        failed = np.asarray(self.check_failed if self.check_failed is not None else [], dtype=bool)
+        return pd.DataFrame({"width_m": widths, "failed": failed})
 
     @property
     def block(self) -> Block:

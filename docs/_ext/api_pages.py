@@ -19,13 +19,14 @@ THEMES = {
     "pulses": ("pulses: records, pulse shapes, fitting, classification", [
         ("Records", ["Record", "read_record", "write_sac", "RecordError", "read_pair", "pair_files",
                      "Pairing", "check_pair", "check_triplet", "rotate_pair", "component",
-                     "PeerDownload", "peer"]),
+                     "PeerDownload", "peer", "from_stream", "UnitsWarning"]),
         ("Pulse shapes", ["Pulse", "Rectangular", "OneSine", "SymmetricRicker",
                           "AntisymmetricRicker", "make_pulse", "shape_class", "design_pulse",
                           "pulse_period"]),
         ("Fitting a pulse to a record", ["fit_pulse", "PulseFit", "Candidate", "FitError"]),
         ("Pulse-like records (Shahi & Baker)", ["classify_pulse", "PulseClassification",
                                                 "PulseCandidate"]),
+        ("Results as tables", ["to_frame"]),
     ]),
     "rocking": ("rocking: the block, the solvers, design", [
         ("The block", ["Block", "eta_housner", "linear_error_estimate"]),
@@ -34,6 +35,8 @@ THEMES = {
         ("Design: the width a column needs", ["required_width", "RequiredWidth", "eq31", "eq20",
                                               "envelope_rule", "min_slenderness", "MinSlenderness",
                                               "min_slenderness_batch"]),
+        ("The governing pulse of a record", ["governing_pulse", "GoverningPulse",
+                                             "fitting_candidates"]),
         ("Charts and spectra", ["slenderness_chart", "plot_chart", "overturning_spectrum",
                                 "OverturningSpectrum", "critical_amplitudes",
                                 "CriticalAmplitudes"]),
@@ -42,6 +45,7 @@ THEMES = {
         ("Rocking frames", ["frame_p", "eta_frame", "equivalent_size"]),
     ]),
     "pipeline": ("pipeline: the command line and batches from Python", [
+        ("The batch from Python", ["design", "DesignRun"]),
         ("The command line", ["main"]),
     ]),
 }
