@@ -66,6 +66,33 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Run the ``pipeline`` command with ``argv``, as the shell does, and return its exit status.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``pipeline`` (default: ``sys.argv[1:]``); ``pipeline --help`` lists
+        the sub-commands (docs/commands.md).
+
+    Returns
+    -------
+    int
+        0 on success, 1 when a record or the file system failed, 2 for an argument error (its
+        one-line reason printed on standard error), 130 when interrupted.
+
+    See Also
+    --------
+    rocking.simulate : the solver ``pipeline simulate`` calls.
+
+    Examples
+    --------
+    >>> from pipeline import main
+    >>> main(["simulate", "--block", "7.5x1.8", "--pulse", "sine", "--ap", "0.5g", "--tp", "1.0"])
+    7.5 x 1.8 m column (tan(alpha) = 0.24, p = 1.381 rad/s) under sine pulse ap=0.5g tp=1 s:
+      survives; max|theta|/alpha = 0.7906 (max|theta| = 0.1862 rad)
+      impacts: 1; model: fast (verdict by energy rule)
+    0
+    """
     from . import interrupts
 
     interrupts.reset()

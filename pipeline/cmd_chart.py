@@ -1,12 +1,14 @@
-"""``pipeline chart``: Fig. 8, the exact minimum tan(alpha) against ap/g for several pTp.
+"""``pipeline chart``: Fig. 8, the exact minimum tan(alpha) against ap/g for several pTp; or,
+with ``--heights``, the width a column needs against its height for one pulse under every rule.
 
-    pipeline chart --pulse all [--csv chart.csv] [--plot chart.png]
+    pipeline chart --pulse all [--csv chart.csv] [--plot chart.png] [--block 7.5x1.8 --ap 0.5g --tp 1]
+    pipeline chart --heights 3:15 --pulse sine --ap 0.5g --tp 1 [--block 7.5x1.8] [--plot w.png]
 """
 from __future__ import annotations
 
 import time
 
-from .args import ArgumentError, ShapeNames
+from .args import ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_positive
 
 
 def _floats(text, what):
@@ -30,9 +32,36 @@ def add_parser(subparsers):
     p.add_argument("--ptp", help="comma-separated pTp values (default 0.5,1,2,3,4,6,10,20)")
     p.add_argument("--apg", help="comma-separated ap/g values (default 20 from 0.075 to 1.5)")
     p.add_argument("--criterion", default="overturn", choices=["overturn", "exceed"])
+    p.add_argument("--heights", help="LOW:HIGH[:N] or comma-separated heights in m: the width "
+                                      "against height for the pulse of --pulse/--ap/--tp under every rule")
+    p.add_argument("--ap", help="your pulse's amplitude, e.g. 0.5g or 4.9m/s2 (with --tp)")
+    p.add_argument("--tp", help="your pulse's period, s (with --ap)")
+    p.add_argument("--block", help="your column HEIGHTxWIDTH in m, e.g. 7.5x1.8: marked on the chart")
     p.add_argument("--csv", help="write the table to this CSV file")
     p.add_argument("--plot", help="write the chart to this PNG file")
     p.set_defaults(func=run)
+
+
+def _heights(text):
+    parts = str(text).split(":")
+    if len(parts) in (2, 3):
+        lo, hi = (float(_floats(v, "--heights")[0]) for v in parts[:2])
+        n = int(_floats(parts[2], "--heights")[0]) if len(parts) == 3 else 13
+        if not (lo < hi and 2 <= n <= 200):
+            raise ArgumentError(f"--heights: need LOW < HIGH and 2..200 points, got {text!r}")
+        return [lo + (hi - lo) * k / (n - 1) for k in range(n)]
+    return _floats(text, "--heights")
+
+
+def _your_pulse(args):
+    """``(shape, ap, tp)`` from --pulse/--ap/--tp, or None when neither --ap nor --tp is given."""
+    if args.ap is None and args.tp is None:
+        return None
+    if args.ap is None or args.tp is None:
+        raise ArgumentError("--ap and --tp go together (your pulse's amplitude and period)")
+    if args.pulse == "all":
+        raise ArgumentError("--ap/--tp need one pulse shape: --pulse sine, rect, ricker-sym or ricker-anti")
+    return args.pulse, parse_acceleration(args.ap, signed=False), parse_positive(args.tp, "--tp")
 
 
 def run(args) -> int:
@@ -42,7 +71,12 @@ def run(args) -> int:
     from .outpaths import check_file_options
 
     check_file_options(args, "chart")
-
+    pulse = _your_pulse(args)
+    column = parse_block(args.block) if args.block else None
+    if args.heights:
+        if pulse is None:
+            raise ArgumentError("--heights needs your pulse: --pulse SHAPE --ap AMPLITUDE --tp PERIOD")
+        return _run_heights(args, _heights(args.heights), pulse, column)
     shapes = ShapeNames().names() if args.pulse == "all" else [args.pulse]
     ptp = _floats(args.ptp, "--ptp") if args.ptp else CHART_PTP
     apg = _floats(args.apg, "--apg") if args.apg else CHART_APG
@@ -63,6 +97,52 @@ def run(args) -> int:
         write_output(args.csv, frame.to_csv(index=False), "csv")
         print(f"wrote {args.csv}")
     if args.plot:
-        write_output(args.plot, figure_png(lambda buf: rocking.plot_chart(frame, buf)), "png")
+        mark = _mark(pulse, column)
+        write_output(args.plot, figure_png(lambda buf: rocking.plot_chart(frame, buf, mark=mark)), "png")
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def _mark(pulse, column):
+    """Your pulse and column as a point of Fig. 8: ``(shape, pTp, ap/g, tan alpha)``."""
+    if pulse is None or column is None:
+        return None
+    import rocking
+    from pulses import G
+
+    shape, ap, tp = pulse
+    block = rocking.Block.from_dimensions(*column)
+    return shape, block.p * tp, ap / G, block.tan_alpha
+
+
+def _run_heights(args, heights, pulse, column) -> int:
+    import pulses
+
+    from .outpaths import figure_png, write_output
+    from .width_chart import RULES, width_figure, widths_by_height
+
+    shape, ap, tp = pulse
+    start = time.perf_counter()
+    frame = widths_by_height(pulses.make_pulse(shape, ap, tp), heights)
+    elapsed = time.perf_counter() - start
+    title = f"{shape} pulse, ap = {ap / pulses.G:.3g} g, Tp = {tp:g} s: width a column needs"
+    print(f"{title}, by rule, {len(heights)} heights in {elapsed:.1f} s (m)")
+    table = frame.pivot(index="height_m", columns="rule", values="width_m")[list(RULES)]
+    print(f"{'height':>8} " + " ".join(f"{r:>9}" for r in table.columns))
+    for h, row in table.iterrows():
+        print(f"{h:>8.4g} " + " ".join(f"{v:>9.3f}" for v in row))
+    if column is not None:
+        h, b = column
+        import rocking
+
+        need = rocking.required_width(h, pulses.make_pulse(shape, ap, tp), rule="exact").width
+        print(f"your column {h:g} x {b:g} m: the exact rule asks for {need:.3f} m "
+              + ("(it is wide enough)" if b >= need else "(it is too narrow)"))
+    if args.csv:
+        write_output(args.csv, frame.to_csv(index=False), "csv")
+        print(f"wrote {args.csv}")
+    if args.plot:
+        fig = width_figure(frame, title, column)
+        write_output(args.plot, figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110)), "png")
         print(f"wrote {args.plot}")
     return 0

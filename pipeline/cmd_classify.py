@@ -163,4 +163,5 @@ def format_rows(rows) -> str:
                      f"{r['velocity_tp_s']:6.2f}  {r['pgv_m_s']:9.3f}  {r['orientation_deg']:+7.1f}  {az}  "
                      f"{r['arrival_s']:11.2f}  {'yes' if r['late'] else 'no ':<4}  {r['pgv_ratio']:5.3f}  "
                      f"{r['energy_ratio']:5.3f}  {files}")
+    lines += [f"{r['file']}: {r['pulse_like_reason']}" for r in rows if r.get("pulse_like_reason")]
     return "\n".join(lines)

@@ -1,6 +1,7 @@
 """``pipeline spectrum``: the overturning spectrum of Fig. 5.
 
     pipeline spectrum --alpha 14deg --pulse sine [--grid 200x200] --csv out.csv --plot out.png
+    pipeline spectrum --block 7.5x1.8 --pulse sine --ap 0.5g --tp 1 --plot out.png   # your column marked
 """
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import math
 import re
 import time
 
-from .args import ArgumentError, ShapeNames, parse_angle
+from .args import ArgumentError, ShapeNames, parse_acceleration, parse_angle, parse_block, parse_positive
 
 
 
@@ -36,7 +37,11 @@ def add_parser(subparsers):
         description="Survive / overturn over omega_p/p (x) and ap/(g tan alpha) (y) for blocks of "
                     "slenderness alpha under one pulse shape (the paper's Fig. 5), from the batch "
                     "solver and the similarity law.")
-    p.add_argument("--alpha", required=True, help="slenderness: 14deg, 0.244rad or tan0.25")
+    p.add_argument("--alpha", help="slenderness: 14deg, 0.244rad or tan0.25 (default: --block's)")
+    p.add_argument("--block", help="your column HEIGHTxWIDTH in m, e.g. 7.5x1.8 (its slenderness; "
+                                    "with --ap and --tp, marked on the plot)")
+    p.add_argument("--ap", help="your pulse's amplitude, e.g. 0.5g (with --block and --tp)")
+    p.add_argument("--tp", help="your pulse's period, s (with --block and --ap)")
     p.add_argument("--pulse", default="sine", choices=ShapeNames(), metavar="SHAPE",
                    help="pulse shape: %(choices)s (default sine)")
     p.add_argument("--grid", default="200x200", help="points along omega_p/p x ap/(g tan alpha)")
@@ -55,7 +60,11 @@ def run(args) -> int:
     from .outpaths import check_file_options
 
     check_file_options(args, "spectrum")
-    alpha = parse_angle(args.alpha)
+    if args.alpha is None and args.block is None:
+        raise ArgumentError("give the slenderness: --alpha 14deg, or your column with --block 7.5x1.8")
+    block = rocking.Block.from_dimensions(*parse_block(args.block)) if args.block else None
+    alpha = parse_angle(args.alpha) if args.alpha else block.alpha
+    mark = _mark(args, block)
     nw, na = _grid(args.grid)
     w0, w1 = _range(args.wp_range, "--wp-range")
     a0, a1 = _range(args.ap_range, "--ap-range")
@@ -82,6 +91,18 @@ def run(args) -> int:
         write_output(args.csv, spec.to_frame().to_csv(index=False), "csv")
         print(f"wrote {args.csv}")
     if args.plot:
-        write_output(args.plot, figure_png(spec.plot), "png")
+        write_output(args.plot, figure_png(lambda buf: spec.plot(buf, mark=mark)), "png")
         print(f"wrote {args.plot}")
     return 0
+
+
+def _mark(args, block):
+    """Your column under your pulse as a point of the spectrum, ``(omega_p/p, ap/(g tan alpha))``."""
+    if args.ap is None and args.tp is None:
+        return None
+    if args.ap is None or args.tp is None or block is None:
+        raise ArgumentError("--ap and --tp mark your pulse with your column: give --block, --ap and --tp")
+    from pulses import G
+
+    ap, tp = parse_acceleration(args.ap, signed=False), parse_positive(args.tp, "--tp")
+    return 2 * math.pi / (block.p * tp), ap / (G * block.tan_alpha)

@@ -19,6 +19,7 @@ from . import report
 from .design_table import (eq31_text, failing_text, metadata_text, pulse_text, search_text,
                            survives_text, verdict_lines, fine_print, vertical_text)
 from .design_table import number as _num
+from .report import FIT_TOLERANCE
 
 #: the file in ``--out``
 REPORT_HTML = "report.html"
@@ -66,6 +67,12 @@ document.querySelectorAll("table.sortable").forEach(function (table) {
 });
 """
 
+
+
+def _whole(value):
+    """A count as a whole number (``1500``, not ``1500.0`` as a CSV round trip gives it)."""
+    number = _num(value)
+    return int(number) if number is not None and float(number).is_integer() else value
 
 def output_files() -> list[str]:
     """The files this module writes into ``--out``."""
@@ -170,10 +177,12 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
             ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s"),
             ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
                            f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
-                           f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"),
+                           f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"
+                           + (f": {first['pulse_like_reason']}" if first.get("pulse_like_reason") else "")),
             ("fitted pulse", f"{first.get('pulse_shape') or '-'}: ap {_fixed(first.get('pulse_ap_g'), 3) or '-'} g, "
                              f"Tp {_fixed(first.get('pulse_tp_s'), 3) or '-'} s, score {_fixed(first.get('pulse_score'), 2) or '-'} "
-                             f"({first.get('pulse_fit') or '-'} least squares); shapes that fit: "
+                             f"({first.get('pulse_fit') or '-'} least squares); shapes fitting almost as well (score at least "
+                             f"{FIT_TOLERANCE:g} x the best): "
                              f"{first.get('shapes_fitting') or '-'}"),
         ]
         if first.get("warnings"):
@@ -181,7 +190,11 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
         out.append("<dl>" + "".join(f"<dt>{_e(k)}</dt><dd>{_e(v)}</dd>" for k, v in facts) + "</dl>")
         out.append("<ul>")
         for r in rows:
-            parts = [f"column {r.get('column')}: governing pulse {pulse_text(r)}",
+            governs = f"column {r.get('column')}: governing pulse {pulse_text(r)}"
+            if r.get("governing_shape") and r.get("governing_shape") != first.get("pulse_shape"):
+                governs += (f" (not the best fit, {first.get('pulse_shape')}: of the shapes that fit, "
+                            "the one asking for the widest column by Eq. 31)")
+            parts = [governs,
                      f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
                      + (" (below the design width)" if (_num(r.get("eq31_width_m")) or 0) < (_num(r.get("verified_width_m")) or 0) else "")
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
@@ -191,7 +204,7 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
-                parts.append(f"check above the search width: {r.get('check_runs')} widths up to twice "
+                parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to twice "
                              "it (or the no-uplift width), "
                              + (f"{100 * share:.2g} % fail, the widest at "
                                 + (failing_text(r.get("widest_failing_width_m"), r.get("search_width_m")) or "-")

@@ -14,7 +14,8 @@ from .design_table import excess_text
 #: dots per inch; the figures are 9 in wide: 1350 px
 DPI = 150
 WIDTH_IN = 9.0
-SAFE, FAIL = "#cfe3cf", "C3"
+#: Okabe-Ito sky blue (pale) and vermillion: apart with every common colour-vision deficiency
+SAFE, FAIL = "#cde6f7", "#D55E00"
 
 
 def _png(fig) -> bytes:
@@ -24,7 +25,7 @@ def _png(fig) -> bytes:
 
 
 def _bars(ax, x, failed, scale=1.0, offset=0.0):
-    """A failing width drawn as a red line, the rest of the row pale green (safe)."""
+    """A failing width drawn as a vermillion line, the rest of the row pale blue (safe)."""
     ax.axhspan(0.0, 1.0, color=SAFE, lw=0)
     xf = (np.asarray(x)[failed] - offset) * scale
     ax.vlines(xf, 0.0, 1.0, color=FAIL, lw=1.0)
@@ -66,7 +67,7 @@ def widths_figure(title, width, widths, failed, widest_failing=None, near=0.05):
         ax1.axvline(widest_failing, color=FAIL, lw=2, ls="--",
                     label=f"widest failing width {widest_failing:.4g} m "
                           f"({excess_text(widest_failing, width)})")
-    ax1.set_xlabel("column width B (m): red overturns, green survives")
+    ax1.set_xlabel("column width B (m): vermillion overturns, pale blue survives")
     ax1.set_title(f"{title}: {x.size} widths, {int(f.sum())} overturn, "
                   f"{int(above.sum())} of them above the verified width", fontsize=9)
     ax1.legend(loc="upper right", fontsize=7, framealpha=0.9)
@@ -112,5 +113,5 @@ def record_widths_png(record_id, verified) -> bytes | None:
                      f"search's first transition {w:.4g} m); the check above it: {x.size} widths, "
                      f"{int(f.sum())} fail (share {v.failing_share:.3g})", fontsize=9)
         ax.legend(loc="upper right", fontsize=7, framealpha=0.9)
-        ax.set_xlabel("B / search width - 1 (%, log scale): red fails, green survives")
+        ax.set_xlabel("B / search width - 1 (%, log scale): vermillion fails, pale blue survives")
     return _png(fig)

@@ -30,11 +30,14 @@ MAX_PULSES = 4
 #: most curves per rotation-history panel (the column as it stands, the Eq. 31 design, the
 #: verified width)
 MAX_CURVES = 3
+#: Okabe-Ito colours (apart with every common colour-vision deficiency); styles tell curves apart too
+PALETTE = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9"]
 _PULSE_STYLES = ["-", "--", "-.", ":"]
 _CURVE_STYLES = ["-", "--", "-."]
 #: record figure in inches: margins (room for the y label and tick labels as wide as "-0.0075",
-#: the x tick labels and label, the first title), height of a panel, gap between panels (a title)
-_RECORD_LEFT, _RECORD_RIGHT, _RECORD_TOP, _RECORD_BOTTOM = 0.95, 0.15, 0.36, 0.55
+#: the legends beside the panels, off the curves and the +-alpha lines, the x tick labels and
+#: label, the first title), height of a panel, gap between panels (a title)
+_RECORD_LEFT, _RECORD_RIGHT, _RECORD_TOP, _RECORD_BOTTOM = 0.95, 3.35, 0.36, 0.55
 _PANEL, _GAP = 1.75, 0.45
 #: matplotlib is not thread-safe and dask may run tasks in threads of one process
 _LOCK = threading.Lock()
@@ -100,7 +103,7 @@ def record_figure(record_id, record, fit, fitting, histories, velocity=None) -> 
         raise ValueError(f"at most {MAX_PULSES} fitted pulses per record figure, got {len(fitting)}")
     n_top = 1 if velocity is None else 2
     n_gaps = len(histories) + n_top - 1
-    width, height = 8.0, _RECORD_TOP + _RECORD_BOTTOM + (n_top + len(histories)) * _PANEL + n_gaps * _GAP
+    width, height = 7.85 + _RECORD_RIGHT, _RECORD_TOP + _RECORD_BOTTOM + (n_top + len(histories)) * _PANEL + n_gaps * _GAP
     fig = _figure(width, height)
     # margins fixed in inches (room for these labels, checked by tests/test_plots.py): a layout
     # engine measures every text before drawing it, which made the figure half as costly again
@@ -111,7 +114,7 @@ def record_figure(record_id, record, fit, fitting, histories, velocity=None) -> 
     t = record.time
     ax.plot(*_thin(t, record.acc / G), color="0.55", lw=0.6, label="record")
     for i, c in enumerate(fitting):
-        ax.plot(*_thin(t, c.pulse(t) / G), color=f"C{i}", lw=1.6 if i == 0 else 1.1, ls=_PULSE_STYLES[i],
+        ax.plot(*_thin(t, c.pulse(t) / G), color=PALETTE[i], lw=1.6 if i == 0 else 1.1, ls=_PULSE_STYLES[i],
                 label=f"{c.shape}: ap {c.ap / G:+.3g} g, Tp {c.tp:.3g} s, score {c.score:.2f}")
     ax.set_ylabel("ground acc. (g)", fontsize=LABEL_SIZE)
     # titles at a given height (y=1): matplotlib otherwise measures the axes' ticks to place them
@@ -124,7 +127,7 @@ def record_figure(record_id, record, fit, fitting, histories, velocity=None) -> 
             raise ValueError(f"at most {MAX_CURVES} curves per history panel, got {len(curves)}")
         for j, (curve_label, block, res) in enumerate(curves):
             verdict = "overturns" if res.overturned else f"max {res.max_rotation_ratio:.3g} alpha"
-            ax.plot(*_thin(res.t, np.asarray(res.theta, dtype=float) / block.alpha), color=f"C{j}", lw=1.0,
+            ax.plot(*_thin(res.t, np.asarray(res.theta, dtype=float) / block.alpha), color=PALETTE[j], lw=1.0,
                     ls=_CURVE_STYLES[j], label=f"{curve_label}: {verdict}")
         ax.axhline(1.0, color="k", lw=0.5, ls=":")  # overturning starts past |theta| = alpha
         ax.axhline(-1.0, color="k", lw=0.5, ls=":")
@@ -133,8 +136,8 @@ def record_figure(record_id, record, fit, fitting, histories, velocity=None) -> 
     for ax in axes:
         _style(ax)
         if ax.get_legend_handles_labels()[0]:
-            # a fixed corner: 'best' searches every point of every curve
-            ax.legend(loc="upper right", fontsize=LEGEND_SIZE)
+            # beside the panel, off the data ('best' would search every point of every curve)
+            ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=LEGEND_SIZE, frameon=False)
     axes[0].set_xlim(record.t_start, record.t_start + record.duration)
     axes[-1].set_xlabel("time (s)", fontsize=LABEL_SIZE)
     fig.align_ylabels(axes)
@@ -146,7 +149,7 @@ def _velocity_panel(ax, cls) -> None:
     t = cls.time
     verdict = "pulse-like" if cls.is_pulse else "not pulse-like"
     ax.plot(*_thin(t, cls.velocity), color="0.55", lw=0.6, label="ground velocity")
-    ax.plot(*_thin(t, cls.pulse), color="C3", lw=1.4,
+    ax.plot(*_thin(t, cls.pulse), color=PALETTE[3], lw=1.4,
             label=f"velocity pulse: Tp {cls.tp:.3g} s, PI {cls.indicator:+.3g} ({verdict})")
     ax.set_ylabel("velocity (m/s)", fontsize=LABEL_SIZE)
     ax.set_title("velocity in the pulse's direction and the extracted velocity pulse (Shahi & Baker 2014)",
@@ -207,9 +210,9 @@ def summary_figure(rows) -> Figure:
         y31 = np.array([_num(r, "governing_eq31_tan_alpha") for r in blocks])
         yv = np.array([_num(r, "verified_tan_alpha") for r in blocks])
         over = np.array([bool(r.get("overturns")) for r in blocks])
-        ax1.scatter(x, y31, marker="o", facecolors="none", edgecolors="C0", label="Eq. 31 (governing pulse)")
-        ax1.scatter(x[~over], yv[~over], marker="x", color="C2", label="verified, column survives")
-        ax1.scatter(x[over], yv[over], marker="x", color="C3", label="verified, column overturns")
+        ax1.scatter(x, y31, marker="o", facecolors="none", edgecolors=PALETTE[0], label="Eq. 31 (governing pulse)")
+        ax1.scatter(x[~over], yv[~over], marker="x", color=PALETTE[2], label="verified, column survives")
+        ax1.scatter(x[over], yv[over], marker="x", color=PALETTE[3], label="verified, column overturns")
         hi = np.nanmax(np.concatenate([x, y31, yv, [0.0]]))
     hi = 1.1 * hi if hi > 0 else 1.0
     ax1.plot([0, hi], [0, hi], "k-", lw=0.6)
@@ -229,8 +232,8 @@ def summary_figure(rows) -> Figure:
     hi2 = np.nanmax(np.concatenate([x, y, [0.0]])) if rows else 0.0
     hi2 = 1.1 * hi2 if hi2 > 0 else 1.0
     if rows:
-        ax2.scatter(x[~bad], y[~bad], marker="o", color="C0", label="Eq. 31 design survives the record")
-        ax2.scatter(x[bad], y[bad], marker="o", color="C3", label="Eq. 31 design overturns")
+        ax2.scatter(x[~bad], y[~bad], marker="o", color=PALETTE[0], label="Eq. 31 design survives the record")
+        ax2.scatter(x[bad], y[bad], marker="o", color=PALETTE[3], label="Eq. 31 design overturns")
         ax2.legend(fontsize=LEGEND_SIZE)
     ax2.plot([0, hi2], [0, hi2], "k-", lw=0.6)
     ax2.set_xlim(0, hi2)

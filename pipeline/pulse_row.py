@@ -7,7 +7,8 @@ from .report import Columns
 
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
-           "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio"]
+           "orientation_deg", "azimuth_deg", "arrival_s", "late", "pgv_ratio", "energy_ratio",
+           "pulse_like_reason"]
 #: the subset ``pipeline run`` reports, with their units and meanings (its reports' columns)
 RUN_PULSE_COLUMNS = Columns(
     ("pulse_like", "-", "The record (for a pair: the pair) is pulse-like by Shahi & Baker's (2014) "
@@ -20,6 +21,10 @@ RUN_PULSE_COLUMNS = Columns(
                                "towards the second (0 for a single component)."),
     ("azimuth_deg", "deg", "Azimuth of the strongest velocity pulse, clockwise from north (0..180), "
                            "where the files state the azimuths; else blank."),
+    ("pulse_like_reason", "-", "Why the record is or is not pulse-like: the test of Shahi & Baker's "
+                               "that decided (the indicator PI with the residual's shares, or a late "
+                               "arrival), and a note where the velocity is one-sided, which their "
+                               "two-sided wavelets fit poorly (`PulseClassification.reason`)."),
 )
 #: their names
 RUN_COLUMNS = list(RUN_PULSE_COLUMNS.names)
@@ -31,7 +36,8 @@ def result_row(result, file="", file2="") -> dict:
             "pgv_m_s": float(result.pgv), "orientation_deg": float(result.orientation),
             "azimuth_deg": None if result.azimuth is None else float(result.azimuth),
             "arrival_s": float(result.arrival), "late": bool(result.late),
-            "pgv_ratio": float(result.pgv_ratio), "energy_ratio": float(result.energy_ratio)}
+            "pgv_ratio": float(result.pgv_ratio), "energy_ratio": float(result.energy_ratio),
+            "pulse_like_reason": result.reason}
 
 
 def classify_fields(record, other=None) -> dict:

@@ -157,6 +157,16 @@ def read_pair(path1, path2, **read_options) -> tuple[Record, Record]:
     -------
     (Record, Record)
         Accelerations in m/s^2, truncated to the same length (see :func:`check_pair`).
+
+    Examples
+    --------
+    >>> from importlib.resources import files
+    >>> import pulses
+    >>> data = files("pipeline.data")
+    >>> first, second = pulses.read_pair(str(data / "synth_sine_055g_0.9s.sac"),
+    ...                                  str(data / "synth_broadband_only.sac"))
+    >>> first.npts == second.npts, first.dt
+    (True, 0.01)
     """
     from .io import read_record
 
@@ -243,7 +253,17 @@ _AZIMUTH_CODE = re.compile(r"^(.*?[A-Za-z_\-.])(\d{3})$")
 class Pairing:
     """What :func:`pair_files` found: ``pairs`` (first, second), ``singles`` (horizontals
     without a partner, or in groups that are ambiguous), ``verticals`` (left out) and ``notes``
-    (one line per ambiguous group)."""
+    (one line per ambiguous group).
+
+    Examples
+    --------
+    >>> import pulses
+    >>> found = pulses.pair_files(["RSN1_A_1.AT2", "RSN1_A_2.AT2", "RSN2_B_1.AT2"])
+    >>> found.pairs
+    [('RSN1_A_1.AT2', 'RSN1_A_2.AT2')]
+    >>> found.singles
+    ['RSN2_B_1.AT2']
+    """
 
     pairs: list = field(default_factory=list)
     singles: list = field(default_factory=list)
@@ -319,6 +339,15 @@ def pair_files(paths, metadata=None) -> Pairing:
         Groups of exactly two horizontals become pairs (ordered ``_1`` before ``_2``, otherwise
         by file name); a group with more than two horizontals is ambiguous and its files stay
         single (with a note); verticals are listed apart.
+
+    Examples
+    --------
+    >>> import pulses
+    >>> found = pulses.pair_files(["RSN1_A_1.AT2", "RSN1_A_2.AT2", "RSN2_B_1.AT2"])
+    >>> found.pairs
+    [('RSN1_A_1.AT2', 'RSN1_A_2.AT2')]
+    >>> found.singles
+    ['RSN2_B_1.AT2']
     """
     metadata = metadata or {}
     result = Pairing()

@@ -270,6 +270,16 @@ class PeerDownload:
         The parsed report.
     refused : dict
         Zip members that are never read, ``name -> reason`` (unsafe names, oversized members).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import pulses
+    >>> try:
+    ...     pulses.PeerDownload(tempfile.mkdtemp())
+    ... except pulses.RecordError as err:
+    ...     print("_SearchResults.csv" in str(err))
+    True
     """
 
     def __init__(self, path):

@@ -24,6 +24,17 @@ def check_triplet(first: Record, second: Record, vertical: Record, vertical_name
         Naming the files: every reason of :func:`pulses.check_pair`, a third record that is not a
         vertical or whose polarity is not stated, and the vertical off the horizontals' time axis
         (:func:`pulses.pairs.check_time_axis`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import pulses
+    >>> ns = pulses.Record(np.zeros(1000), dt=0.01, name="N", metadata={"azimuth": 0.0})
+    >>> ew = pulses.Record(np.zeros(1000), dt=0.01, name="E", metadata={"azimuth": 90.0})
+    >>> up = pulses.Record(np.zeros(990), dt=0.01, name="Z_UP", metadata={"vertical": True})
+    >>> first, second, vertical = pulses.check_triplet(ns, ew, up)
+    >>> first.npts, vertical.npts
+    (990, 990)
     """
     first, second = check_pair(first, second)
     names = f"{_label(first)}, {_label(second)} and {_label(vertical)}"

@@ -66,6 +66,8 @@ PC_MEAN, PC_SCALE = 1.208421, 0.2462717
 PGV_MEAN, PGV_SCALE = 11.58861, 18.88015
 #: PI = c0 + cPP P^2 + cVV V^2 + cP P + cV V + cPV P V
 PI_COEFFICIENTS = (-7.817, -0.5679, -0.1516, -3.0253, -1.7396, -2.7156)
+#: a velocity is one-sided when its peak one way is at least this many times its peak the other
+ONE_SIDED_RATIO = 4.0
 #: late pulse: when the pulse has reached PULSE_PERCENT of its energy the record has reached
 #: RECORD_PERCENT of its own or more
 LATE_PULSE_PERCENT, LATE_RECORD_PERCENT = 5.0, 17.0
@@ -511,6 +513,30 @@ class PulseClassification:
     def time(self) -> np.ndarray:
         """Sample times, s."""
         return self.t_start + self.dt * np.arange(self.pulse.size)
+
+    @property
+    def reason(self) -> str:
+        """The verdict in one sentence: which of Shahi & Baker's tests decided it, with the numbers;
+        and, for a record not pulse-like whose velocity is one-sided (peak one way at least
+        :data:`ONE_SIDED_RATIO` times the other), that their wavelets are two-sided, so such a
+        pulse may be missed."""
+        if self.is_pulse:
+            text = (f"pulse-like: indicator PI = {self.indicator:.1f} > 0 and the pulse arrives early "
+                    f"enough")
+        elif self.late:
+            text = ("not pulse-like: the pulse arrives late (the record had reached "
+                    f"{LATE_RECORD_PERCENT:g} % of its energy before the pulse reached {LATE_PULSE_PERCENT:g} % "
+                    "of its own)")
+        else:
+            text = (f"not pulse-like: indicator PI = {self.indicator:.1f} <= 0 (without the extracted "
+                    f"pulse the record keeps {100 * self.pgv_ratio:.0f} % of its peak velocity and "
+                    f"{100 * self.energy_ratio:.0f} % of its energy; PGV {100 * self.pgv:.0f} cm/s)")
+        v = self.velocity
+        big, small = (max(v.max(), -v.min()), min(v.max(), -v.min())) if v.size else (0.0, 0.0)
+        if not self.is_pulse and big > 0 and big >= ONE_SIDED_RATIO * max(small, 0.0):
+            text += ("; the velocity is one-sided, which Shahi & Baker's two-sided wavelets fit "
+                     "poorly: a one-sided pulse may be judged not pulse-like")
+        return text
 
     def to_frame(self):
         """One row per candidate (:class:`pandas.DataFrame`), strongest first, ``chosen`` marking

@@ -613,24 +613,27 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
     method : {"taylor", "rk8", "rk4"}
         Stepping formula of the fast engine (see :func:`simulate`).
     threads : int, optional
-        Threads sharing the batch (default: ``rocking.lanes.get_threads()``, one per CPU, for
-        batches of 256 runs or more, else 1; worker processes that already share the cores call
-        ``rocking.lanes.set_threads(1)`` or pass 1).
+        Threads sharing the batch (default ``rocking.lanes.get_threads()``: one per CPU from 256
+        runs on, else 1; worker processes that already share the cores pass 1).
     lanes : bool
-        True: runs under a record go through the batch engine's lanes where they apply; False:
-        every run one by one (the same answers; to compare their speed).
+        False: every run one by one instead of the batch engine's lanes (the same answers).
     vertical : pulses.Record, optional
-        Upward ground acceleration (m/s^2) on the record's time axis, scaled with it
-        (docs/theory.md section 10): the runs go one by one through the compiled engine (model
-        ``"fast-vertical"``; Taylor steps) and the result has ``lifts_off`` and ``t_lift_off``.
-        A zero vertical is no vertical (the horizontal-only batch, bit for bit).
+        Upward ground acceleration (m/s^2) on the record's time axis, scaled with it (docs/theory.md
+        section 10): runs one by one in the compiled engine (model ``"fast-vertical"``), with
+        ``lifts_off`` and ``t_lift_off``; a zero vertical is no vertical (bit for bit).
 
     Returns
     -------
     BatchResult
-        Arrays ``overturned``, ``exceeded_alpha``, ``max_rotation`` (rad),
-        ``max_rotation_ratio``, ``n_impacts``, ``uplifted``.
+        Arrays ``overturned``, ``exceeded_alpha``, ``max_rotation`` (rad), ``max_rotation_ratio``.
 
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> batch = rocking.simulate_many(column, pulses.OneSine(0.3 * pulses.G, 1.0), scales=[1, 2, 4])
+    >>> batch.overturned.tolist()
+    [False, True, True]
     """
     if model not in ("fast", "linear"):
         raise ValueError("simulate_many supports model='fast' or 'linear'")

@@ -74,29 +74,37 @@ class OverturningSpectrum:
             "max_rotation_ratio": self.max_rotation_ratio.ravel(),
         })
 
-    def plot(self, path=None, ax=None):
+    def plot(self, path=None, ax=None, mark=None):
         """Draw the spectrum as in Fig. 5 (x: ``omega_p/p``, y: ``ap/(g tan alpha)``) on ``ax``, or
         on a new figure (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is
-        chosen for the caller) saved to ``path`` when given."""
+        chosen for the caller) saved to ``path`` when given.  ``mark``, ``(omega_p/p,
+        ap/(g tan alpha))``, puts one's own column under one's own pulse on it.  Colours are
+        Okabe-Ito's (distinct with every common colour-vision deficiency), named in a legend
+        beside the axes."""
         from matplotlib.colors import ListedColormap
         from matplotlib.figure import Figure
+        from matplotlib.patches import Patch
 
         fig = None
         if ax is None:
-            fig = Figure(figsize=(5.5, 4.5))
+            fig = Figure(figsize=(7.2, 4.5), layout="constrained")
             ax = fig.subplots()
         state = np.where(self.overturned, 2, np.where(self.exceeded_alpha, 1, 0)).T
-        cmap = ListedColormap(["#9fd89f", "#f3d37a", "#d9534f"])
-        ax.pcolormesh(self.wp_over_p, self.ap_over_gtan, state, cmap=cmap, vmin=0, vmax=2,
-                      shading="nearest")
+        colours = ["#56B4E9", "#F0E442", "#D55E00"]
+        ax.pcolormesh(self.wp_over_p, self.ap_over_gtan, state, cmap=ListedColormap(colours),
+                      vmin=0, vmax=2, shading="nearest")
+        handles = [Patch(color=c, label=lab) for c, lab in
+                   zip(colours, ["survives", "survives, |theta| > alpha", "overturns"])]
+        if mark is not None:
+            handles += ax.plot([mark[0]], [mark[1]], "o", color="k", mfc="white", mew=2, ms=9,
+                               label="your column under your pulse")
         ax.set_xlabel(r"$\omega_p / p$")
         ax.set_ylabel(r"$a_p / (g \tan\alpha)$")
-        ax.set_title(f"{self.shape} pulse, alpha = {math.degrees(self.alpha):.3g} deg\n"
-                     "green: survive, yellow: |theta| > alpha, red: overturn", fontsize=8)
-        if fig is not None:
-            fig.tight_layout()
-            if path is not None:
-                fig.savefig(path, dpi=110)
+        ax.set_title(f"{self.shape} pulse, alpha = {math.degrees(self.alpha):.3g} deg", fontsize=9)
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False,
+                  fontsize=8)
+        if fig is not None and path is not None:
+            fig.savefig(path, dpi=110)
         return ax
 
 
@@ -170,6 +178,15 @@ def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
     ratio`` (``exact / eq31``; above 1 where Eq. 31 is unconservative), ``transitions`` (how
     many verdict changes the scan found) and ``islands`` (how many safe islands lie below the
     answer).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> frame = rocking.slenderness_chart(shapes=("sine",), p_tp=(2.0,), ap_over_g=(0.3, 0.6))
+    >>> frame[["shape", "pTp", "ap_over_g"]].values.tolist()
+    [['sine', 2.0, 0.3], ['sine', 2.0, 0.6]]
+    >>> frame["ratio"].round(2).tolist()
+    [1.05, 0.99]
     """
     import pandas as pd
 
@@ -189,9 +206,23 @@ def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
     return pd.DataFrame(rows)
 
 
-def plot_chart(frame, path=None, dpi=110):
+def plot_chart(frame, path=None, dpi=110, mark=None):
     """Draw Fig. 8 from :func:`slenderness_chart`: one panel per shape, Eq. 31 dashed over it
-    (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is chosen for the caller)."""
+    (a :class:`matplotlib.figure.Figure`, outside pyplot: no backend is chosen for the caller).
+
+    ``mark``, ``(shape, pTp, ap/g, tan alpha)``, puts one's own column under one's own pulse on
+    the panel of its shape (survives where it lies above the exact curve of its ``pTp``).
+    Colours: viridis (ordered, readable with every common colour-vision deficiency); the legend
+    sits beside the panels, off the curves.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> frame = rocking.slenderness_chart(shapes=("sine",), p_tp=(2.0,), ap_over_g=(0.3, 0.6))
+    >>> fig = rocking.plot_chart(frame, mark=("sine", 1.38, 0.5, 0.24))
+    >>> len(fig.axes)
+    1
+    """
     import matplotlib
     from matplotlib.figure import Figure
 
@@ -199,7 +230,7 @@ def plot_chart(frame, path=None, dpi=110):
     n = len(shapes)
     ncol = 2 if n > 1 else 1
     nrow = int(math.ceil(n / ncol))
-    fig = Figure(figsize=(5.2 * ncol, 4.2 * nrow))
+    fig = Figure(figsize=(5.2 * ncol + 1.6, 4.2 * nrow), layout="constrained")
     axes = fig.subplots(nrow, ncol, squeeze=False)
     ptps = sorted(set(frame["pTp"]))
     colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, len(ptps)))
@@ -207,16 +238,23 @@ def plot_chart(frame, path=None, dpi=110):
         sub = frame[frame["shape"] == shape]
         for c, x in zip(colors, ptps):
             s = sub[sub["pTp"] == x].sort_values("ap_over_g")
-            ax.plot(s["ap_over_g"], s["exact"], "-", color=c, lw=1.5, label=f"pTp={x:g}")
+            ax.plot(s["ap_over_g"], s["exact"], "-", color=c, lw=1.5, label=f"pTp = {x:g}")
             ax.plot(s["ap_over_g"], s["eq31"], "--", color=c, lw=0.9)
+        if mark is not None and mark[0] == shape:
+            ax.plot([mark[2]], [mark[3]], "s", color="#D55E00", ms=8,
+                    label=f"your column (pTp = {mark[1]:.3g})")
         ax.set_title(f"{shape}: exact (solid) vs Eq. 31 (dashed)", fontsize=9)
         ax.set_xlabel("ap / g")
         ax.set_ylabel("minimum tan(alpha)")
         ax.grid(alpha=0.3)
-    axes.ravel()[0].legend(fontsize=7, ncol=2)
+    handles, labels = {}, {}
+    for ax in axes.ravel()[:n]:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    fig.legend(list(handles.values()), list(handles), loc="outside right upper", fontsize=7,
+               frameon=False)
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
-    fig.tight_layout()
     if path is not None:
         fig.savefig(path, dpi=dpi)
     return fig

@@ -171,19 +171,14 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         ``rule="exact"``: the performance level R in (0, 1]: the design keeps
         ``max|theta|/alpha <= R`` (a width fails where it exceeds R or the column overturns);
         None (default): overturning, the paper's question (docs/design.md, "Performance levels").
-    shape : str, optional
-        Shape whose envelope factor to use with ``rule="envelope"`` (default: every shape).
-    lam : float
-        The lambda of Eq. 20 for ``rule="eq20"``.
+    shape, lam : str (optional), float
+        ``rule="envelope"``: the shape whose factor to use (default every shape); Eq. 20's lambda.
     n_scan, n_zone, rtol : int, int, float, optional
-        ``rule="exact"``: scan points up to the no-uplift width ``H peak/g`` (pulse:
-        ``settings.n_scan`` uniform; record: ``settings.record_scan`` geometric), points of the
-        dense zone just above the widest failing width (pulse: ``settings.zone_points`` uniform,
-        0 switches it off; record: an optional extra zone of ``settings.record_zone_points``
-        geometric widths, off by default, next to the fine zone, see :func:`_record_width`), and
-        the relative width of the final bracket; each overrides its field of ``settings``.  For a record only the top transition is refined
-        (its verdicts may change hundreds of times with the width) and the widths scanned are
-        chosen adaptively; the answer holds at the resolution stated in :func:`_record_width`.
+        ``rule="exact"``: scan points up to the no-uplift width ``H peak/g`` (pulse: uniform;
+        record: geometric), points of the dense zone just above the widest failing width (0
+        switches it off; for a record an extra zone, off by default) and the relative width of
+        the final bracket; each overrides its field of ``settings``.  For a record only the top
+        transition is refined, on adaptively chosen widths (resolution: :func:`_record_width`).
     settings : rocking.search.SearchSettings
         Settings of the exact searches (default :data:`rocking.search.DEFAULT_SETTINGS`).
     cap_mass_ratio : float
@@ -191,16 +186,20 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         total mass (docs/theory.md section 8: the frame's ``p`` and ``eta`` at each width); 0, a lone column.
     vertical : pulses.Record, optional
         ``rule="exact"`` under a record: its upward vertical acceleration on the same time axis
-        (docs/theory.md section 10); every run of the search and of the check above it is the
-        compiled engine with the vertical, and the no-uplift width is ``H max|ag|/(g + av)``.  A
-        vertical that reaches -g (the block would leave the ground, which the model does not
-        describe) is refused.
+        (docs/theory.md section 10): every run uses the compiled engine with it; the no-uplift
+        width is ``H max|ag|/(g + av)``; a vertical reaching -g (free flight) is refused.
 
     Returns
     -------
     RequiredWidth
         ``.width``, ``.tan_alpha``, ``.p``, ``.rule``, ``.iterations``.
 
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
+    >>> [round(rocking.required_width(7.5, pulse, rule=r).width, 3) for r in ("eq31", "exact")]
+    [2.17, 1.736]
     """
     height = float(height)
     if not (math.isfinite(height) and height > 0):

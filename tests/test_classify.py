@@ -366,3 +366,26 @@ def test_pipeline_classify_keeps_the_users_files(tmp_path, capsys):
     plots = tmp_path / "plots"
     assert main(["classify", str(one), str(two), "--pairs", "none", "--plot", str(plots)]) == 0
     assert sorted(p.name for p in plots.glob("*.png")) == ["rec-2.png", "rec.png"]
+
+
+def test_the_verdict_gives_its_reason():
+    """``PulseClassification.reason`` names the test that decided, with the record's own numbers,
+    and flags a one-sided velocity (the bundled 0.85 g, 2 s one-sine: PGV 5.25 m/s one way, 0.13
+    the other) as what Shahi & Baker's two-sided wavelets may miss."""
+    import importlib.resources
+
+    data = importlib.resources.files("pipeline.data")
+    one_sided = pulses.classify_pulse(pulses.read_record(str(data / "synth_sine_085g_2.0s.sac")))
+    assert not one_sided.is_pulse and not one_sided.late and one_sided.indicator <= 0
+    v = one_sided.velocity
+    assert max(v.max(), -v.min()) >= 4 * min(v.max(), -v.min())  # one-sided, measured here
+    reason = one_sided.reason
+    assert reason.startswith(f"not pulse-like: indicator PI = {one_sided.indicator:.1f} <= 0")
+    assert f"{100 * one_sided.pgv_ratio:.0f} % of its peak velocity" in reason
+    assert f"{100 * one_sided.energy_ratio:.0f} % of its energy" in reason
+    assert "one-sided" in reason and "two-sided wavelets" in reason
+    broadband = pulses.classify_pulse(pulses.read_record(str(data / "synth_broadband_only.sac")))
+    assert not broadband.is_pulse and "one-sided" not in broadband.reason
+    pulse = pulses.classify_pulse(pulses.read_record(str(data / "synth_ricker_sym_045g_1.2s.sac")))
+    assert pulse.is_pulse and pulse.reason == (f"pulse-like: indicator PI = {pulse.indicator:.1f} > 0 "
+                                               "and the pulse arrives early enough")

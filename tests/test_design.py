@@ -302,6 +302,52 @@ def test_cli_spectrum_and_chart(tmp_path, capsys):
     assert main(["spectrum", "--alpha", "14", "--pulse", "sine"]) == 2
 
 
+def test_cli_chart_width_against_height(tmp_path, capsys):
+    """``pipeline chart --heights``: every rule at every height, each width checked against its own
+    definition (Eq. 31's and Eq. 20's width solve their closed form at the block they give; the
+    exact width survives the pulse and 0.2 % narrower overturns), the column judged."""
+    import pandas as pd
+
+    csv, png = tmp_path / "w.csv", tmp_path / "w.png"
+    assert main(["chart", "--heights", "4:10:3", "--pulse", "sine", "--ap", "0.5g", "--tp", "1",
+                 "--block", "7.5x1.8", "--csv", str(csv), "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    frame = pd.read_csv(csv)
+    assert sorted(set(frame["rule"])) == ["envelope", "eq20", "eq31", "exact"]
+    assert sorted(set(frame["height_m"])) == [4.0, 7.0, 10.0]
+    ap, tp = 0.5 * pulses.G, 1.0
+    pulse = pulses.OneSine(ap, tp)
+    for _, r in frame.iterrows():
+        block = Block.from_dimensions(r.height_m, r.width_m)
+        if r.rule in ("eq31", "eq20"):  # the fixed point: tan(alpha) is the rule at the block's own p
+            rule = rocking.eq31 if r.rule == "eq31" else rocking.eq20
+            assert block.tan_alpha == pytest.approx(rule(ap, tp, block.p), rel=1e-6)
+        elif r.rule == "exact":
+            assert not rocking.simulate(block, pulse).overturned
+            assert rocking.simulate(Block.from_dimensions(r.height_m, r.width_m * 0.998), pulse).overturned
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert "your column 7.5 x 1.8 m: the exact rule asks for 1.736 m (it is wide enough)" in out
+    # one pulse shape, and --ap with --tp: one-line errors, exit status 2
+    assert main(["chart", "--heights", "4:10", "--pulse", "all", "--ap", "0.5g", "--tp", "1"]) == 2
+    assert main(["chart", "--heights", "4:10", "--pulse", "sine"]) == 2
+    assert main(["chart", "--heights", "10:4", "--pulse", "sine", "--ap", "0.5g", "--tp", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 3 and "one pulse shape" in err and "--heights" in err
+
+
+def test_cli_spectrum_and_chart_mark_your_column(tmp_path, capsys):
+    """``--block`` gives the spectrum its slenderness; with ``--ap``/``--tp`` the column is marked."""
+    png = tmp_path / "s.png"
+    assert main(["spectrum", "--block", "7.5x1.8", "--pulse", "sine", "--ap", "0.5g", "--tp", "1",
+                 "--grid", "10x10", "--plot", str(png)]) == 0
+    assert "alpha = 13.5 deg" in capsys.readouterr().out  # atan(1.8 / 7.5) = 13.50 deg
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert main(["chart", "--pulse", "sine", "--ptp", "1", "--apg", "0.3", "--ap", "0.5g", "--tp", "1",
+                 "--block", "7.5x1.8", "--plot", str(tmp_path / "c.png")]) == 0
+    assert main(["spectrum", "--pulse", "sine", "--ap", "0.5g", "--tp", "1"]) == 2
+    assert main(["spectrum", "--alpha", "14deg", "--pulse", "sine", "--ap", "0.5g"]) == 2
+
+
 # ------------------------------------------------------------------------- fast searches
 def _brute_verified_width(height, record, lo, hi, n):
     """Brute force: ``n`` uniform widths on ``[lo, hi]`` (every one run), the verified width is the
