@@ -10,7 +10,7 @@ examples' RSN179 pair too by S&B14; the first ``--pairs`` of them), one after th
 run, ``pipeline run --pair A B --directions 36 --block 7.5x1.8 --jobs J`` (38 directions) by:
 
 - the baseline (its defaults: every direction checked and drawn);
-- this version, default options (the check and the figures where they decide, pipeline/passes.py);
+- this version, default options (the check and the figures where they decide, pipeline/batch/passes.py);
 - this version with ``--thorough`` (every direction checked and drawn).
 
 Each run is a fresh process tree in a fresh ``--out``; its CPU is user + sys of the process and

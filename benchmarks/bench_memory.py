@@ -70,8 +70,8 @@ def memory(n: int = 2000) -> dict:
 
 
 def _timed(paths, out, **kw):
-    from pipeline.batch import Column, Options
-    from pipeline.runner import run
+    from pipeline.batch.record import Column, Options
+    from pipeline.batch.runner import run
 
     t0 = time.perf_counter()
     run(paths, [Column(7.5, 1.8)], out, options=Options(shapes=("sine",), plots=False), quiet=True, **kw)

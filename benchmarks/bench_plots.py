@@ -38,9 +38,9 @@ def run(repeat: int = 5) -> dict:
     """Measure; return (and print) a dict of seconds and PNG sizes."""
     import matplotlib
 
-    from pipeline import plots
-    from pipeline.batch import Column, Options, _process
-    from pipeline.runner import make_tasks
+    from pipeline.reports import plots
+    from pipeline.batch.record import Column, Options, _process
+    from pipeline.batch.runner import make_tasks
 
     paths = sorted(str(p) for p in DATA.glob("*.sac"))
     tasks = make_tasks(paths, [Column(7.5, 1.8), Column(6.0, 1.2)], Options())

@@ -43,7 +43,7 @@ def _command(paths, out):
 
 
 def run(n: int = 200) -> dict:
-    from pipeline import resume
+    from pipeline.batch import resume
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)

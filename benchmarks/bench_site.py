@@ -2,7 +2,7 @@
 
     PYTHONPATH=. python -m benchmarks.bench_site [--cost-pairs 1] [--heights 2.5 7.5] [--n 36]
 
-1. Cost per pair (``pipeline run``'s own per-task function, ``pipeline.batch.process_record``,
+1. Cost per pair (``pipeline run``'s own per-task function, ``pipeline.batch.record.process_record``,
    one process, no plots) for the default directions (two components, pulse direction and its
    normal), for ``--directions 36``, and for the default directions with ``--fragility``
    (critical scale of the column as it stands in each direction, up to 10).
@@ -30,8 +30,8 @@ def shared_pairs():
 
 
 def cost(pair, columns, n_even, fragility):
-    from pipeline import pairs
-    from pipeline.batch import Options, process_record
+    from pipeline.batch import pairs
+    from pipeline.batch.record import Options, process_record
 
     opts = Options(plots=False, fragility=fragility)
     tasks = pairs.pair_tasks([], [pair], "none", columns, opts, n_even, say=lambda m: None)
@@ -45,7 +45,7 @@ def cost(pair, columns, n_even, fragility):
 def miss(pair, heights, n_even):
     import pulses
     import rocking
-    from pipeline import site
+    from pipeline.batch import site
 
     first, second = pulses.read_pair(*pair)
     orient = pulses.classify_pulse(first, second).orientation
@@ -69,7 +69,7 @@ def main(argv=None):
     ap.add_argument("--skip-cost", action="store_true")
     ap.add_argument("--skip-miss", action="store_true")
     args = ap.parse_args(argv)
-    from pipeline.batch import Column
+    from pipeline.batch.record import Column
 
     pairs = shared_pairs()
     print(f"{len(pairs)} pairs in {SHARED}")

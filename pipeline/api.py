@@ -62,9 +62,9 @@ def _many(value, *, pair_is_one: bool = False):
 
 
 def _column(block):
-    """A :class:`pipeline.tasks.Column` (height, width) from one of the accepted forms."""
+    """A :class:`pipeline.batch.tasks.Column` (height, width) from one of the accepted forms."""
     from .args import parse_block
-    from .tasks import Column
+    from .batch.tasks import Column
 
     if isinstance(block, Column):  # the command line's own, already checked
         return block
@@ -84,7 +84,7 @@ def _column(block):
 
 def _height(h):
     from .args import parse_length
-    from .tasks import Column
+    from .batch.tasks import Column
 
     if not _is_number(h):
         raise TypeError(f"heights: expected numbers (the column's full height in m), got "
@@ -177,7 +177,7 @@ class DesignRun:
     Examples
     --------
     >>> import pipeline
-    >>> from pipeline.cmd_demo import bundled_records
+    >>> from pipeline.commands.demo import bundled_records
     >>> with bundled_records() as paths:
     ...     run = pipeline.design(paths[3:4], heights=7.5, shapes="sine")
     >>> run.exit_code, list(run.design["governing_shape"]), run.out is None
@@ -200,28 +200,28 @@ class DesignRun:
     @property
     def design(self):
         """``design.csv`` as a DataFrame (columns in the file's order)."""
-        from .design_table import DESIGN_FIELDS
+        from .reports.design_table import DESIGN_FIELDS
 
         return _frame(self.design_rows, DESIGN_FIELDS)
 
     @property
     def summary(self):
         """``summary.csv`` as a DataFrame."""
-        from .batch import FIELDS
+        from .batch.record import FIELDS
 
         return _frame(self.summary_rows, FIELDS)
 
     @property
     def failures(self):
         """``failures.csv`` as a DataFrame: ``record``, ``file``, ``stage``, ``reason`` ..."""
-        from .batch import FAILURE_FIELDS
+        from .batch.record import FAILURE_FIELDS
 
         return _frame(self.failure_rows, FAILURE_FIELDS)
 
     @property
     def suite(self):
         """``suite.csv`` as a DataFrame."""
-        from .site import SUITE_COLUMNS
+        from .batch.site import SUITE_COLUMNS
 
         return _frame(self.suite_rows, list(SUITE_COLUMNS.names))
 
@@ -243,7 +243,7 @@ _NAMES = ("record", "column", "pair", "file")
 def _frame(rows, columns):
     import pandas as pd
 
-    from .report import fmt
+    from .reports.report import fmt
 
     def cell(row, c):
         v = row.get(c)
@@ -317,7 +317,7 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     Examples
     --------
     >>> import pipeline
-    >>> from pipeline.cmd_demo import bundled_records
+    >>> from pipeline.commands.demo import bundled_records
     >>> with bundled_records() as paths:
     ...     run = pipeline.design(paths[1:2], blocks="7.5x1.8", shapes="sine")
     >>> run.design[["record", "column", "verified_width_m"]].shape
@@ -341,7 +341,7 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
           units, dt, scale, plots, force, quiet, **more) -> Plan:
     """Every argument of :func:`design` checked and in the forms the runner takes."""
     from .args import parse_units
-    from .tasks import Options
+    from .batch.tasks import Options
 
     unknown = sorted(set(more) - set(_MORE))
     if unknown:
@@ -378,7 +378,7 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
 class Plan:
     """A run, checked: what :func:`design` and ``pipeline run`` hand to :func:`run_plan`.  The
     settings of pairs and scales keep the command line's names and text forms (``directions``,
-    ``scale`` as text), which :func:`pipeline.pairs.tasks_from_args` reads."""
+    ``scale`` as text), which :func:`pipeline.batch.pairs.tasks_from_args` reads."""
 
     records: list
     columns: tuple
@@ -404,9 +404,9 @@ class Plan:
 def _paths(plan, say):
     """``(downloads, record paths)`` of a run's inputs; the files of its folders that are plainly
     not records are skipped with a note."""
-    from . import peer_inputs
-    from .report import display
-    from .tasks import expand_inputs
+    from .batch import peer_inputs
+    from .reports.report import display
+    from .batch.tasks import expand_inputs
 
     if not plan.records and not plan.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
@@ -429,7 +429,7 @@ def _paths(plan, say):
 def _tasks(plan, say):
     """``(paths, tasks or None, absent)`` of a run, as ``pipeline run`` makes them (``absent``: the
     PEER search's records not in the download, listed, not failed)."""
-    from . import pairs, vertical
+    from .batch import pairs, vertical
 
     # a triplet's horizontals are a pair
     plan = dataclasses.replace(plan, pair=list(plan.pair) + [[a, b] for a, b in plan.triplets])
@@ -447,10 +447,10 @@ def _tasks(plan, say):
 
 def run_plan(plan) -> DesignRun:
     """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments)."""
-    from .runner import run
+    from .batch.runner import run
 
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
-    from .peer_inputs import NOT_DOWNLOADED, not_downloaded_text
+    from .batch.peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
     paths, tasks, absent = _tasks(plan, say)
     # with no folder of the caller's, the runner's messages would name the private one: the table
@@ -462,7 +462,7 @@ def run_plan(plan) -> DesignRun:
                       lists={NOT_DOWNLOADED: not_downloaded_text(absent)})
     t = summary.tables
     if not plan.quiet and plan.out is None:
-        from .design_table import table_text
+        from .reports.design_table import table_text
 
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,

@@ -56,9 +56,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMANDS:
         try:
-            module = importlib.import_module(f"pipeline.cmd_{name}")
+            module = importlib.import_module(f"pipeline.commands.{name}")
         except ModuleNotFoundError as exc:
-            if exc.name == f"pipeline.cmd_{name}":
+            if exc.name == f"pipeline.commands.{name}":
                 continue  # sub-command not built in this version
             raise
         module.add_parser(sub)

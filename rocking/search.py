@@ -67,7 +67,7 @@ class SearchSettings:
     is irregular from one width to the next, not where the block rocks hardest (on the shared
     records the ratio next to a failing width is often that of the smooth surroundings, 0.3-0.6,
     while the bin's spread is among the span's largest).  0 runs switch the check off; so does
-    ``check_above`` (m; a pair's design width found in other directions, pipeline/passes.py) at
+    ``check_above`` (m; a pair's design width found in other directions, pipeline/batch/passes.py) at
     or above ``min(check_span ** check_rounds w, no-uplift width)``, the widest width the
     rounds could reach (each round's span is at most ``check_span`` times the width the round
     before left): such a check could not find a failing width above it; and so are the rounds

@@ -10,11 +10,11 @@ import pytest
 
 import pipeline
 import rocking
-from pipeline import report
-from pipeline.batch import FIELDS
+from pipeline.reports import report
+from pipeline.batch.record import FIELDS
 from pipeline.cli import main
-from pipeline.cmd_demo import bundled_records
-from pipeline.design_table import DESIGN_FIELDS
+from pipeline.commands.demo import bundled_records
+from pipeline.reports.design_table import DESIGN_FIELDS
 
 from .vertical_cases import DOWNLOAD
 
@@ -84,7 +84,7 @@ def test_a_peer_download_gives_pipeline_runs_design_csv(tmp_path):
 
 def test_the_forms_of_a_column():
     from pipeline.api import columns_from
-    from pipeline.tasks import Column
+    from pipeline.batch.tasks import Column
 
     block = rocking.Block.from_dimensions(7.5, 1.8)
     want = (Column(7.5, 1.8),)
@@ -191,7 +191,7 @@ def test_a_loop_with_the_governing_pulse_gives_pipeline_runs_eq31_widths():
 def test_the_runner_refuses_columns_that_are_not_columns(tmp_path):
     """The issue's first finding: runner.run(paths, ["9"], out) wrote a header-only design.csv and
     an internal AttributeError per record; now a TypeError pointing to pipeline.design."""
-    from pipeline.runner import run
+    from pipeline.batch.runner import run
 
     with pytest.raises(TypeError, match=r"pipeline.design\(records, blocks="):
         run([tmp_path / "a.sac"], ["9"], tmp_path / "out")

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from pipeline import remote, runner
+from pipeline.batch import remote, runner
 from pipeline.cli import main
 
 from .test_pipeline_run import BATCH_ARGS, read_csv, tree, write_good

@@ -309,7 +309,7 @@ def test_pair_files_ambiguous_group_stays_single():
 @pytest.mark.slow
 def test_pipeline_classify_command(tmp_path, capsys):
     from pipeline.cli import main
-    from pipeline.cmd_classify import COLUMNS, RUN_COLUMNS, classify_fields
+    from pipeline.commands.classify import COLUMNS, RUN_COLUMNS, classify_fields
 
     one = shared_record("shahi_baker_examples/example1.AT2")
     two = shared_record("shahi_baker_examples/example2.AT2")

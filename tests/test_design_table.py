@@ -1,6 +1,6 @@
 """The answer rows of design.csv and the printed table: a pair's widest failing width and its
 verdict with the vertical, from rows of summary.csv."""
-from pipeline.design_table import design_rows, excess_text, failing_text, metadata_text, table_text
+from pipeline.reports.design_table import design_rows, excess_text, failing_text, metadata_text, table_text
 
 
 def _row(direction, verified, failing, overturns=False, vertical=None, search=None):

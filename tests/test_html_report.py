@@ -22,8 +22,8 @@ import tempfile
 
 import pytest
 
-from pipeline import design_table, html_report
-from pipeline.cmd_demo import bundled_records
+from pipeline.reports import design_table, html_report
+from pipeline.commands.demo import bundled_records
 
 CHROMIUM = shutil.which("chromium") or ("/usr/bin/chromium" if os.path.exists("/usr/bin/chromium") else None)
 #: the demo's report with its figures must stay small enough to mail or archive

@@ -1,4 +1,4 @@
-"""A pair's directions in passes (pipeline/passes.py): the check above the verified width and the
+"""A pair's directions in passes (pipeline/batch/passes.py): the check above the verified width and the
 figures only where they decide, the same design width as ``--thorough``.
 
 The synthetic pairs are those of tests/test_site.py (8 s, one-sine pulses in noise); the real
@@ -9,8 +9,8 @@ import csv
 
 import pytest
 
-from pipeline import passes
-from pipeline.batch import CHECK_COLUMNS
+from pipeline.batch import passes
+from pipeline.batch.record import CHECK_COLUMNS
 from pipeline.cli import main as cli_main
 from rocking.search import DEFAULT_SETTINGS
 
@@ -90,7 +90,7 @@ def test_the_check_goes_to_the_governing_direction_then_where_it_could_reach_the
 
 
 def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
-    from pipeline.tasks import Column, Options, Task
+    from pipeline.batch.tasks import Column, Options, Task
 
     options = Options()
     cols = (Column(7.5, 1.8),)

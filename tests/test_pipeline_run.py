@@ -14,8 +14,9 @@ import pytest
 
 import pulses
 import rocking
-from pipeline import report, resume
-from pipeline.batch import FAILURE_FIELDS, Column, Options, record_ids
+from pipeline.reports import report
+from pipeline.batch import resume
+from pipeline.batch.record import FAILURE_FIELDS, Column, Options, record_ids
 from pipeline.cli import main
 from pulses import G
 
@@ -181,9 +182,9 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     assert (after / name).read_bytes() == png
     # in this process: drawn first, then again after the other records drew four pulses and three
     # curves a panel; the target also with one pulse and one curve fewer a panel
-    from pipeline import plots
-    from pipeline.batch import _process
-    from pipeline.runner import make_tasks
+    from pipeline.reports import plots
+    from pipeline.batch.record import _process
+    from pipeline.batch.runner import make_tasks
 
     tasks = make_tasks([*map(str, others), str(target)], [Column(7.5, 1.8), Column(6.0, 1.2)], Options())
     parts = [_process(t)[1] for t in tasks]
@@ -260,7 +261,7 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
 
 @pytest.mark.slow
 def test_progress_bar_only_when_asked_or_on_a_terminal(tmp_path, capsys):
-    from pipeline.runner import run
+    from pipeline.batch.runner import run
 
     rec = write_good(tmp_path, 3)
     opts = Options(shapes=("sine",), plots=False)
@@ -581,7 +582,7 @@ def test_files_the_run_did_not_write_are_left_as_they_are(tmp_path, capsys):
 def test_foreign_fixed_reports_and_bad_out_are_argument_errors(tmp_path, capsys, monkeypatch):
     """A summary.csv the run did not write, an --out that is a file or cannot be written: exit 2 in
     one line, before any record is read."""
-    from pipeline import worker
+    from pipeline.batch import worker
 
     def no_work(task):
         raise AssertionError("a record was processed")
@@ -687,7 +688,7 @@ def test_absurd_sizes_are_argument_errors(bad, tmp_path, capsys):
 
 def test_report_rows_must_match_their_declared_columns():
     """Writing a row with an undeclared key, or without a declared one, fails (no silent blank)."""
-    from pipeline.batch import FIELDS, RECORD_COLUMNS
+    from pipeline.batch.record import FIELDS, RECORD_COLUMNS
 
     row = dict.fromkeys(FIELDS, 1.0)
     assert report.csv_text(FIELDS, [row]).count("\n") == 2
@@ -709,7 +710,7 @@ def test_a_swallowed_interrupt_still_stops_the_run(tmp_path, monkeypatch):
     import signal
     import time
 
-    from pipeline import worker
+    from pipeline.batch import worker
 
     real, seen = worker.process_record, []
 

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pipeline import plots
-from pipeline.batch import Column, Options, _process
-from pipeline.runner import make_tasks
+from pipeline.reports import plots
+from pipeline.batch.record import Column, Options, _process
+from pipeline.batch.runner import make_tasks
 from pulses import G
 
 from .test_pipeline_run import write_good

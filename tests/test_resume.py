@@ -11,7 +11,9 @@ import time
 
 import pytest
 
-from pipeline import report, resume
+from pipeline.reports import report
+
+from pipeline.batch import resume
 from pipeline.cli import main
 
 from .test_pipeline_run import BATCH_ARGS, tree, write_bad, write_good

@@ -17,7 +17,9 @@ import time
 
 import pytest
 
-from pipeline import report, resume
+from pipeline.reports import report
+
+from pipeline.batch import resume
 from pipeline.cli import main
 
 from .test_pipeline_run import SAFE_ARGS, read_csv, tree, write_good
@@ -74,7 +76,7 @@ def test_a_second_run_into_a_busy_out_is_refused_and_nothing_is_lost(recs, alone
 
 def test_the_lock_goes_with_the_run(recs, tmp_path, capsys):
     """Held: refused; released (the run ended): the next run goes on."""
-    from pipeline import outlock
+    from pipeline.batch import outlock
 
     out = tmp_path / "out"
     out.mkdir()
@@ -206,7 +208,7 @@ def test_classify_plot_never_replaces_a_users_png(tmp_path, capsys):
     mine.unlink()
     assert main(["classify", str(a), "--plot", str(plots)]) == 0
     drawn = mine.read_bytes()
-    from pipeline.outpaths import is_ours
+    from pipeline.reports.outpaths import is_ours
 
     assert is_ours(mine, "png") and drawn.startswith(b"\x89PNG")
     assert main(["classify", str(a), "--plot", str(plots)]) == 0  # its own: replaced
@@ -269,7 +271,7 @@ def test_broken_entries_of_a_folder_are_failed_records(tmp_path, capsys):
 def test_a_folder_that_cannot_be_listed_fails_alone(tmp_path, monkeypatch):
     """An unreadable folder stopped the whole batch with no failures.csv; now it is one failed
     record and the others are processed."""
-    import pipeline.runner as runner_module
+    import pipeline.batch.runner as runner_module
 
     good = tmp_path / "good"
     good.mkdir()
@@ -319,7 +321,7 @@ def test_files_of_a_folder_without_search_permission_are_failed_records(tmp_path
 def test_scales_obey_the_scale_rule(table, tmp_path, capsys, monkeypatch):
     """--scales 1e6 ran to the end at 874,060 g (exit 0), 1e-9 failed deep inside after 18 s; rows
     for one record were resolved silently.  Now each is refused at once, in one line."""
-    from pipeline import worker
+    from pipeline.batch import worker
 
     def no_work(task):
         raise AssertionError("a record was processed")

@@ -258,7 +258,7 @@ def test_lift_off_is_its_own_verdict_never_survives(tmp_path, capsys):
 # -- (12) anchors --------------------------------------------------------------------------------------
 def test_record_ids_get_distinct_anchors():
     """Record ids ``a+b`` and ``a_2Bb`` had one anchor in report.html."""
-    from pipeline.html_report import _anchor
+    from pipeline.reports.html_report import _anchor
 
     ids = ["a+b", "a_2Bb", "a_b", "a%b", "a_25b", "RSN77_SFERN_PUL164"]
     anchors = [_anchor(i) for i in ids]
@@ -325,7 +325,7 @@ def test_a_sac_record_ending_in_a_zip_signature_is_a_record(tmp_path):
 def test_a_download_is_hashed_once_per_run(tmp_path, monkeypatch):
     """Every task of a PEER download hashed the whole zip again (205 tasks on a 50 MB zip: +7.3 s);
     now a file is hashed once while it stays the same, and again once it changes."""
-    from pipeline import resume
+    from pipeline.batch import resume
 
     path = make_zip(tmp_path / "dl.zip", [(1, "A000.AT2", "A090.AT2", "-----")], pair_members("A"))
     opened = []

@@ -1,5 +1,5 @@
 """``pipeline run`` for a site: pairs in every direction, scales, velocity-pulse columns, suite
-results, frames and collapse fragility (pipeline/site.py).
+results, frames and collapse fragility (pipeline/batch/site.py).
 
 The records are short synthetic pairs (8 s at 100 Hz, a one-sine pulse plus band-limited noise in
 each component) written as SAC files by ``pulses.write_sac``, so that each run takes seconds."""
@@ -15,7 +15,7 @@ import pytest
 import pulses
 import rocking
 from pipeline.cli import main as cli_main
-from pipeline.site import NOT_PULSE_WARNING, directions
+from pipeline.batch.site import NOT_PULSE_WARNING, directions
 
 H, B = 2.0, 0.35  # a small column: the synthetic pulses (0.3-0.5 g) rock it
 
@@ -84,7 +84,7 @@ def pair_run(pairs, tmp_path_factory):
 def test_a_failed_direction_is_counted_in_pairs_csv(pairs, pair_run, tmp_path, monkeypatch):
     # one direction of the first pair fails (its worker kills itself): the pair's governing row
     # says so, and is the widest of the other directions; the second pair is untouched
-    from pipeline import runner
+    from pipeline.batch import runner
 
     rows = _read(pair_run / "summary.csv")
     first = rows[0]["pair"]
@@ -225,7 +225,7 @@ def test_pulse_columns_and_warning(pairs, tmp_path):
     pulses.write_sac(pulses.Record(acc, 0.01, "noise", 0.0, {}), noise)
     assert _run(out, a1, noise, "--height", H) == 0
     rows = {pathlib.Path(r["file"]).name: r for r in _read(out / "summary.csv")}
-    from pipeline.cmd_classify import classify_fields
+    from pipeline.commands.classify import classify_fields
 
     for name, path in ((a1.name, a1), ("noise.sac", noise)):
         ref = classify_fields(pulses.read_record(path))
@@ -290,7 +290,7 @@ def test_suite_and_fragility_plots():
 
     from matplotlib.image import imread
 
-    from pipeline.plot_site import fragility_figure_png, suite_figure, suite_figure_png
+    from pipeline.reports.plot_site import fragility_figure_png, suite_figure, suite_figure_png
 
     rows = [{"column": "2x0.35", "pair": p, "verified_width_m": w, "eq31_width_m": e}
             for p, w, e in (("a", 0.30, 0.2), ("a", 0.41, 0.25), ("b", 0.22, 0.3), ("c", 0.50, 0.1))]
@@ -311,7 +311,7 @@ def test_suite_and_fragility_plots():
 
 
 def test_a_pair_whose_classification_fails_is_designed_in_its_components_and_says_why():
-    from pipeline.site import classification_fields, directions
+    from pipeline.batch.site import classification_fields, directions
 
     fields, warning = classification_fields(None, pair_fields={"error": "too short"})
     assert set(fields.values()) == {None}  # no pulse columns made up

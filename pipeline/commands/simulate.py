@@ -13,7 +13,7 @@ import json
 import math
 import sys
 
-from .args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration, parse_block,
+from ..args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration, parse_block,
                    parse_positive, record_options)
 
 
@@ -65,7 +65,7 @@ def _excitation(args):
 def run(args) -> int:
     import rocking
 
-    from .outpaths import check_file_options
+    from ..reports.outpaths import check_file_options
 
     check_file_options(args, "simulate", inputs=[getattr(args, "record", None)])
 
@@ -111,7 +111,7 @@ def _write_history(path, res) -> None:
 
     import io
 
-    from .outpaths import write_output
+    from ..reports.outpaths import write_output
 
     data = np.column_stack([res.t, res.theta, res.omega])
     buf = io.StringIO()
@@ -136,7 +136,7 @@ def _plot(path, res, block, label) -> None:
     ax2.set_ylabel(r"$\dot\theta/p$")
     ax2.set_xlabel("t (s)")
     fig.tight_layout()
-    from .outpaths import figure_png, write_output
+    from ..reports.outpaths import figure_png, write_output
 
     data = figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110, metadata={"Software": None}))
     plt.close(fig)

@@ -1,5 +1,5 @@
 """Where the records of a batch run: in this process, a process pool (``--jobs N``) or dask
-(``--dask``).  Each gives the results of :func:`pipeline.worker.work` for every task, in completion
+(``--dask``).  Each gives the results of :func:`pipeline.batch.worker.work` for every task, in completion
 order; none changes a result.
 """
 from __future__ import annotations
@@ -9,8 +9,8 @@ import contextlib
 import logging
 import os
 
-from . import interrupts
-from .args import ArgumentError
+from .. import interrupts
+from ..args import ArgumentError
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, worker_failure
 
 
@@ -40,9 +40,9 @@ def _pool(tasks, jobs):
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     if ctx.get_start_method() == "forkserver":
-        preload = ["pipeline.batch", "pipeline.runner", "pulses", "rocking"]
+        preload = ["pipeline.batch.record", "pipeline.batch.runner", "pulses", "rocking"]
         if plots:
-            preload.append("pipeline.plots")  # matplotlib: ~0.2 s a worker otherwise
+            preload.append("pipeline.reports.plots")  # matplotlib: ~0.2 s a worker otherwise
         ctx.set_forkserver_preload(preload)
     if plots:
         # the summary plot needs matplotlib here too: import it while the workers start
@@ -219,7 +219,7 @@ def dask_client(address: str, jobs: int | None):
     if address == "local":
         import dask
 
-        # a task whose worker dies comes back at once; pipeline.remote retries it once itself
+        # a task whose worker dies comes back at once; pipeline.batch.remote retries it once itself
         with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
             cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1,
                                    processes=True, dashboard_address=None, silence_logs=logging.ERROR)
@@ -257,6 +257,6 @@ def execute(tasks, jobs: int | None = 1, dask: str | None = None):
 
 def _import_plots():
     try:
-        import pipeline.plots  # noqa: F401
+        import pipeline.reports.plots  # noqa: F401
     except Exception:  # pragma: no cover - reported when the summary plot is drawn
         pass

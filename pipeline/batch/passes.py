@@ -26,14 +26,14 @@ design width to, :func:`_bracket_step`):
 A direction left unchecked cannot find a failing width above the pair's final design width, so
 the pair's design width is the one ``--thorough`` (every direction checked, as a lone record)
 finds; the unchecked directions' rows say so (``check_runs`` 0, ``failing_share`` blank).  Each
-pass is the same :func:`pipeline.batch.process_record` on tasks whose ``check`` and ``plot``
+pass is the same :func:`pipeline.batch.record.process_record` on tasks whose ``check`` and ``plot``
 switches are set here; a lone record is one pass, checked and drawn.
 """
 from __future__ import annotations
 
 import dataclasses
 
-from .report import fmt
+from ..reports.report import fmt
 
 #: a check whose top lies within this share of the design width is run all the same (the rows'
 #: numbers are read back from text, with their rounding)

@@ -5,7 +5,7 @@ import contextlib
 import importlib.resources
 import pathlib
 
-from .cmd_run import add_common, options_from, parse_jobs
+from .run import add_common, options_from, parse_jobs
 
 DEMO_BLOCK = "7.5x1.8"  #: the Temple of Apollo column at Corinth (paper, Section 6)
 DEFAULT_OUT = "demo-output"
@@ -37,9 +37,9 @@ def bundled_records():
 
 
 def main(args) -> int:
-    from .tasks import Column
-    from .args import parse_block
-    from .runner import run
+    from ..batch.tasks import Column
+    from ..args import parse_block
+    from ..batch.runner import run
 
     jobs = parse_jobs(args.jobs)
     with bundled_records() as paths:

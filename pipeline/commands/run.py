@@ -4,8 +4,8 @@ from __future__ import annotations
 import argparse
 import os
 
-from . import peer_inputs, site, vertical
-from .args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
+from ..batch import peer_inputs, site, vertical
+from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
                    parse_shapes, record_options)
 
 DEFAULT_OUT = "pipeline-output"
@@ -102,7 +102,7 @@ def parse_jobs(text) -> int | None:
 
 
 def build_columns(blocks, heights):
-    from .tasks import Column
+    from ..batch.tasks import Column
 
     columns = [Column(*parse_block(b)) for b in blocks]
     columns += [Column(parse_length(h, "--height (m)")) for h in heights]
@@ -112,7 +112,7 @@ def build_columns(blocks, heights):
 
 
 def options_from(args, **overrides):
-    from .tasks import Options
+    from ..batch.tasks import Options
 
     kw = dict(plots=args.plots != "none", plots_all=args.plots == "all",
               thorough=bool(getattr(args, "thorough", False)))
@@ -123,7 +123,7 @@ def options_from(args, **overrides):
 def main(args) -> int:
     """``pipeline run``: its arguments parsed into the values of :func:`pipeline.design`, which runs
     the batch (the same plan, so the same tasks and numbers)."""
-    from . import api
+    from .. import api
 
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)

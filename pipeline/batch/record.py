@@ -16,7 +16,7 @@ import time
 from pulses.shapes import AntisymmetricRicker
 
 from . import peer_inputs, site, vertical
-from .report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
+from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
 class StageError(Exception):
@@ -70,7 +70,7 @@ def _process_record(task: Task) -> dict:
         out["failure"] = failure(task, "internal", exc)
         return out
     if task.options.plots and task.plot:
-        from .plots import run_figure_png
+        from ..reports.plots import run_figure_png
 
         try:
             out["plot"] = _stage("plot", run_figure_png, task.record_id, *fit_parts)
@@ -83,7 +83,7 @@ def _process_record(task: Task) -> dict:
 def _widths_png(record_id, verified):
     """``plots/widths/<record>.png`` where the check above a verified width found failing widths
     (docs/slivers.md); None elsewhere."""
-    from .plot_widths import record_widths_png
+    from ..reports.plot_widths import record_widths_png
 
     return record_widths_png(record_id, {f"{H:g} m": v for H, v in verified.items()})
 
@@ -534,7 +534,7 @@ def _process(task: Task):
 
 def _check_settings(task: Task) -> dict:
     """The search's settings for each column: the check above the design width where
-    pipeline.passes asks for it (docs/slivers.md)."""
+    pipeline.batch.passes asks for it (docs/slivers.md)."""
     from rocking.search import DEFAULT_SETTINGS
 
     base = DEFAULT_SETTINGS if task.check else DEFAULT_SETTINGS.replace(check_runs=0)

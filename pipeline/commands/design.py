@@ -9,7 +9,7 @@ import json
 import math
 import sys
 
-from .args import (ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_length,
+from ..args import (ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_length,
                    parse_positive)
 
 

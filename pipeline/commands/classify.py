@@ -6,7 +6,7 @@ period Tp, the peak velocity and the orientation of the strongest pulse.  Files 
 what they say (``--pairs auto``, the default: NGA-West2 names, ``_1``/``_2``, the header's
 station and event; verticals are left out) or as named with ``--pair A B``.
 
-:mod:`pipeline.pulse_row` gives this command's rows and the columns ``pipeline run`` adds to its
+:mod:`pipeline.reports.pulse_row` gives this command's rows and the columns ``pipeline run`` adds to its
 reports, from one place.
 """
 from __future__ import annotations
@@ -14,8 +14,8 @@ from __future__ import annotations
 import json
 import sys
 
-from .args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
-from .pulse_row import COLUMNS, RUN_COLUMNS, classify_fields, result_row  # noqa: F401 (this command's row)
+from ..args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
+from ..reports.pulse_row import COLUMNS, RUN_COLUMNS, classify_fields, result_row  # noqa: F401 (this command's row)
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
@@ -43,7 +43,7 @@ def _message(path, exc) -> str:
 def main(args) -> int:
     import pulses
 
-    from .tasks import expand_inputs
+    from ..batch.tasks import expand_inputs
 
     if not args.files and not args.pair:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
@@ -107,7 +107,7 @@ def main(args) -> int:
             rows.append(result_row(result, x, y or ""))
             results.append((result, x, y))
             if args.plot:
-                from .plot_classify import plot_classification
+                from ..reports.plot_classify import plot_classification
 
                 try:
                     plot_classification(result, args.plot, records[x],
@@ -121,8 +121,8 @@ def main(args) -> int:
     elif rows:
         print(format_rows(rows))
     if args.csv and rows:
-        from .outpaths import write_output
-        from .report import csv_text
+        from ..reports.outpaths import write_output
+        from ..reports.report import csv_text
 
         write_output(args.csv, csv_text(COLUMNS, [{c: row[c] for c in COLUMNS} for row in rows]), "csv",
                      inputs=inputs)
@@ -131,7 +131,7 @@ def main(args) -> int:
 
 def _unique_stem(name, taken) -> str:
     """A file-system-safe stem for ``name`` not in ``taken`` (``-2``, ``-3``, ... appended)."""
-    from .tasks import record_ids
+    from ..batch.tasks import record_ids
 
     base = record_ids([name])[0]
     stem, k = base, 1
@@ -143,9 +143,9 @@ def _unique_stem(name, taken) -> str:
 
 
 def _check_outputs(args, inputs) -> None:
-    """Argument errors before any work (:mod:`pipeline.outpaths`): ``--csv`` that is a folder, one
+    """Argument errors before any work (:mod:`pipeline.reports.outpaths`): ``--csv`` that is a folder, one
     of the inputs or a file this command did not write; ``--plot`` that is not a folder."""
-    from .outpaths import check_output_dir, check_output_file
+    from ..reports.outpaths import check_output_dir, check_output_file
 
     if args.csv is not None:
         check_output_file(args.csv, "--csv", "csv", inputs=inputs, command="classify")

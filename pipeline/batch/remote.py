@@ -20,7 +20,7 @@ import shutil
 import tempfile
 import uuid
 
-from .batch import process_record
+from .record import process_record
 from .tasks import Task
 
 
@@ -35,7 +35,7 @@ def read_bytes(path: str) -> bytes | None:
 
 
 def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
-    """Run on a worker: :func:`pipeline.worker.work` on ``data`` (and ``data2``, the second file of
+    """Run on a worker: :func:`pipeline.batch.worker.work` on ``data`` (and ``data2``, the second file of
     a pair), written to private files named as the originals; the result names the original paths."""
     from . import worker
 

@@ -9,7 +9,7 @@ import math
 import re
 import time
 
-from .args import ArgumentError, ShapeNames, parse_acceleration, parse_angle, parse_block, parse_positive
+from ..args import ArgumentError, ShapeNames, parse_acceleration, parse_angle, parse_block, parse_positive
 
 
 
@@ -57,7 +57,7 @@ def run(args) -> int:
 
     import rocking
 
-    from .outpaths import check_file_options
+    from ..reports.outpaths import check_file_options
 
     check_file_options(args, "spectrum")
     if args.alpha is None and args.block is None:
@@ -85,7 +85,7 @@ def run(args) -> int:
     for i in np.unique(np.linspace(0, nw - 1, min(nw, 8)).astype(int)):
         v = mins[i]
         print(f"{spec.wp_over_p[i]:>10.3f}  {('> %.3g' % a1) if np.isnan(v) else ('%.4g' % v):>33}")
-    from .outpaths import figure_png, write_output
+    from ..reports.outpaths import figure_png, write_output
 
     if args.csv:
         write_output(args.csv, spec.to_frame().to_csv(index=False), "csv")

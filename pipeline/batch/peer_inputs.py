@@ -3,7 +3,7 @@
 
 The search report ``_SearchResults.csv`` (:mod:`pulses.peer`) says which files form a record: each
 record with both horizontals in the download is designed as a pair, in every direction
-(:mod:`pipeline.pairs`, as ``--pair`` does), with the report's metadata in every row
+(:mod:`pipeline.batch.pairs`, as ``--pair`` does), with the report's metadata in every row
 (:data:`PEER_COLUMNS`, and ``peer_tp_s`` next to the package's ``velocity_tp_s``).  A record whose
 listed files are not all in the download fails, with the files it lacks, in ``failures.csv``: the
 run goes on and exits with status 1.  Records are designed as recorded unless ``--peer-scales``
@@ -18,7 +18,7 @@ import functools
 import os
 from dataclasses import dataclass
 
-from .report import Columns
+from ..reports.report import Columns
 
 PEER_COLUMNS = Columns(
     ("peer_rsn", "-", "PEER record sequence number (RSN) of the record, from the download's "
@@ -44,7 +44,7 @@ _KEYS = {"peer_rsn": "rsn", "peer_event": "event", "peer_year": "year", "peer_st
          "peer_magnitude": "magnitude", "peer_mechanism": "mechanism", "peer_rjb_km": "rjb_km",
          "peer_rrup_km": "rrup_km", "peer_vs30_m_s": "vs30_m_s",
          "peer_lowest_usable_freq_hz": "lowest_usable_freq_hz", "peer_scale_factor": "scale_factor"}
-#: the site column holding PEER's pulse period (declared in pipeline.site, next to ours)
+#: the site column holding PEER's pulse period (declared in pipeline.batch.site, next to ours)
 PEER_TP = "peer_tp_s"
 
 
@@ -68,7 +68,7 @@ class PeerSource:
     vertical_note: str = ""
 
     def inputs(self) -> list[str]:
-        """The files whose content the record's results depend on (for :mod:`pipeline.resume`)."""
+        """The files whose content the record's results depend on (for :mod:`pipeline.batch.resume`)."""
         if os.path.isdir(self.download):
             return [os.path.join(self.download, n) for n in (self.h1, self.h2, self.vertical) if n]
         return [self.download]
@@ -122,7 +122,7 @@ def scale_of(entry) -> float:
     """The search's scale factor of ``entry``, checked by the one rule of every scale
     (:func:`pipeline.args.parse_scale`); :class:`ArgumentError` when it is missing or outside it
     (a factor of 1e6, 0 or nan was applied, or silently taken as 1)."""
-    from .args import ArgumentError, parse_scale
+    from ..args import ArgumentError, parse_scale
 
     factor = entry.metadata.get("scale_factor")
     what = f"RSN {entry.rsn}: --peer-scales: the search's scale factor (_SearchResults.csv, line {entry.line})"
@@ -134,7 +134,7 @@ def scale_of(entry) -> float:
 
 def _why_not(d, e, scaled: bool) -> str:
     """Why the record ``e`` of download ``d`` cannot be designed (blank: it can)."""
-    from .args import ArgumentError
+    from ..args import ArgumentError
 
     if e.h1 is None or e.h2 is None:
         return f"RSN {e.rsn}: the search report lists no {'Horizontal-1' if e.h1 is None else 'Horizontal-2'} file"
@@ -162,7 +162,7 @@ NOT_DOWNLOADED_FIELDS = ["download", "peer_rsn", "line", "peer_event", "peer_sta
 
 def not_downloaded_text(rows) -> str | None:
     """The text of :data:`NOT_DOWNLOADED` (None when no download was given)."""
-    from .report import csv_text
+    from ..reports.report import csv_text
 
     return None if rows is None else csv_text(NOT_DOWNLOADED_FIELDS, rows)
 

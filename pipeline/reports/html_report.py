@@ -241,7 +241,7 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
     Parameters
     ----------
     design : list of dict
-        Rows of ``design.csv`` (:func:`pipeline.design_table.design_rows`).
+        Rows of ``design.csv`` (:func:`pipeline.reports.design_table.design_rows`).
     rows : list of dict
         Rows of ``summary.csv``.
     failures : list of dict

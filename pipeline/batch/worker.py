@@ -1,4 +1,4 @@
-"""One task in a worker: :func:`work` runs :func:`pipeline.batch.process_record` as a worker (this
+"""One task in a worker: :func:`work` runs :func:`pipeline.batch.record.process_record` as a worker (this
 process, a pool's process or a dask worker) runs it, with the time it took and where.
 """
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from . import joblog
-from .batch import failure, process_record
+from .record import failure, process_record
 from .tasks import Task
 
 

@@ -13,7 +13,7 @@ import pathlib
 import re
 from dataclasses import dataclass, field
 
-from .outfiles import RESERVED_IDS
+from ..reports.outfiles import RESERVED_IDS
 
 @dataclass(frozen=True)
 class Column:
@@ -43,18 +43,18 @@ class Options:
     trace: str | None = None
     plots: bool = True
     #: ``--plots all``: a figure for every direction of a pair (default: its governing direction
-    #: only, pipeline.passes)
+    #: only, pipeline.batch.passes)
     plots_all: bool = False
-    #: a rocking frame's cap beam mass over the columns' (0: lone columns); see pipeline.site
+    #: a rocking frame's cap beam mass over the columns' (0: lone columns); see pipeline.batch.site
     cap_mass_ratio: float = 0.0
     fragility: bool = False
     up_to: float = 10.0
     #: the performance level (``--limit`` R: max|theta|/alpha <= R); None: overturning
     limit: float | None = None
-    #: ``"auto"``: use a record's known vertical (pipeline.vertical); ``"none"``: horizontal only
+    #: ``"auto"``: use a record's known vertical (pipeline.batch.vertical); ``"none"``: horizontal only
     vertical: str = "auto"
     #: ``--thorough``: every direction of a pair gets the check above its verified width and
-    #: (with plots) its figures, as a lone record does (pipeline.passes)
+    #: (with plots) its figures, as a lone record does (pipeline.batch.passes)
     thorough: bool = False
 
 
@@ -65,24 +65,24 @@ class Task:
     path: str
     columns: tuple = ()
     options: Options = field(default_factory=Options)
-    #: a direction of a pair (pipeline.site): the second file, the angle (deg) and why it was chosen
+    #: a direction of a pair (pipeline.batch.site): the second file, the angle (deg) and why it was chosen
     path2: str | None = None
     direction: float | None = None
     direction_kind: str = ""
     pair: str = ""
     scale: float = 1.0
     pair_fields: tuple = ()
-    #: a record of a PEER download (pipeline.peer_inputs.PeerSource): where its files are read from
+    #: a record of a PEER download (pipeline.batch.peer_inputs.PeerSource): where its files are read from
     peer: object = None
-    #: the vertical component's file of a pair (pipeline.vertical: --triplet, --pairs auto)
+    #: the vertical component's file of a pair (pipeline.batch.vertical: --triplet, --pairs auto)
     vertical: str | None = None
-    #: run the check above the verified width (docs/slivers.md); pipeline.passes decides per
+    #: run the check above the verified width (docs/slivers.md); pipeline.batch.passes decides per
     #: direction of a pair
     check: bool = True
     #: with ``check``: run it for a column only where its top lies above this width (m, one per
     #: column; empty: everywhere), ``rocking.search.SearchSettings.check_above``
     check_above: tuple = ()
-    #: draw this task's figures (where ``options.plots``); pipeline.passes decides per direction
+    #: draw this task's figures (where ``options.plots``); pipeline.batch.passes decides per direction
     plot: bool = True
 
 

@@ -23,7 +23,7 @@ import os
 import pathlib
 import re
 
-from . import report
+from ..reports import report
 
 #: the resume journal in ``--out`` (written by ``pipeline run`` alone, like the manifest)
 RESUME = report.RESUME
@@ -112,7 +112,7 @@ def report_rows_text(raw: bytes) -> str | None:
 
 
 def _fields():
-    from .batch import FIELDS
+    from .record import FIELDS
 
     return FIELDS
 

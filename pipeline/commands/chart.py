@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 
-from .args import ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_positive
+from ..args import ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_positive
 
 
 def _floats(text, what):
@@ -68,7 +68,7 @@ def run(args) -> int:
     import rocking
     from rocking.spectrum import CHART_APG, CHART_PTP
 
-    from .outpaths import check_file_options
+    from ..reports.outpaths import check_file_options
 
     check_file_options(args, "chart")
     pulse = _your_pulse(args)
@@ -91,7 +91,7 @@ def run(args) -> int:
         k = sub["ratio"].idxmax()
         print(f"{shape:<12} {x:>6g} {sub['ratio'].max():>10.3f} {sub.loc[k, 'ap_over_g']:>8.3g} "
               f"{sub['ratio'].min():>10.3f} {int((sub['islands'] > 0).sum()):>8d}")
-    from .outpaths import figure_png, write_output
+    from ..reports.outpaths import figure_png, write_output
 
     if args.csv:
         write_output(args.csv, frame.to_csv(index=False), "csv")
@@ -118,8 +118,8 @@ def _mark(pulse, column):
 def _run_heights(args, heights, pulse, column) -> int:
     import pulses
 
-    from .outpaths import figure_png, write_output
-    from .width_chart import RULES, width_figure, widths_by_height
+    from ..reports.outpaths import figure_png, write_output
+    from ..reports.width_chart import RULES, width_figure, widths_by_height
 
     shape, ap, tp = pulse
     start = time.perf_counter()

@@ -81,7 +81,7 @@ def plot_classification(result, folder, first=None, second=None, stem=None, inpu
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
     # a temporary file and a rename (never half a PNG), and never over a file this package did
-    # not write (pipeline.outpaths)
+    # not write (pipeline.reports.outpaths)
     write_output(path, buf.getvalue(), "png", what="--plot", inputs=inputs)
     return str(path)
 

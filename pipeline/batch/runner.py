@@ -13,9 +13,13 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from . import design_table, html_report, interrupts, joblog, outfiles, outlock, passes, report, resume, site
-from .args import ArgumentError, output_folder
-from .batch import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
+from ..reports import design_table, html_report, outfiles, report
+
+from .. import interrupts
+
+from . import joblog, outlock, passes, resume, site
+from ..args import ArgumentError, output_folder
+from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV  # noqa: F401 (tests set it through the runner)
 from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
@@ -113,11 +117,11 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
     """Process ``paths`` for ``columns`` and write every report into ``out``.
 
     A record whose report in ``out`` was made by an earlier run from the same file content, options
-    and package version is kept, not computed again (:mod:`pipeline.resume`), unless ``force``;
+    and package version is kept, not computed again (:mod:`pipeline.batch.resume`), unless ``force``;
     ``summary.csv``, ``failures.csv`` and the plots are rebuilt from every record's report.
-    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.joblog`).  ``lists``: files the
+    ``log`` (a path) gets one JSON line per record (:mod:`pipeline.batch.joblog`).  ``lists``: files the
     inputs add to the reports, ``{name: text}`` (None: a file of that name from an earlier run is
-    removed), such as :data:`pipeline.peer_inputs.NOT_DOWNLOADED`.
+    removed), such as :data:`pipeline.batch.peer_inputs.NOT_DOWNLOADED`.
 
     Raises
     ------
@@ -130,10 +134,10 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
         complete, no temporary file left.
     """
     if tasks is None and not all(isinstance(c, Column) for c in columns):  # not an error per record
-        raise TypeError("columns: expected pipeline.tasks.Column objects; from Python, "
+        raise TypeError("columns: expected pipeline.batch.tasks.Column objects; from Python, "
                         "pipeline.design(records, blocks='7.5x1.8', heights=12.0) takes blocks and heights")
     out = output_folder(out)  # checked before the Path: pathlib makes "" the current folder
-    if tasks is None:  # else made by pipeline.site.make_tasks (pairs, directions, scales)
+    if tasks is None:  # else made by pipeline.batch.site.make_tasks (pairs, directions, scales)
         tasks = make_tasks(paths, columns, options)
     with outlock.locked(out):  # one run at a time in one folder
         return _run_locked(out, tasks, options=options, jobs=jobs, dask=dask, quiet=quiet,
@@ -143,8 +147,8 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
 def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log, lists) -> RunSummary:
     """:func:`run`, the folder locked."""
     outputs = prepare_output(out, tasks, options.plots, options)
-    if log is not None:  # never onto an input or one of this run's own files (pipeline.outpaths)
-        from .outpaths import check_output_file
+    if log is not None:  # never onto an input or one of this run's own files (pipeline.reports.outpaths)
+        from ..reports.outpaths import check_output_file
 
         check_output_file(log, "--log", "log", inputs=[p for t in tasks for p in (t.path, t.path2)],
                           reserved=[out / rel for rel in outfiles.own_files(tasks, options)], command="run")
@@ -182,7 +186,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     header = report.csv_text(FIELDS, [])
     stream = _serial([])
     try:
-        while True:  # pipeline.passes: a pair's directions, then its governing one checked, ...
+        while True:  # pipeline.batch.passes: a pair's directions, then its governing one checked, ...
             if todo:
                 stream = execute(todo, jobs=jobs, dask=dask)
                 for res in stream:
@@ -305,7 +309,7 @@ def _reusable(tasks, journal, force: bool, options, plan, held=()):
 
 
 def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
-    """The tasks of the next pass (pipeline.passes) that must be computed; those an earlier run
+    """The tasks of the next pass (pipeline.batch.passes) that must be computed; those an earlier run
     kept are taken as they are."""
     version = resume.package_version()
     todo = []
@@ -358,7 +362,7 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options):
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed)
     if options.plots:
-        from .plots import summary_figure_png
+        from ..reports.plots import summary_figure_png
 
         outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
@@ -366,7 +370,7 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options):
     return design, rows
 
 
-# -- the answer in view: design.csv, report.html (pipeline.design_table, pipeline.html_report) --------
+# -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------
 def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
     """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
     design = design_table.design_rows(rows, failed)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import os
 
-from .args import ArgumentError
+from ..args import ArgumentError
 
 
 @contextlib.contextmanager
@@ -23,7 +23,7 @@ def locked(folder, what: str = "--out"):
     Raises :class:`ArgumentError` when another process holds it.  Where the file system has no
     such locks (some network file systems) the run goes on unlocked, as before.
     """
-    from .report import display
+    from ..reports.report import display
 
     try:
         import fcntl

@@ -12,8 +12,8 @@ from __future__ import annotations
 import json
 import sys
 
-from .args import ShapeNames, add_record_options, add_weighting_option, parse_shapes, record_options
-from .report import text_cell
+from ..args import ShapeNames, add_record_options, add_weighting_option, parse_shapes, record_options
+from ..reports.report import text_cell
 
 
 def add_parser(subparsers) -> None:
@@ -40,7 +40,7 @@ def main(args) -> int:
 
     shapes = parse_shapes(args.shapes)
     opts = record_options(args)
-    from .outpaths import check_output_dir, check_output_file
+    from ..reports.outpaths import check_output_dir, check_output_file
 
     if args.plot is not None:
         check_output_dir(args.plot, "--plot", inputs=args.files)
@@ -84,7 +84,7 @@ def main(args) -> int:
         frame = pd.concat(rows, ignore_index=True)
         for name in frame.columns:  # text cells a spreadsheet would evaluate: see report.text_cell
             frame[name] = frame[name].map(lambda v: text_cell(v) if isinstance(v, str) else v)
-        from .outpaths import write_output
+        from ..reports.outpaths import write_output
 
         write_output(args.csv, frame.to_csv(index=False, float_format="%.6g"), "csv", inputs=args.files)
     return 1 if failures else 0
@@ -156,7 +156,7 @@ def plot_fit(record, fit, folder, inputs=()) -> str:
     fig.tight_layout()
     safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in record.name)
     path = folder / f"{safe}.png"
-    from .outpaths import figure_png, write_output
+    from ..reports.outpaths import figure_png, write_output
 
     data = figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110, metadata={"Software": None}))
     plt.close(fig)

@@ -1,7 +1,7 @@
 """The vertical component in ``pipeline run``: ``--vertical auto|none`` and ``--triplet H1 H2 V``.
 
 A task has a vertical when its record is a PEER record whose search report lists one
-(:mod:`pipeline.peer_inputs`), a ``--triplet``, or a pair found by ``--pairs auto`` with exactly one
+(:mod:`pipeline.batch.peer_inputs`), a ``--triplet``, or a pair found by ``--pairs auto`` with exactly one
 vertical of the same station.  With ``--vertical auto`` (the default) the three components are read
 on one time axis (:func:`pulses.check_triplet`: cut to the shortest, the vertical made upward by
 its stated polarity), and for every column as it stands the response with the vertical is computed
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from .report import Columns
+from ..reports.report import Columns
 
 VERTICAL_COLUMNS = Columns(
     ("vertical_file", "-", "The vertical component used with this record (`--vertical auto`: a PEER "

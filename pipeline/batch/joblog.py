@@ -12,7 +12,7 @@ import json
 import os
 import socket
 
-#: the result key under which :func:`pipeline.runner.work` reports where and how long a record ran
+#: the result key under which :func:`pipeline.batch.runner.work` reports where and how long a record ran
 WORKER, SECONDS = "worker", "wall_seconds"
 
 

@@ -11,7 +11,7 @@ from .report import (COLUMNS_MD, FAILURES, FRAGILITY_CSV, FRAGILITY_CURVE_CSV, F
 
 
 def site_files(plots: bool, fragility: bool) -> list[str]:
-    """The fixed files of the site part (pipeline.site): pairs, suite and, with ``--fragility``,
+    """The fixed files of the site part (pipeline.batch.site): pairs, suite and, with ``--fragility``,
     the fragility tables; their figures with ``plots``."""
     files = [PAIRS_CSV, SUITE_CSV]
     if plots:

@@ -5,7 +5,7 @@ Every file is written atomically (to a temporary file created exclusively in the
 renamed), so an interrupted run never leaves a half-written report, and the content depends only on
 the inputs (no time stamps, fixed number formatting, input order), so re-running into the same
 folder gives identical files.  Only files the run wrote are ever replaced or removed
-(:class:`Outputs`).  The report columns themselves are declared in :mod:`pipeline.batch`, next to
+(:class:`Outputs`).  The report columns themselves are declared in :mod:`pipeline.batch.record`, next to
 the code that computes them (:class:`Columns`).
 """
 from __future__ import annotations
@@ -162,7 +162,7 @@ def write_atomic(path, data) -> pathlib.Path:
     arriving during the write takes effect when the file is whole.  Unchanged files are not
     rewritten.
     """
-    from . import interrupts
+    from .. import interrupts
 
     path = pathlib.Path(path)
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
@@ -213,7 +213,7 @@ _MANIFEST_HEADER = ("# pipeline run: the files it wrote into this folder (sha256
                     "it replaces or removes no other file\n")
 
 
-#: the resume journal in ``--out`` (:mod:`pipeline.resume`): which records a later run may keep
+#: the resume journal in ``--out`` (:mod:`pipeline.batch.resume`): which records a later run may keep
 RESUME = "pipeline-resume.txt"
 
 
@@ -333,7 +333,7 @@ def append_line(path, header: str, line: str) -> None:
     holding only part of its header (see :func:`read_journal`) is started again.  Ctrl-C waits
     until the line is written.  A failure (a full disk ...) raises an :class:`OSError` naming the
     file."""
-    from . import interrupts
+    from .. import interrupts
 
     head = header.encode("utf-8")
     with interrupts.deferred(), named_errors(path):
@@ -385,7 +385,7 @@ def _real_folder(folder, top) -> bool:
 # -- the files -------------------------------------------------------------------------------------
 SUMMARY, FAILURES, COLUMNS_MD = "summary.csv", "failures.csv", "columns.md"
 SUMMARY_PLOT = "plots/summary.png"
-#: the site part's tables and figures (pipeline.site: pairs, suite, fragility)
+#: the site part's tables and figures (pipeline.batch.site: pairs, suite, fragility)
 PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV, FRAGILITY_CURVE_CSV = ("pairs.csv", "suite.csv", "fragility.csv",
                                                            "fragility_curve.csv")
 SUITE_PLOT, FRAGILITY_PLOT = "plots/suite.png", "plots/fragility.png"

@@ -2,7 +2,7 @@
 direction, scale, velocity pulse), the task's ground motion, suite results and collapse fragility.
 
 A *task* of ``pipeline run`` is one ground motion to design for: a single component file, or one
-horizontal direction of a pair of components (:mod:`pipeline.pairs` makes them; a direction and its
+horizontal direction of a pair of components (:mod:`pipeline.batch.pairs` makes them; a direction and its
 opposite give the same width: the column is symmetric).  The component at ``theta`` is
 ``pulses.component(a1, a2, theta)``.
 
@@ -19,9 +19,9 @@ import math
 from . import peer_inputs
 from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
 from .peer_inputs import PEER_TP
-from .pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
-from .args import SCALE_RANGE, parse_scale
-from .report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
+from ..reports.pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
+from ..args import SCALE_RANGE, parse_scale
+from ..reports.report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
                      Columns)
 
 
@@ -48,7 +48,7 @@ SITE_COLUMNS = Columns(
     ("cap_mass_ratio", "-", "Mass of the cap beam over the columns' total mass (`--cap-mass-ratio`): "
                             "0 for a lone column, above 0 for a rocking frame of such columns "
                             "(docs/theory.md section 8: the frame's p and restitution are used throughout)."),
-    # the velocity-pulse columns (pipeline.pulse_row), PEER's period beside the package's
+    # the velocity-pulse columns (pipeline.reports.pulse_row), PEER's period beside the package's
     *RUN_PULSE_COLUMNS.around(
         "velocity_tp_s",
         (PEER_TP, "s", "PEER's pulse period of the record (`Tp-Pulse Period` of a PEER download's "
@@ -153,7 +153,7 @@ def add_options(parser) -> None:
     """The site options of ``pipeline run``."""
     import argparse
 
-    from .args import add_pair_options
+    from ..args import add_pair_options
 
     add_pair_options(parser, default="none", action="design, in several directions, for")
     parser.add_argument("--directions", metavar="N", default="0",
@@ -187,7 +187,7 @@ def _number(text, what, lo, hi) -> float:
 
 
 def options_from_args(args) -> dict:
-    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.Options`."""
+    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.record.Options`."""
     gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
     up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
     limit = getattr(args, "limit", None)
@@ -388,14 +388,14 @@ def fragility_tables(rows):
 def write_outputs(outputs, rows, fields, options, failed=None) -> None:
     """Write ``pairs.csv``, ``suite.csv`` (and their plots) and, with ``--fragility``, the fragility
     files, from every row of the run (``failed``: ``{pair: directions that failed}``)."""
-    from . import report
+    from ..reports import report
 
     pair_fields = list(PAIR_COLUMNS.names) + list(fields)
     outputs.write(PAIRS_CSV, report.csv_text(pair_fields, governing_rows(rows, failed)))
     suite = suite_rows(rows) if rows else []
     outputs.write(SUITE_CSV, report.csv_text(list(SUITE_COLUMNS.names), suite))
     if options.plots and rows:
-        from .plot_site import suite_figure_png
+        from ..reports.plot_site import suite_figure_png
 
         outputs.write(SUITE_PLOT, suite_figure_png(rows, suite))
     if options.fragility:
@@ -403,7 +403,7 @@ def write_outputs(outputs, rows, fields, options, failed=None) -> None:
         outputs.write(FRAGILITY_CSV, report.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
         outputs.write(FRAGILITY_CURVE_CSV, report.csv_text(list(FRAGILITY_CURVE_COLUMNS.names), curve))
         if options.plots and fits:
-            from .plot_site import fragility_figure_png
+            from ..reports.plot_site import fragility_figure_png
 
             outputs.write(FRAGILITY_PLOT, fragility_figure_png(fits))
 

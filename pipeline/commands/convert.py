@@ -9,8 +9,8 @@ from __future__ import annotations
 import pathlib
 import sys
 
-from .args import ArgumentError, add_record_options, record_options
-from .cmd_fit import _with_path
+from ..args import ArgumentError, add_record_options, record_options
+from .fit import _with_path
 
 
 def add_parser(subparsers) -> None:
@@ -55,7 +55,7 @@ def main(args) -> int:
     import pulses
 
     opts = record_options(args)
-    from .outpaths import check_output_dir, check_output_file
+    from ..reports.outpaths import check_output_dir, check_output_file
 
     out = check_output_dir(args.out, "--out", inputs=args.files)
     failures = 0
@@ -67,7 +67,7 @@ def main(args) -> int:
             failures += 1
             continue
         target = out / output_name(record, path, "." + args.to)
-        try:  # never onto one of the inputs (pipeline.outpaths)
+        try:  # never onto one of the inputs (pipeline.reports.outpaths)
             check_output_file(target, "--out: the file", "record", inputs=args.files, command="convert")
         except ArgumentError as exc:
             print(f"pipeline convert: {path}: {exc}", file=sys.stderr)

@@ -16,8 +16,10 @@ import os
 import pathlib
 import sys
 
-from . import peer_inputs, pulse_row
-from .args import ArgumentError, pair_files, parse_scale
+from . import peer_inputs
+
+from ..reports import pulse_row
+from ..args import ArgumentError, pair_files, parse_scale
 from .tasks import Task, make_tasks, record_ids
 
 #: directions closer than this (deg, modulo 180) are one direction
@@ -234,7 +236,7 @@ def peer_tasks(downloads, columns, options, n_directions, scale, scales, peer_sc
     """The tasks of the PEER downloads: each complete record a pair in every direction
     (:func:`directions`), each incomplete one a task that fails when read, with the
     reason; the records not downloaded at all go to ``absent``, when given
-    (:func:`pipeline.peer_inputs.record_units`).  Indices and record ids are set by :func:`combine`."""
+    (:func:`pipeline.batch.peer_inputs.record_units`).  Indices and record ids are set by :func:`combine`."""
     from pulses import RecordError, check_pair
 
     tasks = []
