@@ -96,3 +96,20 @@ def test_eq31_safe_island_and_the_suite_answer():
     lv = design_rows([dict(base, record="a", pair="a", design_limit=0.4)])[0]
     assert lv["survives"] is False and lv["verdict"] == "NO"
     assert "for max theta/alpha <= 0.4" in table_text([lv])
+
+
+def test_the_motion_that_governs_is_marked_where_it_is_the_vertical():
+    """A design width set by the response with the vertical reads ``(vertical)`` beside it, in the
+    printed table and the page; one set by the horizontal motion alone carries no mark."""
+    from pipeline.reports.design_table import table_cells
+
+    vert = dict(_row(0, 1.553, None, search=1.5), design_governed_by="with vertical",
+                record="v", pair="v")
+    hor = dict(_row(0, 1.431, None, search=1.431), design_governed_by="horizontal",
+               record="h", pair="h")
+    d = {r["record"]: r for r in design_rows([vert, hor])}
+    assert d["v"]["design_governed_by"] == "with vertical"
+    assert table_cells(d["v"])[5] == "1.553 m (vertical)"
+    assert table_cells(d["h"])[5] == "1.431 m"
+    text = table_text([d["v"], d["h"]])
+    assert "1.553 m (vertical)" in text and "1.431 m (vertical)" not in text
