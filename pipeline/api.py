@@ -13,10 +13,9 @@ import sys
 import tempfile
 from dataclasses import dataclass, field
 
-from .args import ArgumentError
+from .args import ArgumentError, jobs_count
 
 #: most worker processes: each holds the solver and a record (a few hundred MB)
-MAX_JOBS = 256
 
 _COLUMN_FORMS = ("a rocking.Block, a 'HxW' string in m (e.g. '7.5x1.8') or a (height, width) pair "
                  "of numbers in m")
@@ -131,9 +130,7 @@ def _choice(value, what, choices):
 def _jobs(jobs) -> int:
     if not isinstance(jobs, int) or isinstance(jobs, bool):
         raise TypeError(f"jobs: expected a whole number of processes (0: one per CPU), got {type(jobs).__name__}")
-    if not 0 <= jobs <= MAX_JOBS:
-        raise ValueError(f"jobs must be 0 (one per CPU) to {MAX_JOBS}, got {jobs}")
-    return jobs or (os.cpu_count() or 1)
+    return jobs_count(jobs, "jobs")
 
 
 def _shapes(shapes):

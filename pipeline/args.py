@@ -17,6 +17,19 @@ class ArgumentError(ValueError):
     """A command-line value that cannot be used (reported in one line, exit status 2)."""
 
 
+#: the most worker processes a run takes (``--jobs``, ``pipeline.design(jobs=)``): each holds the
+#: solver and a record (a few hundred MB)
+MAX_JOBS = 256
+
+
+def jobs_count(jobs: int, name: str) -> int:
+    """The number of worker processes for ``jobs`` (0: one per CPU), in 0..:data:`MAX_JOBS`;
+    ``name`` is the option or argument the message names."""
+    if not 0 <= jobs <= MAX_JOBS:
+        raise ValueError(f"{name} must be 0 (one per CPU) to {MAX_JOBS}, got {jobs}")
+    return jobs or (os.cpu_count() or 1)
+
+
 # -- options for reading records (fit, convert, run, classify, simulate) -----------------------------
 def add_record_options(parser) -> None:
     """Add the options that tell :func:`pulses.read_record` what a file does not say:

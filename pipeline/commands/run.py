@@ -2,16 +2,12 @@
 from __future__ import annotations
 
 import argparse
-import os
 
 from ..batch import peer_inputs, site, vertical
-from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, parse_block, parse_length,
-                   parse_shapes, record_options)
+from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, jobs_count, parse_block,
+                   parse_length, parse_shapes, record_options)
 
 DEFAULT_OUT = "pipeline-output"
-#: most worker processes: each holds the solver and a record (a few hundred MB)
-MAX_JOBS = 256
-
 
 #: what ``--plots`` may be given: figures of each pair's governing direction, or of every one
 PLOT_SCOPES = ("governing", "all")
@@ -96,9 +92,10 @@ def parse_jobs(text) -> int | None:
         jobs = int(str(text))
     except ValueError:
         raise ArgumentError(f"--jobs expects a whole number of processes, got {text!r}") from None
-    if not 0 <= jobs <= MAX_JOBS:
-        raise ArgumentError(f"--jobs must be 0 (one per CPU) to {MAX_JOBS}, got {jobs}")
-    return jobs or (os.cpu_count() or 1)
+    try:
+        return jobs_count(jobs, "--jobs")
+    except ValueError as exc:
+        raise ArgumentError(str(exc)) from None
 
 
 def build_columns(blocks, heights):
