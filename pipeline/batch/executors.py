@@ -14,11 +14,13 @@ from ..args import ArgumentError
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, worker_failure
 
 
-def _serial(tasks):
-    """Records one after the other in this process."""
-    for task in tasks:
-        interrupts.check()
-        yield work(task)
+def _serial(tasks, more=None):
+    """Records one after the other in this process (then those ``more()`` gives, see :func:`execute`)."""
+    while tasks:
+        for task in tasks:
+            interrupts.check()
+            yield work(task)
+        tasks = more() if more is not None else []
 
 
 def _size(task) -> int:
@@ -28,7 +30,7 @@ def _size(task) -> int:
         return 0
 
 
-def _pool(tasks, jobs):
+def _pool(tasks, jobs, more=None):
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
@@ -67,7 +69,7 @@ def _pool(tasks, jobs):
                                    initargs=(os.environ.get(TEST_KILL_ENV),))
 
     try:
-        while queue or suspects:
+        while queue or suspects or _refill(queue, more):
             if pool is None:
                 pool = new_pool()
             if suspects:  # one record alone in the pool
@@ -122,6 +124,13 @@ def _pool(tasks, jobs):
                 pool.shutdown(wait=True)
             else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
                 _stop(pool, others)
+
+
+def _refill(queue, more) -> bool:
+    """Whether ``more()`` (every result so far taken) gave tasks, now in ``queue`` (largest first)."""
+    extra = more() if more is not None else []
+    queue.extend(sorted(extra, key=_size, reverse=True))
+    return bool(extra)
 
 
 def _child_processes() -> set:
@@ -230,29 +239,34 @@ def dask_client(address: str, jobs: int | None):
         raise ArgumentError(f"--dask: cannot connect to the scheduler at {address!r}: {exc}") from None
 
 
-def _dask(tasks, address, jobs):
+def _dask(tasks, address, jobs, more=None):
     from .remote import run_dask
 
     client, cluster = dask_client(address, jobs)
     try:
         client.run(init_worker)
         workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
-        yield from run_dask(tasks, client, workers)
+        while tasks:
+            yield from run_dask(tasks, client, workers)
+            tasks = more() if more is not None else []
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
 
 
-def execute(tasks, jobs: int | None = 1, dask: str | None = None):
+def execute(tasks, jobs: int | None = 1, dask: str | None = None, more=None):
     """Results of :func:`process_record` for every task, in completion order.
 
-    ``jobs`` None (not given) or 1: the records in this process."""
+    ``jobs`` None (not given) or 1: the records in this process.  ``more``: called once every
+    result so far has been taken, it gives the tasks to run next (empty: none), on the same
+    workers (a pair's later passes, :mod:`pipeline.batch.passes`: the pool and its processes
+    are started once, and no pass runs in this process when ``jobs`` asks for workers)."""
     if dask:
-        return _dask(tasks, dask, jobs)
-    if jobs is None or jobs <= 1 or len(tasks) <= 1:
-        return _serial(tasks)
-    return _pool(tasks, min(jobs, len(tasks)))
+        return _dask(tasks, dask, jobs, more)
+    if jobs is None or jobs <= 1 or (len(tasks) <= 1 and more is None):
+        return _serial(tasks, more)
+    return _pool(tasks, jobs if more is not None else min(jobs, len(tasks)), more)
 
 
 def _import_plots():

@@ -185,23 +185,26 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
 
     header = report.csv_text(FIELDS, [])
     stream = _serial([])
+
+    def more():  # pipeline.batch.passes: a pair's directions, then its governing one checked, ...
+        later = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
+        if later and bar is not None:
+            bar.total += len(later)
+            bar.refresh()
+        return later
+
     try:
-        while True:  # pipeline.batch.passes: a pair's directions, then its governing one checked, ...
-            if todo:
-                stream = execute(todo, jobs=jobs, dask=dask)
-                for res in stream:
-                    computed.add(res["index"])
-                    _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
-                    log.record(res, tasks[res["index"]].record_id)
-                    if bar is not None:
-                        bar.update(1)
-                stream.close()
-            todo = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
-            if not todo:
-                break
+        staged = any(passes.staged(t, options) for t in tasks)
+        todo = todo or (more() if staged else [])
+        # one executor for every pass: its workers started once
+        stream = execute(todo, jobs=jobs, dask=dask, more=more if staged else None)
+        for res in stream:
+            computed.add(res["index"])
+            _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
+            log.record(res, tasks[res["index"]].record_id)
             if bar is not None:
-                bar.total += len(todo)
-                bar.refresh()
+                bar.update(1)
+        stream.close()
     finally:
         with interrupts.deferred():
             stream.close()  # an interrupted pool is stopped here, at once

@@ -51,9 +51,12 @@ def work(task: Task) -> dict:
         os.kill(os.getpid(), signal.SIGKILL)
     import time
 
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     res = process_record(task)
     res[joblog.SECONDS] = time.perf_counter() - start
+    # this process's CPU (all its threads) on the task: a pool's workers are no children of the
+    # main process's to getrusage (forkserver), so a batch's CPU is the sum of these
+    res[joblog.CPU] = time.process_time() - cpu
     res[joblog.WORKER] = joblog.here()
     return res
 
