@@ -12,7 +12,7 @@ import numpy as np
 
 from pulses import G, SHAPES
 
-from . import scan
+from . import scan, searches
 from .block import Block
 from .frame import check_cap_mass_ratio, frame_p
 from .closed_forms import envelope_rule, eq20, eq31
@@ -307,8 +307,9 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                     np.asarray(res.max_rotation_ratio, dtype=float) / (limit or 1.0))
 
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
-        res, seen = _record_search(height, top, evaluate_record, criterion=criterion, eta=eta,
-                                   settings=settings)
+        res, seen = searches.remembered(  # a batch's later pass: the same search (rocking.searches)
+            searches.key(excitation, vertical, settings, height, criterion, eta, gamma, limit, model),
+            lambda: _record_search(height, top, evaluate_record, criterion=criterion, eta=eta, settings=settings))
         res.cap_mass_ratio, res.limit, res.search_width = gamma, limit, res.width
         if vertical is not None:
             res.method += "; with the vertical record (compiled engine, fast-vertical)"

@@ -15,7 +15,7 @@ import time
 
 from pulses.shapes import AntisymmetricRicker
 
-from . import peer_inputs, site, vertical
+from . import memo, peer_inputs, site, vertical
 from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
@@ -568,8 +568,10 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
         return out
     for c in fitting:
         p_tp = [b.p * c.tp for b in blocks]
-        res = rocking.min_slenderness_batch(c.shape, p_tp, [abs(c.ap) / G] * len(blocks),
-                                            refine="top", ksection=2, cap_mass_ratio=cap_mass_ratio)
+        key = (c.shape, tuple(p_tp), abs(c.ap) / G, cap_mass_ratio)  # its every input
+        res = memo.remembered("slenderness", key, lambda: rocking.min_slenderness_batch(
+            c.shape, p_tp, [abs(c.ap) / G] * len(blocks), refine="top", ksection=2,
+            cap_mass_ratio=cap_mass_ratio))
         for b, r in zip(blocks, res):
             out[(c.shape, b)] = float(r.tan_alpha)
     return out
@@ -578,4 +580,6 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
 def _fit(record, shapes, weighting):
     import pulses
 
-    return pulses.fit_pulse(record, shapes=list(shapes) if shapes else None, weighting=weighting)
+    key = (memo.samples_key(record), tuple(shapes) if shapes else None, weighting)
+    return memo.remembered("fit", key, lambda: pulses.fit_pulse(
+        record, shapes=list(shapes) if shapes else None, weighting=weighting))

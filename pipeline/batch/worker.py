@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 
-from . import joblog
+from . import joblog, memo
 from .record import failure, process_record
 from .tasks import Task
 
@@ -51,6 +51,7 @@ def work(task: Task) -> dict:
         os.kill(os.getpid(), signal.SIGKILL)
     import time
 
+    memo.on()  # a pair's direction computed again in a later pass reuses its search and fit
     start, cpu = time.perf_counter(), time.process_time()
     res = process_record(task)
     res[joblog.SECONDS] = time.perf_counter() - start

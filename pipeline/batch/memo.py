@@ -1,0 +1,52 @@
+"""What a worker keeps between the passes of a pair's direction (``pipeline.batch.passes``).
+
+A direction searched in a first pass is computed again, with its check, in a later one; its pulse
+fit and exact minimum slenderness are deterministic functions of the record's samples and the
+options, and so is the search (:mod:`rocking.searches`).  A worker keeps the last few of each,
+keyed by a hash of every input (samples included), and answers the second pass with copies: the
+same rows to the last bit, without the repeated work.
+"""
+from __future__ import annotations
+
+import collections
+import copy
+import hashlib
+
+import numpy as np
+
+#: results kept per kind in a worker: a pool's tasks come back for their next pass after the
+#: pass's other tasks, so this covers a few pairs of 38 directions and two heights
+KEPT = 256
+
+_kept: dict[str, collections.OrderedDict] = {}
+
+
+def on() -> None:
+    """Keep results in this process from now on (the search's too)."""
+    from rocking import searches
+
+    searches.keep(KEPT)
+    _kept.setdefault("fit", collections.OrderedDict())
+    _kept.setdefault("slenderness", collections.OrderedDict())
+
+
+def samples_key(record) -> tuple:
+    """A record's samples, time axis and name, as a key."""
+    digest = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes()).hexdigest()
+    return digest, float(record.dt), float(record.t_start), str(record.name)
+
+
+def remembered(kind: str, key, compute):
+    """``compute()``, or a copy of the result kept for ``key`` (kept only after :func:`on`)."""
+    kept = _kept.get(kind)
+    if kept is None:
+        return compute()
+    hit = kept.get(key)
+    if hit is not None:
+        kept.move_to_end(key)
+        return copy.deepcopy(hit)
+    res = compute()
+    kept[key] = copy.deepcopy(res)
+    while len(kept) > KEPT:
+        kept.popitem(last=False)
+    return res
