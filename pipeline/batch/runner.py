@@ -186,13 +186,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     header = report.csv_text(FIELDS, [])
     stream = _serial([])
 
-    def more():  # pipeline.batch.passes: a pair's directions, then its governing one checked, ...
-        later = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
-        if later and bar is not None:
-            bar.total += len(later)
-            bar.refresh()
-        return later
-
+    more = _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar)
     try:
         staged = any(passes.staged(t, options) for t in tasks)
         todo = todo or (more() if staged else [])
@@ -309,6 +303,18 @@ def _reusable(tasks, journal, force: bool, options, plan, held=()):
             journal.drop(t.record_id)
             todo.append(t)
     return texts, keys, todo
+
+
+def _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar):
+    """The executor's ``more``: the tasks of the next pass (pipeline.batch.passes: a pair's
+    directions, then its governing one checked, ...), counted on the progress bar."""
+    def more():
+        later = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
+        if later and bar is not None:
+            bar.total += len(later)
+            bar.refresh()
+        return later
+    return more
 
 
 def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
