@@ -13,13 +13,20 @@ run, ``pipeline run --pair A B --directions 36 --block 7.5x1.8 --jobs J`` (38 di
 - this version, default options (the check and the figures where they decide, pipeline/batch/passes.py);
 - this version with ``--thorough`` (every direction checked and drawn).
 
-Each run is a fresh process tree in a fresh ``--out``; its CPU is user + sys of the process and
-every worker (``getrusage`` of the tree, measured by a wrapper that also reports the main process's
-own share).  Reported per pair: CPU seconds per direction, PNG bytes, and the answers compared:
+Each run is a fresh process tree in a fresh ``--out``.  Its CPU: the main process's own
+(``getrusage(RUSAGE_SELF)``, printed by a wrapper) and, for this version, every task's CPU as its
+worker measured it (``cpu_seconds`` of ``--log``; a pool's forkserver workers are no children
+``getrusage`` would count).  The side-by-side comparison runs with ``--jobs 1`` by default: every
+task then runs in the main process and ``RUSAGE_SELF`` is the whole CPU of either version.  With
+``--share-jobs J`` (default 2) this version's default run is repeated with ``--jobs J`` (and
+with ``--dask local`` where ``--dask`` is given) to measure the main process's share of the CPU.
+
+Reported per pair: CPU seconds per direction, by stage (the stages' times from ``--log``),
+PNG bytes, and the answers compared:
 the pair's design width (the widest verified width or failing width the checks found, over its
 directions) of the default and of ``--thorough`` against the baseline's, and whether every
 direction's verified width, verdicts and check columns of ``--thorough`` equal the baseline's.
-Then the projection for 10,000 pairs on 64 cores.
+Then the projection for 10,000 pairs on 64 cores (at this machine's CPU per direction).
 """
 from __future__ import annotations
 
@@ -39,13 +46,12 @@ PAIRS = [("Rinaldi228.AT2", "Rinaldi318.AT2"), ("RSN77_SFERN_PUL164.AT2", _H + "
          ("RSN150", None), ("RSN250", None), ("RSN879_LANDERS_LCN260.AT2", "RSN879_LANDERS_LCN345.AT2"),
          ("shahi_baker_examples/example1.AT2", "shahi_baker_examples/example2.AT2")]
 ARGS = ["--directions", "36", "--block", "7.5x1.8", "--quiet"]
-#: runs ``pipeline`` in this process and prints the CPU of the main process and of its workers
-WRAPPER = ("import json, resource, sys\n"
+#: runs ``pipeline`` in this process and prints the CPU of the main process and its pid
+WRAPPER = ("import json, os, resource, sys\n"
            "from pipeline.cli import main\n"
            "code = main(sys.argv[1:])\n"
-           "s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)\n"
-           "print(json.dumps({'code': code, 'main': s.ru_utime + s.ru_stime, "
-           "'workers': c.ru_utime + c.ru_stime}))\n")
+           "s = resource.getrusage(resource.RUSAGE_SELF)\n"
+           "print(json.dumps({'code': code, 'self': s.ru_utime + s.ru_stime, 'pid': os.getpid()}))\n")
 #: the check's columns and the verdicts compared row by row
 COMPARED = ["verified_width_m", "overturns", "eq31_width_m", "eq31_width_overturns", "failing_share",
             "widest_failing_width_m", "check_runs", "pulse_shape", "pulse_ap_g", "pulse_tp_s"]
@@ -58,16 +64,31 @@ def pair_paths(spec):
     return str(SHARED / a), str(SHARED / b)
 
 
-def run_one(python, pair, out, jobs, extra=()) -> dict:
-    """One ``pipeline run`` as a fresh process tree: its CPU (main process, workers)."""
-    argv = [python, "-c", WRAPPER, "run", "--pair", *pair, *ARGS, "--jobs", str(jobs), "--out", str(out), *extra]
+def run_one(python, pair, out, jobs, extra=(), log=False) -> dict:
+    """One ``pipeline run`` as a fresh process tree: its CPU (``main``: the main process's own,
+    ``cpu``: the whole run's; with ``log``, ``stages``: seconds per stage summed over the tasks)."""
+    argv = [python, "-c", WRAPPER, "run", "--pair", *pair, *ARGS, "--out", str(out), *extra]
+    argv += ["--jobs", str(jobs)] if jobs else []
+    logfile = pathlib.Path(str(out) + ".jsonl")
+    if log:
+        argv += ["--log", str(logfile)]
     # run from the output's folder: from a checkout, ``-c`` would import that checkout's package
     res = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=pathlib.Path(out).parent)
     line = [ln for ln in res.stdout.splitlines() if ln.startswith("{")]
     if not line:
         raise RuntimeError(f"{' '.join(argv)} failed: {res.stderr[-2000:]}")
     got = json.loads(line[-1])
-    got["cpu"] = got["main"] + got["workers"]
+    got["main"], got["cpu"], got["stages"] = got["self"], got["self"], {}
+    if log:
+        entries = [json.loads(ln) for ln in logfile.read_text(encoding="utf-8").splitlines()]
+        here = [e for e in entries if str(e.get("worker") or "").endswith(f":{got['pid']}")]
+        away = [e for e in entries if e not in here]
+        got["main"] = got["self"] - sum(e["cpu_seconds"] for e in here)   # its own, without tasks
+        got["cpu"] = got["self"] + sum(e["cpu_seconds"] for e in away)
+        for e in entries:
+            for k, v in e.get("stages", {}).items():
+                got["stages"][k] = got["stages"].get(k, 0.0) + v
+        got["tasks"] = len(entries)
     got["png_bytes"] = sum(p.stat().st_size for p in pathlib.Path(out).rglob("*.png"))
     got["rows"] = list(csv.DictReader(open(pathlib.Path(out) / "summary.csv", encoding="utf-8")))
     return got
@@ -85,21 +106,27 @@ def same_rows(a, b) -> bool:
     return ra.keys() == rb.keys() and all(ra[k][c] == rb[k][c] for k in ra for c in COMPARED)
 
 
-def measure(baseline, n_pairs, jobs) -> list[dict]:
+def measure(baseline, n_pairs, jobs, share_jobs, dask) -> list[dict]:
     base_python = str(pathlib.Path(baseline) / ".venv" / "bin" / "python")
+    runs_of = [("baseline", base_python, (), jobs, False), ("default", sys.executable, (), jobs, True),
+               ("thorough", sys.executable, ("--thorough",), jobs, True)]
+    if share_jobs:
+        runs_of.append((f"default-jobs{share_jobs}", sys.executable, (), share_jobs, True))
+    if dask:
+        runs_of.append(("default-dask", sys.executable, ("--dask", "local"), share_jobs or 2, True))
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         for k, spec in enumerate(PAIRS[:n_pairs]):
             pair = pair_paths(spec)
-            runs = {name: run_one(py, pair, pathlib.Path(tmp) / f"{k}-{name}", jobs, extra)
-                    for name, py, extra in (("baseline", base_python, ()), ("default", sys.executable, ()),
-                                            ("thorough", sys.executable, ("--thorough",)))}
+            runs = {name: run_one(py, pair, pathlib.Path(tmp) / f"{k}-{name}", j, extra, log)
+                    for name, py, extra, j, log in runs_of}
             n = len(runs["baseline"]["rows"])
             entry = {"pair": pathlib.Path(pair[0]).stem, "directions": n}
             for name, r in runs.items():
                 entry[name] = {"cpu_per_direction": r["cpu"] / n, "main_share": r["main"] / r["cpu"],
                                "png_mb": r["png_bytes"] / 1e6, "design_width": design_width(r["rows"]),
-                               "exit": r["code"],
+                               "exit": r["code"], "tasks": r.get("tasks"),
+                               "stages_per_direction": {k: round(v / n, 4) for k, v in sorted(r["stages"].items())},
                                "checked": sum(row["check_runs"] not in ("", "0") for row in r["rows"])}
             entry["thorough_rows_equal_baseline"] = same_rows(runs["thorough"]["rows"], runs["baseline"]["rows"])
             entry["default_design_equals_thorough"] = (entry["default"]["design_width"]
@@ -115,11 +142,17 @@ def summary(entries) -> dict:
     def mean(name, what):
         return float(np.mean([e[name][what] for e in entries]))
 
+    names = [k for k in entries[0] if isinstance(entries[0][k], dict)]
     res = {name: {"cpu_per_direction": mean(name, "cpu_per_direction"), "png_mb_per_pair": mean(name, "png_mb"),
                   "main_share": mean(name, "main_share"),
                   # 10,000 pairs of 38 directions on 64 cores, at this machine's speed per core
                   "hours_10000_pairs_64_cores": mean(name, "cpu_per_direction") * 38 * 10_000 / 64 / 3600}
-           for name in ("baseline", "default", "thorough")}
+           for name in names}
+    stages = {}
+    for e in entries:
+        for k, v in e["default"]["stages_per_direction"].items():
+            stages[k] = stages.get(k, 0.0) + v / len(entries)
+    res["default"]["stages_per_direction"] = {k: round(v, 4) for k, v in sorted(stages.items(), key=lambda kv: -kv[1])}
     res["speed_up_default"] = res["baseline"]["cpu_per_direction"] / res["default"]["cpu_per_direction"]
     res["design_widths_equal"] = all(e["default_design_equals_thorough"] for e in entries)
     res["thorough_equal_baseline"] = all(e["thorough_rows_equal_baseline"] for e in entries)
@@ -130,9 +163,13 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", required=True, help="checkout of the version compared with (its .venv)")
     ap.add_argument("--pairs", type=int, default=4, help=f"pairs measured (at most {len(PAIRS)}; default 4)")
-    ap.add_argument("--jobs", type=int, default=1, help="--jobs of every run (default 1)")
+    ap.add_argument("--jobs", type=int, default=1, help="--jobs of the compared runs (default 1: "
+                    "every task in the main process, whose getrusage is then the whole CPU)")
+    ap.add_argument("--share-jobs", type=int, default=2, help="--jobs of a further default run measuring "
+                    "the main process's share (0: none; default 2)")
+    ap.add_argument("--dask", action="store_true", help="also a default run with --dask local")
     args = ap.parse_args(argv)
-    entries = measure(args.baseline, args.pairs, args.jobs)
+    entries = measure(args.baseline, args.pairs, args.jobs, args.share_jobs, args.dask)
     print(json.dumps(summary(entries), indent=1))
 
 

@@ -1,0 +1,92 @@
+"""What a worker keeps between a pair's passes (pipeline/batch/memo.py, rocking/searches.py), and
+the passes run on one executor: the kept search, fit and slenderness are the computed ones to the
+last bit, never another record's; every pass runs in the workers under ``--jobs 2``."""
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+import pulses
+import rocking
+from pipeline.batch import memo
+from pipeline.cli import main as cli_main
+from rocking import searches
+from rocking.search import DEFAULT_SETTINGS
+
+from .test_site import H, _pair, _synthetic
+
+
+@pytest.fixture
+def kept():
+    """Searches kept for the test only (a test process keeps none otherwise)."""
+    searches.keep(8)
+    yield
+    searches.keep(0)
+
+
+def _width(record, check_runs):
+    return rocking.required_width(H, record, rule="exact",
+                                  settings=DEFAULT_SETTINGS.replace(check_runs=check_runs))
+
+
+def _same(a, b):
+    for name in ("width", "search_width", "transitions", "runs", "iterations", "method", "check_runs",
+                 "widest_failing_width", "failing_share"):
+        assert getattr(a, name) == getattr(b, name), name
+    assert np.array_equal(np.asarray(a.check_widths), np.asarray(b.check_widths))
+
+
+def test_a_kept_search_gives_the_computed_answer_with_and_without_its_check(kept):
+    record = _synthetic(0.4, 3)
+    fresh_search, fresh_checked = _width(record, 0), _width(record, 300)
+    searches.keep(0)
+    searches.keep(8)
+    first = _width(record, 0)           # computed and kept
+    again = _width(record, 300)         # the kept search, then its check
+    _same(first, fresh_search)
+    _same(again, fresh_checked)
+    assert again.check_runs > 0 and first.check_runs == 0
+    # a copy: the check run on the kept search did not change what is kept
+    _same(_width(record, 0), fresh_search)
+
+
+def test_a_kept_search_is_never_another_records(kept):
+    record = _synthetic(0.4, 3)
+    _width(record, 0)
+    other = pulses.Record(record.acc * 1.5, record.dt, record.name, record.t_start, record.metadata)
+    searches.keep(0)
+    fresh = _width(other, 0)
+    searches.keep(8)
+    _width(record, 0)
+    _same(_width(other, 0), fresh)      # not the kept one: its samples differ
+    assert _width(other, 0).width != _width(record, 0).width
+
+
+def test_the_memo_hands_out_copies_of_what_it_computed():
+    memo.on()
+    calls = []
+    key = ("test", np.random.default_rng(5).random())
+
+    def compute():
+        calls.append(1)
+        return {"a": [1.0, 2.0]}
+
+    first = memo.remembered("fit", key, compute)
+    first["a"].append(3.0)              # the caller's copy only
+    assert memo.remembered("fit", key, compute) == {"a": [1.0, 2.0]} and len(calls) == 1
+
+
+def test_every_pass_runs_in_the_workers_and_logs_its_cpu(tmp_path):
+    pair = _pair(tmp_path, "STW", 0.45, 0.3, 1)
+    log = tmp_path / "log.jsonl"
+    code = cli_main(["run", "--pair", *map(str, pair), "--block", "2.0x0.35", "--directions", "4",
+                     "--jobs", "2", "--out", str(tmp_path / "out"), "--quiet", "--log", str(log)])
+    assert code == 0
+    entries = [json.loads(line) for line in log.read_text().splitlines()]
+    assert len(entries) > 6            # 6 directions, some computed again in a later pass
+    here = f":{os.getpid()}"
+    assert not [e for e in entries if e["worker"].endswith(here)]
+    assert all(e["cpu_seconds"] > 0 and e["stages"]["verify:required_width"] > 0 for e in entries)
