@@ -1,6 +1,7 @@
 """What a worker keeps between a pair's passes (pipeline/batch/memo.py, rocking/searches.py), and
 the passes run on one executor: the kept search, fit and slenderness are the computed ones to the
-last bit, never another record's; every pass runs in the workers under ``--jobs 2``."""
+last bit, never another record's; every pass runs in the workers under ``--jobs 2``, and so does
+reading and classifying the pairs, with the same tasks."""
 from __future__ import annotations
 
 import json
@@ -90,3 +91,25 @@ def test_every_pass_runs_in_the_workers_and_logs_its_cpu(tmp_path):
     here = f":{os.getpid()}"
     assert not [e for e in entries if e["worker"].endswith(here)]
     assert all(e["cpu_seconds"] > 0 and e["stages"]["verify:required_width"] > 0 for e in entries)
+
+
+def test_pairs_read_and_classified_in_workers_give_the_same_tasks(tmp_path):
+    from pipeline.batch.pairs import pair_tasks
+    from pipeline.batch.tasks import Column, Options
+
+    pairs = [_pair(tmp_path, "STA", 0.45, 0.3, 1), _pair(tmp_path, "STB", 0.3, 0.4, 7),
+             [tmp_path / "missing_1.sac", tmp_path / "missing_2.sac"]]  # unreadable: one failing task
+
+    def tasks(jobs):
+        got = pair_tasks([], [tuple(map(str, p)) for p in pairs], "none", [Column(2.0, 0.35)], Options(),
+                         n_directions=3, say=lambda msg: None, jobs=jobs)
+        return [(t.record_id, t.path, t.path2, t.direction, t.direction_kind, t.pair, t.pair_fields)
+                for t in got]
+
+    here = tasks(None)
+    assert here == tasks(2)
+    # each readable pair in its components, its pulse's direction and normal and 3 more; the
+    # pair fields (its classification) carried alike
+    assert len(here) > 10 and sum(t[4] == "pulse" for t in here) == 2
+    assert all(dict(t[6]).get("pulse_like") is not None for t in here if t[5].startswith("STA"))
+    assert sum(1 for t in here if t[5].startswith("missing")) == 1

@@ -5,7 +5,8 @@ downloads.
 For a pair the directions are, by default, the two recorded components (0 and 90 deg from the first
 towards the second), the direction of the strongest velocity pulse (``pulses.classify_pulse``) and
 its normal; ``--directions N`` adds ``k 180/N`` deg, ``k = 0..N-1``.  Pairs are read and classified
-here, in the main process (their directions depend on the pulse's).
+before their tasks are made (their directions depend on the pulse's), in worker processes under
+``--jobs N``.
 """
 from __future__ import annotations
 
@@ -59,7 +60,7 @@ def _file_tasks(args, paths, columns, options):
         return None
     say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=sys.stderr))
     return pair_tasks(paths, pair_files(args.pair), args.pairs, columns, options, n, scale,
-                      scales, say=say)
+                      scales, say=say, jobs=getattr(args, "jobs", None))
 
 
 def settings_from_args(args):
@@ -155,7 +156,7 @@ def _lookup_names(path, *ids) -> list[str]:
 
 
 def pair_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale=1.0, scales=None,
-               say=print):
+               say=print, jobs=None):
     """Tasks of ``pipeline run``: single files as today, pairs as one task per direction.
 
     ``pairs`` are the ``--pair A B`` couples; with ``pairs_mode == "auto"`` the other files are
@@ -190,22 +191,17 @@ def pair_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale
 
     specs = []  # (name for the id, path, path2, direction, kind, pair name, pair fields, lookup names)
     pair_names = record_ids([pair_name(a, b) + ".pair" if b is not None else a for a, b, _ in units])
+    both = [(a, b, explicit, opts, n_directions) for a, b, explicit in units if b is not None]
+    prepared = iter(_map_pairs(both, jobs))
     for (a, b, explicit), pname in zip(units, pair_names):
         if b is None:
             specs.append((a, a, None, None, "", "", (), _lookup_names(a, pname)))
             continue
-        try:
-            first, second = pulses.read_pair(a, b, **opts)
-            fields = pulse_row.pair_classification(first, second)
-            angles = directions(fields.get("orientation_deg"), n_directions)
-        except pulses.RecordError as exc:
-            if not explicit and _both_readable(a, b, opts):
-                say(f"pipeline run: note: {exc}; designing {a} and {b} one by one")
-                specs += [(p, p, None, None, "", "", (), _lookup_names(p)) for p in (a, b)]
-                continue
-            fields, angles = {}, [(0.0, "component-1")]  # the task fails at reading, with the reason
-        except Exception:  # unreadable: the task fails at reading, with the reason
-            fields, angles = {}, [(0.0, "component-1")]
+        fields, angles, split = next(prepared)
+        if split:
+            say(f"pipeline run: note: {split}; designing {a} and {b} one by one")
+            specs += [(p, p, None, None, "", "", (), _lookup_names(p)) for p in (a, b)]
+            continue
         names = _lookup_names(a, pname) + _lookup_names(b)
         for angle, kind in angles:
             specs.append((f"{pname}_{angle:05.1f}deg.dir", a, b, angle, kind, pname,
@@ -217,6 +213,48 @@ def pair_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale
         tasks.append(Task(i, rid, str(a), tuple(columns), options, path2=None if b is None else str(b),
                           direction=angle, direction_kind=kind, pair=pname, scale=k, pair_fields=fields))
     return tasks
+
+
+def prepare_pair(a, b, explicit, opts, n_directions):
+    """``(pair fields, directions, split)`` of one pair: read and classified (its directions
+    depend on the pulse's); ``split``: why a pair found by ``--pairs auto`` is designed one file at a
+    time (None otherwise).  A pair that cannot be read gets one direction, whose task fails at
+    reading with the reason, as a bad single file does."""
+    import pulses
+
+    try:
+        first, second = pulses.read_pair(a, b, **opts)
+        fields = pulse_row.pair_classification(first, second)
+        return fields, directions(fields.get("orientation_deg"), n_directions), None
+    except pulses.RecordError as exc:
+        if not explicit and _both_readable(a, b, opts):
+            return {}, [], str(exc)
+    except Exception:  # unreadable: the task fails at reading, with the reason
+        pass
+    return {}, [(0.0, "component-1")], None
+
+
+def _map_pairs(args, jobs):
+    """:func:`prepare_pair` of every pair (``args``: its arguments), in input order: in a pool of
+    ``jobs`` worker processes where there are several pairs, so that reading and classifying them
+    does not hold up this process (issue: no serial ceiling); here otherwise."""
+    if not jobs or jobs <= 1 or len(args) < 2:
+        return [prepare_pair(*a) for a in args]
+    import multiprocessing
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    from .worker import _init_pool_worker, TEST_KILL_ENV
+
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_init_pool_worker,
+                             initargs=(os.environ.get(TEST_KILL_ENV),)) as pool:
+        return list(pool.map(_prepare_packed, args, chunksize=max(1, len(args) // (4 * jobs))))
+
+
+def _prepare_packed(args):
+    return prepare_pair(*args)
 
 
 def _both_readable(a, b, opts) -> bool:
