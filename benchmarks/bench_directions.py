@@ -9,7 +9,7 @@ RSN77, RSN181, RSN879, RSN1084, RSN159, RSN150, RSN250 are pulse-like, RSN6 and 
 examples' RSN179 pair too by S&B14; the first ``--pairs`` of them), one after the other in this one
 run, ``pipeline run --pair A B --directions 36 --block 7.5x1.8 --jobs J`` (38 directions) by:
 
-- the baseline (its defaults: every direction checked and drawn);
+- the baseline, default options and ``--thorough``;
 - this version, default options (the check and the figures where they decide, pipeline/batch/passes.py);
 - this version with ``--thorough`` (every direction checked and drawn).
 
@@ -19,13 +19,16 @@ worker measured it (``cpu_seconds`` of ``--log``; a pool's forkserver workers ar
 ``getrusage`` would count).  The side-by-side comparison runs with ``--jobs 1`` by default: every
 task then runs in the main process and ``RUSAGE_SELF`` is the whole CPU of either version.  With
 ``--share-jobs J`` (default 2) this version's default run is repeated with ``--jobs J`` (and
-with ``--dask local`` where ``--dask`` is given) to measure the main process's share of the CPU.
+with ``--dask local`` where ``--dask`` is given) to measure the main process's share of the CPU,
+and at the end every pair is run in one batch with ``--jobs J`` by both versions: the main
+process's CPU of each, and this version's share.
 
 Reported per pair: CPU seconds per direction, by stage (the stages' times from ``--log``),
 PNG bytes, and the answers compared:
 the pair's design width (the widest verified width or failing width the checks found, over its
-directions) of the default and of ``--thorough`` against the baseline's, and whether every
-direction's verified width, verdicts and check columns of ``--thorough`` equal the baseline's.
+directions) of the default against ``--thorough``'s, and whether every direction's verified
+width, verdicts and check columns equal the baseline's (``--thorough`` against its ``--thorough``,
+the default against its default).
 Then the projection for 10,000 pairs on 64 cores (at this machine's CPU per direction).
 """
 from __future__ import annotations
@@ -67,7 +70,8 @@ def pair_paths(spec):
 def run_one(python, pair, out, jobs, extra=(), log=False) -> dict:
     """One ``pipeline run`` as a fresh process tree: its CPU (``main``: the main process's own,
     ``cpu``: the whole run's; with ``log``, ``stages``: seconds per stage summed over the tasks)."""
-    argv = [python, "-c", WRAPPER, "run", "--pair", *pair, *ARGS, "--out", str(out), *extra]
+    pairs = [pair] if isinstance(pair[0], str) else pair   # one pair, or a batch of them
+    argv = [python, "-c", WRAPPER, "run", *[a for p in pairs for a in ("--pair", *p)], *ARGS, "--out", str(out), *extra]
     argv += ["--jobs", str(jobs)] if jobs else []
     logfile = pathlib.Path(str(out) + ".jsonl")
     if log:
@@ -101,7 +105,7 @@ def design_width(rows) -> float:
 
 def same_rows(a, b) -> bool:
     """Every direction's :data:`COMPARED` columns equal (as written)."""
-    key = lambda r: (r["direction_deg"], r["column"])
+    key = lambda r: (r.get("pair"), r["direction_deg"], r["column"])
     ra, rb = {key(r): r for r in a}, {key(r): r for r in b}
     return ra.keys() == rb.keys() and all(ra[k][c] == rb[k][c] for k in ra for c in COMPARED)
 
@@ -109,6 +113,7 @@ def same_rows(a, b) -> bool:
 def measure(baseline, n_pairs, jobs, share_jobs, dask) -> list[dict]:
     base_python = str(pathlib.Path(baseline) / ".venv" / "bin" / "python")
     runs_of = [("baseline", base_python, (), jobs, False), ("default", sys.executable, (), jobs, True),
+               ("baseline-thorough", base_python, ("--thorough",), jobs, False),
                ("thorough", sys.executable, ("--thorough",), jobs, True)]
     if share_jobs:
         runs_of.append((f"default-jobs{share_jobs}", sys.executable, (), share_jobs, True))
@@ -128,7 +133,9 @@ def measure(baseline, n_pairs, jobs, share_jobs, dask) -> list[dict]:
                                "exit": r["code"], "tasks": r.get("tasks"),
                                "stages_per_direction": {k: round(v / n, 4) for k, v in sorted(r["stages"].items())},
                                "checked": sum(row["check_runs"] not in ("", "0") for row in r["rows"])}
-            entry["thorough_rows_equal_baseline"] = same_rows(runs["thorough"]["rows"], runs["baseline"]["rows"])
+            entry["thorough_rows_equal_baseline"] = same_rows(runs["thorough"]["rows"],
+                                                              runs["baseline-thorough"]["rows"])
+            entry["default_rows_equal_baseline"] = same_rows(runs["default"]["rows"], runs["baseline"]["rows"])
             entry["default_design_equals_thorough"] = (entry["default"]["design_width"]
                                                        == entry["thorough"]["design_width"])
             print(json.dumps(entry), flush=True)
@@ -156,6 +163,7 @@ def summary(entries) -> dict:
     res["speed_up_default"] = res["baseline"]["cpu_per_direction"] / res["default"]["cpu_per_direction"]
     res["design_widths_equal"] = all(e["default_design_equals_thorough"] for e in entries)
     res["thorough_equal_baseline"] = all(e["thorough_rows_equal_baseline"] for e in entries)
+    res["default_equal_baseline"] = all(e["default_rows_equal_baseline"] for e in entries)
     return res
 
 
@@ -170,7 +178,25 @@ def main(argv=None) -> None:
     ap.add_argument("--dask", action="store_true", help="also a default run with --dask local")
     args = ap.parse_args(argv)
     entries = measure(args.baseline, args.pairs, args.jobs, args.share_jobs, args.dask)
-    print(json.dumps(summary(entries), indent=1))
+    res = summary(entries)
+    if args.share_jobs:
+        res["batch"] = batch(args.baseline, args.pairs, args.share_jobs)
+    print(json.dumps(res, indent=1))
+
+
+def batch(baseline, n_pairs, jobs) -> dict:
+    """The main process's CPU on one batch of the ``n_pairs`` pairs with ``--jobs J``: this version's
+    (and its share of the run's CPU, its workers' from ``--log``) and the baseline's (its own
+    seconds only: a pool's workers are not its children to getrusage)."""
+    pairs = [pair_paths(spec) for spec in PAIRS[:n_pairs]]
+    with tempfile.TemporaryDirectory() as tmp:
+        this = run_one(sys.executable, pairs, pathlib.Path(tmp) / "this", jobs, (), True)
+        base = run_one(str(pathlib.Path(baseline) / ".venv" / "bin" / "python"), pairs,
+                       pathlib.Path(tmp) / "base", jobs, (), False)
+    return {"pairs": n_pairs, "jobs": jobs, "tasks": this["tasks"], "main_cpu_s": this["main"],
+            "cpu_s": this["cpu"], "main_share": this["main"] / this["cpu"],
+            "cpu_per_direction": this["cpu"] / len(this["rows"]), "baseline_main_cpu_s": base["main"],
+            "rows_equal_baseline": same_rows(this["rows"], base["rows"])}
 
 
 if __name__ == "__main__":

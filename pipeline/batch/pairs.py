@@ -241,16 +241,19 @@ def _map_pairs(args, jobs):
     if not jobs or jobs <= 1 or len(args) < 2:
         return [prepare_pair(*a) for a in args]
     import multiprocessing
-    import os
     from concurrent.futures import ProcessPoolExecutor
-
-    from .worker import _init_pool_worker, TEST_KILL_ENV
 
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_init_pool_worker,
-                             initargs=(os.environ.get(TEST_KILL_ENV),)) as pool:
+    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_ignore_interrupts) as pool:
         return list(pool.map(_prepare_packed, args, chunksize=max(1, len(args) // (4 * jobs))))
+
+
+def _ignore_interrupts() -> None:
+    """Ctrl-C left to the main process (a worker interrupted on its own would print a traceback)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _prepare_packed(args):
