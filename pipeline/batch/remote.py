@@ -64,6 +64,7 @@ def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
         row["file"] = task.path
         if "file2" in row:
             row["file2"] = task.path2
+    res[worker.TEXT] = worker.rows_text(res["rows"])  # with the paths as given
     if res["failure"]:
         res["failure"]["file"] = task.path
         for here, there in swaps.items():

@@ -21,7 +21,7 @@ from . import joblog, outlock, passes, resume, site
 from ..args import ArgumentError, output_folder
 from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from .executors import _serial, execute
-from .worker import TEST_KILL_ENV  # noqa: F401 (tests set it through the runner)
+from .worker import TEST_KILL_ENV, TEXT  # noqa: F401 (tests set TEST_KILL_ENV through the runner)
 from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
 
 
@@ -85,7 +85,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
     problems = []
     try:
         if res["rows"]:
-            outputs.write(report.record_csv_name(rid), report.csv_text(FIELDS, res["rows"]))
+            outputs.write(report.record_csv_name(rid), res.get(TEXT) or report.csv_text(FIELDS, res["rows"]))
         else:  # a report from an earlier run would look like this record's
             outputs.remove(report.record_csv_name(rid))
     except OSError as exc:
@@ -250,7 +250,7 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
     task = tasks[i]
     figure = res.get("plot")
     _write_record(outputs, task, res, options.plots and task.plot, say)
-    texts[i] = report.csv_text(FIELDS, res["rows"])[len(header):]
+    texts[i] = (res.get(TEXT) or report.csv_text(FIELDS, res["rows"]))[len(header):]  # made by the worker
     failures[i] = res["failure"]
     plan.note(task, res["rows"])
     if res["failure"] or not res["rows"] or keys[i] is None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from . import joblog, memo
-from .record import failure, process_record
+from .record import FIELDS, failure, process_record
 from .tasks import Task
 
 
@@ -59,7 +59,24 @@ def work(task: Task) -> dict:
     # main process's to getrusage (forkserver), so a batch's CPU is the sum of these
     res[joblog.CPU] = time.process_time() - cpu
     res[joblog.WORKER] = joblog.here()
+    res[TEXT] = rows_text(res["rows"])
     return res
+
+
+#: the result key of the record's report as CSV text (header and rows), made in the worker so that
+#: the main process only writes it (pipeline.batch.runner)
+TEXT = "text"
+
+
+def rows_text(rows):
+    """``<record>.csv``'s text of ``rows``, or None where they do not match the columns (the main
+    process then fails as it did)."""
+    from ..reports.report import ReportError, csv_text
+
+    try:
+        return csv_text(FIELDS, rows)
+    except ReportError:
+        return None
 
 
 def worker_failure(task: Task, exc: BaseException) -> dict:
