@@ -1444,54 +1444,39 @@ cdef bint _turn(long order, double a, const double* uval, long j, double ta, dou
     return True
 
 
-cdef bint _impact(double a, const double* uval, long j, double ta, double tb, double h,
-                  double theta, double omega, double side, double sa, double ca, double p,
-                  double eta, double omega_zeno, double max_abs, double* cf, double* kt,
-                  double* kw, double* out) noexcept nogil:
-    """An interval of a rocking lane moving toward zero in which ``theta`` reaches zero once (a
-    plain impact: no Zeno rest after it, no other event before the interval's end), taken as
-    :func:`run_core` takes it, operation for operation (the same bits): its tight loop's step at
-    ``ORDERS_START`` (else the unrolled steps from there up, over ``tb - ta``), the impact located
-    on the step's polynomial (:func:`_impact_state`), the peak before it, the restitution, and
-    one step over the rest of the interval from ``theta = 0`` on the other side.  False where
-    anything else happens (the engine takes the interval).  ``out``: theta, omega, sin, cos at
-    the end of the interval (sin and cos as the lanes set them after the engine) and ``max_abs``
+cdef bint _impact(long order, double a, const double* uval, long j, double ta, double tb,
+                  double h, double theta, double omega, double side, double sa, double ca,
+                  double p, double eta, double omega_zeno, double max_abs, double* cf,
+                  double* kt, double* kw, double* out) noexcept nogil:
+    """A step of a rocking lane moving toward zero in which ``theta`` reaches zero once (a plain
+    impact: no Zeno rest after it, no second event before the interval's end), as
+    :func:`run_core` takes it: the step's Taylor polynomial, the impact located on it
+    (:func:`_impact_state`), the peak before it, the restitution, and one step over the rest of
+    the interval from ``theta = 0`` on the other side; else False (the engine takes the
+    interval).  ``out``: theta, omega, sin, cos at the end of the interval and ``max_abs``
     raised to the peaks."""
     cdef double u0 = a * uval[j], u1 = a * (uval[j + 1] - uval[j]), p2 = p * p
-    cdef double sn, cs, th2, wh2, s1, c1, om2, c0, c1h, c2, c3, lo, hi, x, th_x, om_x, h2
-    cdef double hh = tb - ta, peak = max_abs, t_imp
-    cdef bint interior, quiet
+    cdef double sn, cs, th2, wh2, s1, c1, om2, c0, c1h, c2, c3, lo, hi, x, th_x, om_x, hh, h2
+    cdef double t_imp, peak = max_abs
+    cdef bint interior
     cdef int flag
-    cdef long n = ORDERS_START
+    cdef long n = order
     cdef Forcing F
     cdef Dyn D
-    F.kind, F.amp, F.tp, F.t0, F.uval = NODAL, a, 1.0, 0.0, uval
-    F.vval, F.vamp = NULL, 0.0
-    D.p, D.sa, D.ca, D.linear, D.method = p, sa, ca, False, TAYLOR
     sn, cs = corner_sincos(theta, side, sa, ca)
-    th2, wh2, s1, c1, flag = taylor_fixed(n, u0, u1, p2 * h * h, theta, omega * h, sn, cs,
+    th2, wh2, s1, c1, flag = taylor_fixed(n, u0, u1, (p * h) * (p * h), theta, omega * h, sn, cs,
                                           TAYLOR_EPS, cf)
-    quiet = (omega * h) * wh2 > 0.0 and side * th2 > 0.0 and fabs(th2) < HALF_PI
-    omega = (omega * h) * (1.0 / h)  # as the tight loop hands it over
-    om2 = wh2 * (1.0 / h)
-    if flag == 0:  # the unrolled steps, from the same order up
-        u0, u1 = linear_forcing(&F, j, ta, tb, ta, hh)
-        while True:
-            th2, wh2, s1, c1, flag = taylor_fixed(n, u0, u1, p2 * hh * hh, theta, omega * hh, sn,
-                                                  cs, TAYLOR_EPS, cf)
-            if flag != 0 or n >= ORDERS_LAST:
-                break
-            n += 2
-        if flag == 0:
-            return False
-        om2 = wh2 / hh
-        quiet = omega * om2 > 0.0 and side * th2 > 0.0 and fabs(th2) < HALF_PI
-    if quiet or fabs(th2) >= HALF_PI:
-        return False  # nothing happens after all, or it may overturn: the engine
+    if flag == 0 or fabs(th2) >= HALF_PI:
+        return False
+    hh = tb - ta  # the step's length as run_core takes it after its tight loop
+    om2 = wh2 / h
     c0, c1h, c2, c3 = _hermite(theta, omega, th2, om2, hh)
     lo, hi, interior = _first_crossing(c0, c1h, c2, c3, side, 0.0)
     if lo < 0.0 or (interior and side * taylor_eval(cf, n, hi, hh)[0] > 0.0):
         return False
+    F.kind, F.amp, F.tp, F.t0, F.uval = NODAL, a, 1.0, 0.0, uval
+    F.vval, F.vamp = NULL, 0.0
+    D.p, D.sa, D.ca, D.linear, D.method = p, sa, ca, False, TAYLOR
     x, th_x, om_x = _impact_state(&F, j, ta, tb, ta, hh, theta, omega, side, &D, kt, kw, cf, n,
                                   c0, c1h, c2, c3, lo, hi)
     t_imp = ta + x * hh
@@ -1501,6 +1486,7 @@ cdef bint _impact(double a, const double* uval, long j, double ta, double tb, do
         peak = _step_peak(&F, j, ta, tb, ta, t_imp - ta, theta, omega, th_x, om_x, side, &D, kt,
                           kw, hh, cf, n, max_abs)
     omega = eta * om_x
+    # the rest of the interval, from theta = 0 on the other side (at the order that suffices)
     side = -side
     h2 = tb - t_imp
     u0, u1 = linear_forcing(&F, j, ta, tb, t_imp, h2)
@@ -1515,7 +1501,8 @@ cdef bint _impact(double a, const double* uval, long j, double ta, double tb, do
         return False  # another event before the interval's end
     out[0] = th2
     out[1] = om2
-    out[2], out[3] = corner_sincos(th2, side, sa, ca)
+    out[2] = s1
+    out[3] = c1
     out[4] = max(peak, fabs(th2))
     return True
 
@@ -1610,7 +1597,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                             continue
                     elif L.f[R_OM][i] * L.f[R_SIDE][i] < 0.0:
                         # moving toward zero: a plain impact, in the lane
-                        if _impact(L.f[R_A][i], uval, j, ta, tb, h, L.f[R_TH][i],
+                        if _impact(order, L.f[R_A][i], uval, j, ta, tb, h, L.f[R_TH][i],
                                    L.f[R_OM][i], L.f[R_SIDE][i], L.f[R_SA][i], L.f[R_CA][i],
                                    L.f[R_P][i], L.f[R_ETA][i],
                                    zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i], L.f[R_MX][i], cf,
