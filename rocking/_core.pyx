@@ -563,36 +563,6 @@ cdef (double, double, int, double, double) _advance(
     return th, om, 0, 0.0, 0.0
 
 
-cdef (double, double, double) _impact_state(
-        const Forcing* F, long j, double ta, double tb, double t, double h, double theta,
-        double omega, double s, const Dyn* D, double* kt, double* kw, const double* cf, int nt,
-        double c0, double c1, double c2, double c3, double lo, double hi) noexcept nogil:
-    """Where ``theta`` reaches 0 inside the step of length ``h`` from ``(t, theta, omega)``, given
-    the bracket ``[lo, hi]`` of its cubic Hermite interpolant ``c0 .. c3``
-    (:func:`_first_crossing`): ``(x, theta, omega)`` there (``t + x h``).  The root of the cubic
-    (cheap; one root in the bracket, where it is monotonic), then Newton on the step's polynomial
-    or the re-integrated solution (:func:`_sub`): its first iteration corrects the interpolation
-    error, the second confirms convergence to rounding."""
-    cdef double x, xn, th_x = 0.0, om_x = 0.0
-    cdef bint converged = False
-    cdef int it
-    x = _cubic_root(c0, c1, c2, c3, s, lo, hi)
-    for it in range(8):
-        th_x, om_x = _sub(F, j, ta, tb, t, h, x, theta, omega, s, D, kt, kw, cf, nt)
-        if om_x == 0.0:
-            break
-        xn = x - th_x / (om_x * h)
-        if xn <= 0.0 or xn > 1.0:
-            break
-        converged = fabs(xn - x) < 4e-16
-        x = xn
-        if converged:
-            break  # (th_x, om_x) is the state 4e-16 h before x: kept as is
-    if not converged:
-        th_x, om_x = _sub(F, j, ta, tb, t, h, x, theta, omega, s, D, kt, kw, cf, nt)
-    return x, th_x, om_x
-
-
 cdef inline bint _below(const double* cf, int n, double level) noexcept nogil:
     """Whether ``|theta| < level`` all over the step, by the bound ``sum |cf_k|`` of its
     polynomial on ``[0, 1]`` (with a 1 % margin, so that a peak computed by :func:`_step_peak`
@@ -1027,16 +997,16 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
     cdef double* C = work + 2 * N_STAGES + 3 * M
     cdef double* cf = work + 2 * N_STAGES + 4 * M
     cdef double tan_a = tan(alpha), p2 = p * p, sa, ca
-    cdef bint sc_known = False, pending = False, fixed, unrolled, uplifted, interior
+    cdef bint sc_known = False, pending = False, fixed, unrolled, uplifted, converged, interior
     cdef double s_phi = 0.0, c_phi = 1.0, th2 = 0.0, om2 = 0.0, s_next = 0.0, c_next = 1.0
     cdef long nt = 0, n_pending = 0, order, n_low = 0, lowest, highest, low_run, n_general
     cdef double theta, omega, s, max_abs, rest_until, omega_zeno, t, ta, tb, hsub, t2, h
-    cdef long n_imp = 0, j, n_int, n_hist = 0, events, k
+    cdef long n_imp = 0, j, n_int, n_hist = 0, events, k, it
     cdef int status
     cdef Dyn D
     cdef Cruise cr
     cdef double stepped[5]
-    cdef double c0, c1, c2, c3, lo, hi, th_e, x, th_x, om_x, t_imp, t_lift, g_a, g_b
+    cdef double c0, c1, c2, c3, lo, hi, th_e, x, th_x, om_x, xn, t_imp, t_lift, g_a, g_b
     cdef Outcome out
     cdef int n_adv
     # forcing linear over each step: unrolled Taylor steps of a fixed order, adapted as we go
@@ -1208,8 +1178,27 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
                     if s * th_e > 0.0:
                         lo = -1.0
                 if lo >= 0.0 and events < MAX_EVENTS_PER_STEP:
-                    x, th_x, om_x = _impact_state(F, j, ta, tb, t, h, theta, omega, s, &D, kt,
-                                                  kw, cf, nt, c0, c1, c2, c3, lo, hi)
+                    # the root of the cubic (cheap; one root in [lo, hi], where it is monotonic),
+                    # then Newton on the step's polynomial or the re-integrated solution: its
+                    # first iteration corrects the interpolation error, the second confirms
+                    # convergence to rounding
+                    x = _cubic_root(c0, c1, c2, c3, s, lo, hi)
+                    converged = False
+                    for it in range(8):
+                        th_x, om_x = _sub(F, j, ta, tb, t, h, x, theta, omega, s, &D, kt, kw, cf,
+                                          nt)
+                        if om_x == 0.0:
+                            break
+                        xn = x - th_x / (om_x * h)
+                        if xn <= 0.0 or xn > 1.0:
+                            break
+                        converged = fabs(xn - x) < 4e-16
+                        x = xn
+                        if converged:
+                            break  # (th_x, om_x) is the state 4e-16 h before x: kept as is
+                    if not converged:
+                        th_x, om_x = _sub(F, j, ta, tb, t, h, x, theta, omega, s, &D, kt, kw, cf,
+                                          nt)
                     t_imp = t + x * h
                     if t_imp <= t:
                         t_imp = t + 4.5e-16 * max(fabs(t), 1.0)  # at least one ulp of t
@@ -1444,69 +1433,6 @@ cdef bint _turn(long order, double a, const double* uval, long j, double ta, dou
     return True
 
 
-cdef bint _impact(long order, double a, const double* uval, long j, double ta, double tb,
-                  double h, double theta, double omega, double side, double sa, double ca,
-                  double p, double eta, double omega_zeno, double max_abs, double* cf,
-                  double* kt, double* kw, double* out) noexcept nogil:
-    """A step of a rocking lane moving toward zero in which ``theta`` reaches zero once (a plain
-    impact: no Zeno rest after it, no second event before the interval's end), as
-    :func:`run_core` takes it: the step's Taylor polynomial, the impact located on it
-    (:func:`_impact_state`), the peak before it, the restitution, and one step over the rest of
-    the interval from ``theta = 0`` on the other side; else False (the engine takes the
-    interval).  ``out``: theta, omega, sin, cos at the end of the interval and ``max_abs``
-    raised to the peaks."""
-    cdef double u0 = a * uval[j], u1 = a * (uval[j + 1] - uval[j]), p2 = p * p
-    cdef double sn, cs, th2, wh2, s1, c1, om2, c0, c1h, c2, c3, lo, hi, x, th_x, om_x, hh, h2
-    cdef double t_imp, peak = max_abs
-    cdef bint interior
-    cdef int flag
-    cdef long n = order
-    cdef Forcing F
-    cdef Dyn D
-    sn, cs = corner_sincos(theta, side, sa, ca)
-    th2, wh2, s1, c1, flag = taylor_fixed(n, u0, u1, (p * h) * (p * h), theta, omega * h, sn, cs,
-                                          TAYLOR_EPS, cf)
-    if flag == 0 or fabs(th2) >= HALF_PI:
-        return False
-    hh = tb - ta  # the step's length as run_core takes it after its tight loop
-    om2 = wh2 / h
-    c0, c1h, c2, c3 = _hermite(theta, omega, th2, om2, hh)
-    lo, hi, interior = _first_crossing(c0, c1h, c2, c3, side, 0.0)
-    if lo < 0.0 or (interior and side * taylor_eval(cf, n, hi, hh)[0] > 0.0):
-        return False
-    F.kind, F.amp, F.tp, F.t0, F.uval = NODAL, a, 1.0, 0.0, uval
-    F.vval, F.vamp = NULL, 0.0
-    D.p, D.sa, D.ca, D.linear, D.method = p, sa, ca, False, TAYLOR
-    x, th_x, om_x = _impact_state(&F, j, ta, tb, ta, hh, theta, omega, side, &D, kt, kw, cf, n,
-                                  c0, c1h, c2, c3, lo, hi)
-    t_imp = ta + x * hh
-    if t_imp <= ta or t_imp >= tb or fabs(eta * om_x) <= omega_zeno:
-        return False  # at the step's ends, or a Zeno sequence: the engine's own rules
-    if not _below(cf, n, max_abs):
-        peak = _step_peak(&F, j, ta, tb, ta, t_imp - ta, theta, omega, th_x, om_x, side, &D, kt,
-                          kw, hh, cf, n, max_abs)
-    omega = eta * om_x
-    # the rest of the interval, from theta = 0 on the other side (at the order that suffices)
-    side = -side
-    h2 = tb - t_imp
-    u0, u1 = linear_forcing(&F, j, ta, tb, t_imp, h2)
-    while True:
-        th2, wh2, s1, c1, flag = taylor_fixed(n, u0, u1, p2 * h2 * h2, 0.0, omega * h2,
-                                              side * sa, ca, TAYLOR_EPS, cf)
-        if flag != 0 or n >= ORDERS_LAST:
-            break
-        n += 2
-    om2 = wh2 / h2
-    if flag == 0 or not (omega * om2 > 0.0 and side * th2 > 0.0 and fabs(th2) < HALF_PI):
-        return False  # another event before the interval's end
-    out[0] = th2
-    out[1] = om2
-    out[2] = s1
-    out[3] = c1
-    out[4] = max(peak, fabs(th2))
-    return True
-
-
 cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double t_start,
                  double h, long n_int, const double* p, const double* alpha, const double* eta,
                  double zeno_tol, unsigned char* overturned, double* max_abs,
@@ -1514,9 +1440,8 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
     """Runs ``i0 .. i1-1`` (at most :data:`LANES`) from rest over the whole record; results
     (after the energy rule at the end of the record) written at their indices.
 
-    ``stats`` (6 integers) counts steps kept in lanes, turning points taken in lanes, intervals
-    handed to the engine for rocking lanes and for lanes at rest, impacts taken in lanes, and
-    the intervals of rocking lanes handed to the engine because the chunk's order was too low.
+    ``stats`` (4 integers) counts steps kept in lanes, turning points taken in lanes, and
+    intervals handed to the engine for rocking lanes and for lanes at rest.
     """
     cdef Chunk L
     cdef long n = i1 - i0, i, k, j, n_bad, n_two, w, b, st, st2
@@ -1595,22 +1520,6 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                                 L.f[R_MX][i] = turned[4]
                             stats[1] += 1
                             continue
-                    elif L.f[R_OM][i] * L.f[R_SIDE][i] < 0.0:
-                        # moving toward zero: a plain impact, in the lane
-                        if _impact(order, L.f[R_A][i], uval, j, ta, tb, h, L.f[R_TH][i],
-                                   L.f[R_OM][i], L.f[R_SIDE][i], L.f[R_SA][i], L.f[R_CA][i],
-                                   L.f[R_P][i], L.f[R_ETA][i],
-                                   zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i], L.f[R_MX][i], cf,
-                                   kt, kw, turned):
-                            L.f[R_TH][i] = turned[0]
-                            L.f[R_OM][i] = turned[1]
-                            L.f[R_SPHI][i] = turned[2]
-                            L.f[R_CPHI][i] = turned[3]
-                            L.f[R_MX][i] = turned[4]
-                            L.f[R_SIDE][i] = -L.f[R_SIDE][i]
-                            L.i[I_NIMP][i] += 1
-                            stats[4] += 1
-                            continue
                 else:  # at rest: the engine only where the block may uplift in this interval
                     if L.i[I_WAKE][i] > j:
                         next_wake = min(next_wake, L.i[I_WAKE][i])
@@ -1625,8 +1534,6 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                         continue
                 # something happens in this interval: the engine takes this lane through it
                 stats[2 if st == ROCKING else 3] += 1
-                if st == ROCKING and L.bad[i] == 2:
-                    stats[5] += 1
                 F.amp = L.f[R_A][i]
                 o = run_core(&F, t_start, h, 1, NULL, True, L.f[R_P][i], L.f[R_ALPHA][i],
                              L.f[R_ETA][i], False, TAYLOR, zeno_tol, False, False, j,
@@ -1751,7 +1658,7 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
     cdef bint uniform = nodes.shape[0] == 0
     if not (0 <= i0 <= i1 <= p.shape[0] and p.shape[0] <= min(amp.shape[0], alpha.shape[0],
             eta.shape[0], n_sub.shape[0], overturned.shape[0], max_abs.shape[0],
-            n_impacts.shape[0], uplifted.shape[0]) and stats.shape[0] >= 6):
+            n_impacts.shape[0], uplifted.shape[0]) and stats.shape[0] >= 4):
         raise ValueError("batch arrays of unequal lengths")
     if lanes and i1 - i0 > LANES:
         raise ValueError(f"at most {LANES} runs are stepped together")

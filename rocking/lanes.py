@@ -81,10 +81,8 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
 
     ``threads``: how many threads share the batch (default :func:`get_threads` for batches of at
     least :data:`PARALLEL_MIN_RUNS` runs, else 1; 1 runs it on the calling thread).  ``stats``
-    (6 integers, lanes only) is incremented by the steps kept in lanes, the turning points taken
-    in lanes, the intervals handed to the engine for rocking lanes and for lanes at rest, the
-    impacts taken in lanes, and the intervals of rocking lanes handed to the engine because the
-    lanes' order was too low (counted in the third too).
+    (4 integers, lanes only) is incremented by the steps kept in lanes, the turning points taken
+    in lanes, and the intervals handed to the engine for rocking lanes and for lanes at rest.
 
     ``vval``: node values of the vertical ground motion, scaled as the record (``1 + amp * vval`` =
     ``1 + av/g``; one by one only, docs/theory.md section 10); then a fifth array is returned, the
@@ -104,7 +102,7 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
     else:
         size = n if threads == 1 else TASK_RUNS
     starts = range(0, n, max(size, 1))
-    counts = np.zeros((len(starts), 6), dtype=np.int64)
+    counts = np.zeros((len(starts), 4), dtype=np.int64)
     f64 = as_input
     # the flags as bytes (the same memory as the boolean results)
     results = (out[0].view(np.uint8), out[1], out[2], out[3].view(np.uint8))
