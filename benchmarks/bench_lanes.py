@@ -19,6 +19,12 @@ over.  Each build runs in its own process, alternately, ``--rounds`` times (the 
 shared); the best of the rounds' medians is printed, and a digest of every answer (verdicts,
 peaks, impact counts) says whether the builds agree bit for bit.  (Impacts in lanes: builds that
 count them, six counts; the package counts four, the rest printed 0.)
+
+``--early-stop``: instead, what a compiled early stop of a performance level (a run stopped once
+``max|theta|/alpha > R``) would skip in ``required_width(7.5, record, rule="exact", limit=R)``, R
+= 0.3 and 0.6: the runs the design makes (the blocks ``rocking.widths`` hands to its batch
+runner), each run again alone with its history; the work after ``R alpha`` is first passed (rocking samples,
+and 15 per impact: an impact costs about 15-30 steps, benchmarks/lanes.md) over the design's.
 """
 from __future__ import annotations
 
@@ -88,14 +94,58 @@ def child(python: str, base: str | None, records: list[str]) -> dict:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+def early_stop_share(records, limits=(0.3, 0.6)) -> None:
+    """Print the share of a level design's work after its runs first pass the level."""
+    import numpy as np
+
+    import pulses
+    import rocking
+    from rocking import widths
+
+    batch, seen = widths._batch, []
+
+    def spy(blocks, *args, **kwargs):
+        seen.extend(blocks)
+        return batch(blocks, *args, **kwargs)
+
+    widths._batch = spy
+    try:
+        for path in records:
+            rec = pulses.read_record(path)
+            for limit in limits:
+                seen.clear()
+                rocking.required_width(7.5, rec, rule="exact", limit=limit)
+                total = after = 0.0
+                n_over = 0
+                for block in seen:
+                    r = rocking.simulate(block, rec)
+                    th = np.abs(r.theta)
+                    impacts = np.asarray(r.impacts)
+                    total += np.count_nonzero(th) + 15 * impacts.size
+                    over = th > limit * block.alpha
+                    if over.any():
+                        k = int(np.argmax(over))
+                        n_over += 1
+                        after += np.count_nonzero(th[k:]) + 15 * np.count_nonzero(impacts > r.t[k])
+                print(f"{pathlib.Path(path).stem}, limit {limit}: {len(seen)} runs, {n_over} pass "
+                      f"the level; work after it is first passed: {after / total:.3f} of the design's")
+    finally:
+        widths._batch = batch
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", action="append", default=[], metavar="NAME=PATH",
                     help="another checkout of the package, built in place (repeatable)")
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--records", nargs="*", default=list(DEFAULT))
+    ap.add_argument("--early-stop", action="store_true",
+                    help="the share of a level design's work an early stop would skip")
     args = ap.parse_args(argv)
     records = [str(RECORDS / r) for r in args.records]
+    if args.early_stop:
+        early_stop_share(records)
+        return 0
     builds = dict(b.split("=", 1) for b in args.build)
     builds["this"] = None
     best: dict = {}
