@@ -46,11 +46,6 @@ def _pool(tasks, jobs, more=None):
         if plots:
             preload.append("pipeline.reports.plots")  # matplotlib: ~0.2 s a worker otherwise
         ctx.set_forkserver_preload(preload)
-    if plots:
-        # the summary plot needs matplotlib here too: import it while the workers start
-        import threading
-
-        threading.Thread(target=_import_plots, daemon=True).start()
     others = _child_processes()
     # the largest files first (longer records take longer), so that no long record is left alone at
     # the end while the other workers idle; results are placed by index, so the reports do not
@@ -269,8 +264,35 @@ def execute(tasks, jobs: int | None = 1, dask: str | None = None, more=None):
     return _pool(tasks, jobs if more is not None else min(jobs, len(tasks)), more)
 
 
-def _import_plots():
+@contextlib.contextmanager
+def renderer(away: bool):
+    """``render(fn, *args)``: ``fn(*args)`` (a figure's PNG bytes) in a worker process where
+    ``away`` (the run's records ran elsewhere: the run's own figures, matplotlib included, are no
+    work for this process either), else here.  The worker is started at the first figure."""
+    if not away:
+        yield lambda fn, *args: fn(*args)
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    pool = None
+
+    def render(fn, *args):
+        nonlocal pool
+        if pool is None:
+            methods = multiprocessing.get_all_start_methods()
+            ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+            pool = ProcessPoolExecutor(1, mp_context=ctx, initializer=_init_pool_worker,
+                                       initargs=(None,))
+        fut = pool.submit(fn, *args)
+        while True:  # a short wait, so that Ctrl-C stops the run
+            try:
+                return fut.result(timeout=0.25)
+            except TimeoutError:
+                interrupts.check()
+
     try:
-        import pipeline.reports.plots  # noqa: F401
-    except Exception:  # pragma: no cover - reported when the summary plot is drawn
-        pass
+        yield render
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)

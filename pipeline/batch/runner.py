@@ -20,6 +20,7 @@ from .. import interrupts
 from . import joblog, outlock, passes, resume, site
 from ..args import ArgumentError, output_folder
 from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
+from . import executors
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV, TEXT  # noqa: F401 (tests set TEST_KILL_ENV through the runner)
 from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
@@ -228,7 +229,8 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
                 outputs.remove(rel)
         except report.NotOurs as exc:
             say(f"pipeline run: note: {exc}")
-    design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options)
+    with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
+        design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options, render)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
     n_reused = len(tasks) - len(computed)
@@ -367,7 +369,7 @@ def _progress_bar(n_todo: int, quiet: bool, progress: bool | None):
                 ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
 
 
-def _write_tables(outputs, out, tasks, header, text, failures, failed, options):
+def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None):
     """Write the run's own files from every record's rows (``text``: summary.csv's rows as the records'
     reports hold them, below ``header``); return the design rows and the rows of summary.csv."""
     outputs.write(report.SUMMARY, header + text)
@@ -376,14 +378,18 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options):
                   + site.columns_markdown() + design_table.columns_markdown())
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
-    site.write_outputs(outputs, rows, FIELDS, options, failed)
+    site.write_outputs(outputs, rows, FIELDS, options, failed, render)
     if options.plots:
         from ..reports.plots import summary_figure_png
 
-        outputs.write(report.SUMMARY_PLOT, summary_figure_png(rows))
+        outputs.write(report.SUMMARY_PLOT, (render or _here)(summary_figure_png, rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
     outputs.finish()
     return design, rows
+
+
+def _here(fn, *args):
+    return fn(*args)
 
 
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------

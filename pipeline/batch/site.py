@@ -385,10 +385,13 @@ def fragility_tables(rows):
 # -- files -----------------------------------------------------------------------------------------------
 
 
-def write_outputs(outputs, rows, fields, options, failed=None) -> None:
+def write_outputs(outputs, rows, fields, options, failed=None, render=None) -> None:
     """Write ``pairs.csv``, ``suite.csv`` (and their plots) and, with ``--fragility``, the fragility
-    files, from every row of the run (``failed``: ``{pair: directions that failed}``)."""
+    files, from every row of the run (``failed``: ``{pair: directions that failed}``); ``render(fn,
+    *args)`` draws a figure (default: here; pipeline.batch.executors.renderer)."""
     from ..reports import report
+
+    render = render or (lambda fn, *args: fn(*args))
 
     pair_fields = list(PAIR_COLUMNS.names) + list(fields)
     outputs.write(PAIRS_CSV, report.csv_text(pair_fields, governing_rows(rows, failed)))
@@ -397,7 +400,7 @@ def write_outputs(outputs, rows, fields, options, failed=None) -> None:
     if options.plots and rows:
         from ..reports.plot_site import suite_figure_png
 
-        outputs.write(SUITE_PLOT, suite_figure_png(rows, suite))
+        outputs.write(SUITE_PLOT, render(suite_figure_png, rows, suite))
     if options.fragility:
         summary, curve, fits = fragility_tables(rows)
         outputs.write(FRAGILITY_CSV, report.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
@@ -405,7 +408,7 @@ def write_outputs(outputs, rows, fields, options, failed=None) -> None:
         if options.plots and fits:
             from ..reports.plot_site import fragility_figure_png
 
-            outputs.write(FRAGILITY_PLOT, fragility_figure_png(fits))
+            outputs.write(FRAGILITY_PLOT, render(fragility_figure_png, fits))
 
 
 def columns_markdown() -> str:
