@@ -68,6 +68,18 @@ def test_a_kept_search_is_never_another_records(kept):
 
 def test_the_memo_hands_out_copies_of_what_it_computed():
     memo.on()
+    try:
+        _copies()
+    finally:
+        memo.off()
+    # off: computed every time
+    calls = []
+    for _ in range(2):
+        memo.remembered("fit", "k", lambda: calls.append(1))
+    assert len(calls) == 2
+
+
+def _copies():
     calls = []
     key = ("test", np.random.default_rng(5).random())
 
@@ -113,3 +125,12 @@ def test_pairs_read_and_classified_in_workers_give_the_same_tasks(tmp_path):
     assert len(here) > 10 and sum(t[4] == "pulse" for t in here) == 2
     assert all(dict(t[6]).get("pulse_like") is not None for t in here if t[5].startswith("STA"))
     assert sum(1 for t in here if t[5].startswith("missing")) == 1
+
+
+def test_a_run_in_this_process_keeps_nothing_after_it(tmp_path):
+    pair = _pair(tmp_path, "STS", 0.45, 0.3, 1)
+    code = cli_main(["run", "--pair", *map(str, pair), "--block", "2.0x0.35", "--directions", "2",
+                     "--out", str(tmp_path / "out"), "--quiet", "--no-plots"])
+    assert code == 0
+    # a later rocking.required_width in this process computes (a test may have changed the solver)
+    assert searches._size == 0 and not searches._kept and not memo._kept

@@ -11,16 +11,22 @@ import os
 
 from .. import interrupts
 from ..args import ArgumentError
+from . import memo
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, worker_failure
 
 
 def _serial(tasks, more=None):
-    """Records one after the other in this process (then those ``more()`` gives, see :func:`execute`)."""
-    while tasks:
-        for task in tasks:
-            interrupts.check()
-            yield work(task)
-        tasks = more() if more is not None else []
+    """Records one after the other in this process (then those ``more()`` gives, see :func:`execute`),
+    keeping what a later pass reuses (:mod:`pipeline.batch.memo`) while they run."""
+    memo.on()
+    try:
+        while tasks:
+            for task in tasks:
+                interrupts.check()
+                yield work(task)
+            tasks = more() if more is not None else []
+    finally:
+        memo.off()
 
 
 def _size(task) -> int:

@@ -30,6 +30,14 @@ def on() -> None:
     _kept.setdefault("slenderness", collections.OrderedDict())
 
 
+def off() -> None:
+    """Keep nothing from now on; what was kept is dropped."""
+    from rocking import searches
+
+    searches.keep(0)
+    _kept.clear()
+
+
 def samples_key(record) -> tuple:
     """A record's samples, time axis and name, as a key."""
     digest = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes()).hexdigest()

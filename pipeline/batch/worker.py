@@ -51,7 +51,8 @@ def work(task: Task) -> dict:
         os.kill(os.getpid(), signal.SIGKILL)
     import time
 
-    memo.on()  # a pair's direction computed again in a later pass reuses its search and fit
+    if _in_worker:  # a pair's direction computed again in a later pass reuses its search and fit
+        memo.on()  # (in this process: while the batch runs, pipeline.batch.executors._serial)
     start, cpu = time.perf_counter(), time.process_time()
     res = process_record(task)
     res[joblog.SECONDS] = time.perf_counter() - start
