@@ -128,7 +128,9 @@ def measure(baseline, n_pairs, jobs, share_jobs, dask) -> list[dict]:
             n = len(runs["baseline"]["rows"])
             entry = {"pair": pathlib.Path(pair[0]).stem, "directions": n}
             for name, r in runs.items():
-                entry[name] = {"cpu_per_direction": r["cpu"] / n, "main_share": r["main"] / r["cpu"],
+                # without --log (the baseline) the main process's own share is not known
+                entry[name] = {"cpu_per_direction": r["cpu"] / n,
+                               "main_share": None if r.get("tasks") is None else r["main"] / r["cpu"],
                                "png_mb": r["png_bytes"] / 1e6, "design_width": design_width(r["rows"]),
                                "exit": r["code"], "tasks": r.get("tasks"),
                                "stages_per_direction": {k: round(v / n, 4) for k, v in sorted(r["stages"].items())},
@@ -147,7 +149,8 @@ def summary(entries) -> dict:
     import numpy as np
 
     def mean(name, what):
-        return float(np.mean([e[name][what] for e in entries]))
+        values = [e[name][what] for e in entries if e[name][what] is not None]
+        return float(np.mean(values)) if values else None
 
     names = [k for k in entries[0] if isinstance(entries[0][k], dict)]
     res = {name: {"cpu_per_direction": mean(name, "cpu_per_direction"), "png_mb_per_pair": mean(name, "png_mb"),
