@@ -3,6 +3,8 @@
     python benchmarks/bench_design_width.py                 # ~15 min on 2 busy cores; needs ../shared
     python benchmarks/bench_design_width.py --heights 7.5   # one column height
     python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
+    python benchmarks/bench_design_width.py --seeds 1,2,3 --no-level --cache /tmp/dense --misses
+        # the check's seed set to each; overturning only; dense grids kept; where the misses lie
 
 For every real record of ../shared/records (``raw/`` and its sub-folders, and the horizontal
 components of ``peer_download/`` that are not in ``raw/``: the check was sized on ``raw/`` at
@@ -60,7 +62,43 @@ def _verdicts(height, record, widths):
     return np.asarray(res.overturned, dtype=bool)
 
 
-def measure(paths, heights, settings=None):
+def samples_key(record) -> str:
+    """The record's samples and time step, hashed: two files of the same component (RSN77_2 and
+    the PEER download's RSN77_SFERN_PUL254) count once."""
+    import hashlib
+
+    h = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes())
+    h.update(repr(float(record.dt)).encode())
+    return h.hexdigest()[:16]
+
+
+def dense_failures(height, record, w, top, cache=None):
+    """The failing widths (m) of the dense grid of ``DENSE`` linear widths in ``(w, min(SPAN w,
+    top)]``; ``cache``: a folder where they are kept by record, height and ``w`` (the grid depends
+    on nothing else), so that runs with other check settings or seeds reuse it."""
+    x = np.linspace(w, min(SPAN * w, top), DENSE + 1)[1:]
+    path = None
+    if cache is not None:
+        path = pathlib.Path(cache) / f"{samples_key(record)}_{height:g}_{w:.17g}_{DENSE}_{SPAN:g}.npy"
+        if path.is_file():
+            return np.load(path)
+    fx = x[_verdicts(height, record, x)]
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        np.save(path, fx)
+    return fx
+
+
+def sliver_width(height, record, b, step):
+    """How thin the failing sliver at ``b`` is: the failing stretch around ``b``, found by
+    widening steps of ``step`` m (relative width of the failing run of a 21-point grid)."""
+    x = b + step * np.arange(-10, 11) / 10.0
+    f = _verdicts(height, record, x)
+    run = np.nonzero(f)[0]
+    return (x[run].max() - x[run].min() + step / 10.0) / b if run.size else 0.0
+
+
+def measure(paths, heights, settings=None, cache=None, level=True, misses=False):
     import pulses
     import rocking
     from pulses import G
@@ -76,17 +114,23 @@ def measure(paths, heights, settings=None):
             over = rocking.required_width(H, record, rule="exact", settings=settings)
             t_over = time.perf_counter() - t
             t = time.perf_counter()
-            half = rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
+            half = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
+                    if level else over)
             t_half = time.perf_counter() - t
             w, W = over.search_width, over.width
             top = H * record.pga / G
-            x = np.linspace(w, min(SPAN * w, top), DENSE + 1)[1:]
-            f = _verdicts(H, record, x)
-            widest = float(x[f].max()) if f.any() else None
-            ratio = rocking.simulate(rocking.Block.from_dimensions(H, half.width), record,
-                                     history=False).max_rotation_ratio
-            fx = x[f]
-            row = dict(record=path.stem, height=H, w=w, W=W, widest_dense=widest,
+            fx = dense_failures(H, record, w, top, cache)
+            widest = float(fx.max()) if fx.size else None
+            ratio = (rocking.simulate(rocking.Block.from_dimensions(H, half.width), record,
+                                      history=False).max_rotation_ratio if level else 0.0)
+            if misses and widest and widest > 1.01 * W:
+                far = fx[fx > 1.01 * W]
+                step = (min(SPAN * w, top) - w) / DENSE
+                thin = [sliver_width(H, record, b, step) for b in far[:5]]
+                print(f"  MISS {path.stem} H {H:g}: W {W:.5f}; {far.size} dense failures above "
+                      f"1.01 W at W x " + " ".join(f"{b / W:.4f}" for b in far[:12])
+                      + "; sliver widths (rel.) " + " ".join(f"{t:.1e}" for t in thin), flush=True)
+            row = dict(record=path.stem, key=samples_key(record), height=H, w=w, W=W, widest_dense=widest,
                        far_old=bool(widest and widest > 1.01 * w),
                        far_new=bool(widest and widest > 1.01 * W),
                        # within the span the check covers: (w, 2 w] today, (W, 2 W] now
@@ -103,10 +147,19 @@ def measure(paths, heights, settings=None):
     return rows
 
 
+def _unique(rows, name):
+    """Cases counted once per record's samples and height (``name`` true on any copy)."""
+    seen = {}
+    for r in rows:
+        seen[(r["key"], r["height"])] = seen.get((r["key"], r["height"]), False) or bool(r[name])
+    return sum(seen.values()), len(seen)
+
+
 def table(rows):
     n = len(rows)
     old = sum(r["far_old"] for r in rows)
     new = sum(r["far_new"] for r in rows)
+    (old_u, n_u), (new_u, _) = _unique(rows, "far_old"), _unique(rows, "far_new")
     raised = sum(r["W"] > r["w"] for r in rows)
     bad_half = [r for r in rows if r["ratio_half"] > LEVEL]
     below = [r for r in rows if r["W_half"] < r["W"]]
@@ -118,6 +171,8 @@ def table(rows):
         f"{n} cases (records x heights); dense grid {DENSE} linear widths in (w, min({SPAN:g} w, top)].",
         f"- failing widths more than 1 % above the search's answer w (today's width): {old} cases; "
         f"more than 1 % above the design width W: {new} cases",
+        f"- counted once per record's samples ({n_u} cases): above 1.01 w {old_u}; above 1.01 W "
+        f"{new_u} (" + ", ".join(f"{r['record']} {r['height']:g} m" for r in rows if r["far_new"]) + ")",
         f"- within the check's span: failing widths in (1.01 w, 2 w]: "
         f"{sum(r['far_old_2'] for r in rows)} cases; in (1.01 W, 2 W]: "
         f"{sum(r['far_new_2'] for r in rows)} cases ("
@@ -125,7 +180,8 @@ def table(rows):
         f"- W above w on {raised} cases (median +{np.median(up[up > 0]) if raised else 0:.2f} %, "
         f"max +{up.max():.2f} %)",
         f"- limit {LEVEL}: max|theta|/alpha at W_R above {LEVEL} on {len(bad_half)} cases "
-        f"({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W on {len(below)}",
+        f"({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W on {len(below)}"
+        + "".join(f" ({r['record']} {r['height']:g} m: {r['W_half']:.5f} < {r['W']:.5f})" for r in below),
         f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
         f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
         f"limit {LEVEL} median {np.median(runs_h):.0f} (max {runs_h.max()})",
@@ -193,15 +249,25 @@ def main(argv=None):
     if "--sensitivity" in argv:
         print("\n".join(sensitivity(paths, heights)))
         return 0
-    settings = None
-    if "--settings" in argv:       # e.g. --settings check_rounds=3,check_runs=1500
-        from rocking.search import DEFAULT_SETTINGS
+    from rocking.search import DEFAULT_SETTINGS
 
+    settings = DEFAULT_SETTINGS
+    if "--settings" in argv:       # e.g. --settings check_rounds=3,check_runs=1500
         pairs = (kv.split("=") for kv in argv[argv.index("--settings") + 1].split(","))
         settings = DEFAULT_SETTINGS.replace(**{k: (int if getattr(DEFAULT_SETTINGS, k) is None
                                                    else type(getattr(DEFAULT_SETTINGS, k)))(v)
                                                for k, v in pairs})
-    print("\n".join(table(measure(paths, heights, settings))))
+    # --cache DIR: keep the dense grids there (they depend on the search's width only)
+    cache = argv[argv.index("--cache") + 1] if "--cache" in argv else None
+    # --seeds 1,2,3: the check's seed (SearchSettings.check_seed) set to each in turn
+    seeds = ([int(k) for k in argv[argv.index("--seeds") + 1].split(",")] if "--seeds" in argv
+             else [settings.check_seed])
+    for seed in seeds:
+        if len(seeds) > 1 or seed is not None:
+            print(f"check seed {seed}:")
+        rows = measure(paths, heights, settings.replace(check_seed=seed), cache=cache,
+                       level="--no-level" not in argv, misses="--misses" in argv)
+        print("\n".join(table(rows)), flush=True)
     return 0
 
 
