@@ -42,6 +42,14 @@ DENSE = 6000
 SPAN = 3.0
 LEVEL = 0.5
 SEEDS = (1, 2, 3, 4)
+
+
+def _baseline():
+    from rocking.search import SearchSettings
+
+    # 0.5.0's search (fine zone 0.05 % apart up to 20 % above), no check: its answer is the width
+    # the floors are measured against, and anchors the dense grid
+    return SearchSettings(record_fine=5e-4, record_fine_span=0.2, check_runs=0)
 ETA_FACTORS = (0.95, 0.975, 1.025, 1.05)
 
 
@@ -105,6 +113,8 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
     from rocking.search import DEFAULT_SETTINGS
 
     settings = settings or DEFAULT_SETTINGS
+    global BASELINE
+    BASELINE = _baseline()      # a global: measure() is the only user
 
     rows = []
     for path in paths:
@@ -117,7 +127,11 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
             half = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
                     if level else over)
             t_half = time.perf_counter() - t
-            w, W = over.search_width, over.width
+            # the reference: the search of 0.5.0 alone (its first transition, today's verified
+            # width), whatever the settings measured
+            base = rocking.required_width(H, record, rule="exact", settings=BASELINE)
+            w = base.search_width
+            W = over.width
             top = H * record.pga / G
             fx = dense_failures(H, record, w, top, cache)
             widest = float(fx.max()) if fx.size else None
@@ -136,7 +150,8 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
                        # within the span the check covers: (w, 2 w] today, (W, 2 W] now
                        far_old_2=bool(np.any((fx > 1.01 * w) & (fx <= 2.0 * w))),
                        far_new_2=bool(np.any((fx > 1.01 * W) & (fx <= 2.0 * W))),
-                       runs=over.total_runs, runs_today=over.runs + settings.check_runs,
+                       runs=over.total_runs, runs_today=base.runs + 1500,
+                       w_search=over.search_width,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
                        t_over=t_over, t_half=t_half)
             rows.append(row)
