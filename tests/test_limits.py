@@ -146,3 +146,23 @@ def test_pipeline_run_limit(tmp_path):
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
     assert widths["half"] >= widths["over"]
+
+
+def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
+    """fragility.csv: without a level the records that fail count as overturned; with --limit R
+    (critical scales where max|theta|/alpha first exceeds R) they go to n_failed_at_level and
+    n_overturned is blank (a level's critical scale does not say the column overturns)."""
+    from pipeline.batch.site import fragility_tables
+
+    def rows(limit):
+        # four records of one column, three with a critical scale (log-moments: a fit exists)
+        return [dict(column="7.5x0.8", pair=f"r{k}", column_kind="block", critical_scale=s,
+                     fragility_up_to=4.0, uplift_scale=0.3, pga_g=0.4, design_limit=limit)
+                for k, s in enumerate((1.2, 1.8, 2.5, None))]
+
+    (over,), _, _ = fragility_tables(rows(None))
+    (level,), _, _ = fragility_tables(rows(0.5))
+    assert over["n_overturned"] == 3 and over["n_failed_at_level"] is None
+    assert level["n_overturned"] is None and level["n_failed_at_level"] == 3
+    assert over["n_records"] == level["n_records"] == 4
+    assert over["median_scale"] is not None and not over["error"]
