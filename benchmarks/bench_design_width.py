@@ -124,8 +124,11 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
             over = rocking.required_width(H, record, rule="exact", settings=settings)
             t_over = time.perf_counter() - t
             t = time.perf_counter()
-            half = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
-                    if level else over)
+            # the level alone (pipeline run --limit), and given the overturning design
+            alone = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
+                     if level else over)
+            half = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings,
+                                           overturning=over) if level else over)
             t_half = time.perf_counter() - t
             # the reference: the search of 0.5.0 alone (its first transition, today's verified
             # width), whatever the settings measured
@@ -135,8 +138,9 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
             top = H * record.pga / G
             fx = dense_failures(H, record, w, top, cache)
             widest = float(fx.max()) if fx.size else None
-            ratio = (rocking.simulate(rocking.Block.from_dimensions(H, half.width), record,
-                                      history=False).max_rotation_ratio if level else 0.0)
+            ratio = max((rocking.simulate(rocking.Block.from_dimensions(H, h.width), record,
+                                          history=False).max_rotation_ratio if level else 0.0)
+                        for h in (alone, half))
             if misses and widest and widest > 1.01 * W:
                 far = fx[fx > 1.01 * W]
                 step = (min(SPAN * w, top) - w) / DENSE
@@ -153,6 +157,7 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
                        runs=over.total_runs, runs_today=base.runs + 1500,
                        w_search=over.search_width,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
+                       W_alone=alone.width, runs_alone=alone.total_runs,
                        t_over=t_over, t_half=t_half)
             rows.append(row)
             print(f"{path.stem:28s} H {H:4.1f}: w {w:.4f} W {W:.4f} (+{(W / w - 1) * 100:5.2f} %) "
@@ -178,6 +183,8 @@ def table(rows):
     raised = sum(r["W"] > r["w"] for r in rows)
     bad_half = [r for r in rows if r["ratio_half"] > LEVEL]
     below = [r for r in rows if r["W_half"] < r["W"]]
+    below_alone = [r for r in rows if r["W_alone"] < r["W"]]
+    runs_a = np.array([r["runs_alone"] for r in rows])
     runs = np.array([r["runs"] for r in rows])
     today = np.array([r["runs_today"] for r in rows])
     runs_h = np.array([r["runs_half"] for r in rows])
@@ -194,12 +201,15 @@ def table(rows):
         + ", ".join(f"{r['record']} {r['height']:g} m" for r in rows if r["far_new_2"]) + ")",
         f"- W above w on {raised} cases (median +{np.median(up[up > 0]) if raised else 0:.2f} %, "
         f"max +{up.max():.2f} %)",
-        f"- limit {LEVEL}: max|theta|/alpha at W_R above {LEVEL} on {len(bad_half)} cases "
-        f"({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W on {len(below)}"
-        + "".join(f" ({r['record']} {r['height']:g} m: {r['W_half']:.5f} < {r['W']:.5f})" for r in below),
+        f"- limit {LEVEL}: max|theta|/alpha above {LEVEL} at W_R (alone or given W) on "
+        f"{len(bad_half)} cases ({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W: "
+        f"alone on {len(below_alone)}"
+        + "".join(f" ({r['record']} {r['height']:g} m: {r['W_alone']:.5f} < {r['W']:.5f})" for r in below_alone)
+        + f", given the overturning design on {len(below)}",
+        f"- runs per level width alone: median {np.median(runs_a):.0f} (max {runs_a.max()})",
         f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
         f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
-        f"limit {LEVEL} median {np.median(runs_h):.0f} (max {runs_h.max()})",
+        f"limit {LEVEL} given W median {np.median(runs_h):.0f} (max {runs_h.max()})",
     ]
 
 

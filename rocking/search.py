@@ -105,7 +105,7 @@ class SearchSettings:
     record_rounds: int = 12
     record_chunk: int = 32
     check_runs: int = 1500
-    check_span: float = 2.0
+    check_span: float = 1.5
     check_near: float = 0.5
     check_first: float = 1e-4
     check_follow: float = 0.8

@@ -149,7 +149,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
                    shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
                    settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None, limit=None,
-                   horizontal=None):
+                   horizontal=None, overturning=None):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -171,6 +171,13 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         ``rule="exact"``: the performance level R in (0, 1]: the design keeps
         ``max|theta|/alpha <= R`` (a width fails where it exceeds R or the column overturns);
         None (default): overturning, the paper's question (docs/design.md, "Performance levels").
+    overturning : RequiredWidth, optional
+        With ``limit``: the overturning design of the same column and record (``limit=None``,
+        the same settings), already computed.  A width that overturns fails every level, so the
+        level's design width is made at least its width (one run there, and a bisection above it
+        where that width exceeds the level): ``width >= overturning.width`` by construction, at
+        no cost where the level's own design is already wider.  Under a record without a vertical
+        record only.
     shape, lam : str (optional), float
         ``rule="envelope"``: the shape whose factor to use (default every shape); Eq. 20's lambda.
     n_scan, n_zone, rtol : int, int, float, optional
@@ -207,11 +214,17 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
+    if overturning is not None and (rule != "exact" or limit is None or vertical is not None
+                                    or overturning.limit is not None
+                                    or getattr(excitation, "shape", "record") in SHAPES):
+        raise ValueError("overturning= goes with rule='exact' under a record, a limit and no "
+                         "vertical record: the overturning design (limit=None) of the same column "
+                         "and record")
     if rule == "exact":
         kw = dict(criterion=criterion, eta=eta, n_scan=n_scan, rtol=rtol, model=model,
                   n_zone=n_zone, settings=settings, gamma=gamma, limit=limit)
         if vertical is None:
-            return _exact_width(height, excitation, **kw)
+            return _exact_width(height, excitation, overturning=overturning, **kw)
         return governing(horizontal or _exact_width(height, excitation, **kw),
                          _exact_width(height, excitation, vertical=vertical, **kw))
     if vertical is not None:
@@ -281,7 +294,7 @@ def _uplift_ratio(record, vertical) -> float:
 
 
 def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None,
-                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None, limit=None):
+                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None, limit=None, overturning=None):
     _check_criterion(criterion)
     # wider than this the column never uplifts
     top = height * (_peak(excitation) / G if vertical is None else _uplift_ratio(excitation, vertical))
@@ -319,7 +332,9 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
             seed = settings.check_seed
             if seed is None:
                 seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
-            _check_rounds(res, top, evaluate_record, settings, seed, seen)
+            seen = _check_rounds(res, top, evaluate_record, settings, seed, seen)
+        if overturning is not None and overturning.width > res.width:
+            _at_least(res, overturning, evaluate_record, seen, settings)
         return res
     res = _pulse_width(height, top, lambda idx, widths: _failed(run_widths(widths), criterion, limit),
                        settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol))
@@ -484,6 +499,7 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
         left = max(left - (res.refine_runs - before), 0)     # a round's refinement: from the rest
     order = np.argsort(cx, kind="stable")
     res.check_widths, res.check_failed = cx[order], cf[order]
+    seen = (xs, fs, rs)
     res.check_runs = int(cx.size)
     res.check_top = float(min(settings.check_span * res.width, top))
     res.failing_share = float(cf.mean()) if cx.size else 0.0
@@ -494,6 +510,27 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
                                 + (f"; design width {res.width:.6g} m, just above the widest "
                                    f"failing width {res.widest_failing_width:.6g} m"
                                    if res.widest_failing_width else ""))
+    return seen
+
+
+def _at_least(res, overturning, evaluate, seen, settings) -> None:
+    """A level's design ``res`` made at least the overturning design ``overturning`` (whose
+    widest failing width overturned, so fails the level too): its width is run under the level;
+    if it survives it is the design width, else the bracket above it is bisected
+    (:func:`_raise_to_failures`, ``seen``: every width the level ran)."""
+    x = np.array([float(overturning.width)])
+    f, r = evaluate(x)
+    res.refine_runs += 1
+    known = overturning.widest_failing_width
+    if not bool(np.asarray(f)[0]):
+        res.width = float(x[0])
+        res.widest_failing_width = max(res.widest_failing_width or 0.0, known or 0.0) or None
+    else:
+        xs, fs = (np.concatenate([np.asarray(seen[0], dtype=float), x]),
+                  np.concatenate([np.asarray(seen[1], dtype=bool), np.asarray(f, dtype=bool)]))
+        _raise_to_failures(res, evaluate, (xs, fs), settings)
+    res.method += (f"; at least the overturning design width {overturning.width:.6g} m (a width "
+                   f"that overturns fails every level)")
 
 
 def _add_check(res, top, evaluate, settings, seed, seen=None):
