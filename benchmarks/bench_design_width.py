@@ -3,7 +3,7 @@
     python benchmarks/bench_design_width.py                 # ~15 min on 2 busy cores; needs ../shared
     python benchmarks/bench_design_width.py --heights 7.5   # one column height
     python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
-    python benchmarks/bench_design_width.py --seeds 1,2,3 --no-level --cache /tmp/dense --misses
+    python benchmarks/bench_design_width.py --seeds record,1,2 --no-level --cache /tmp/dense --misses
         # the check's seed set to each; overturning only; dense grids kept; where the misses lie
 
 For every real record of ../shared/records (``raw/`` and its sub-folders, and the horizontal
@@ -285,11 +285,12 @@ def main(argv=None):
     # --cache DIR: keep the dense grids there (they depend on the search's width only)
     cache = argv[argv.index("--cache") + 1] if "--cache" in argv else None
     # --seeds 1,2,3: the check's seed (SearchSettings.check_seed) set to each in turn
-    seeds = ([int(k) for k in argv[argv.index("--seeds") + 1].split(",")] if "--seeds" in argv
-             else [settings.check_seed])
+    # ("record": the package's own seed, made from the record and the column)
+    seeds = ([None if k == "record" else int(k) for k in argv[argv.index("--seeds") + 1].split(",")]
+             if "--seeds" in argv else [settings.check_seed])
     for seed in seeds:
         if len(seeds) > 1 or seed is not None:
-            print(f"check seed {seed}:")
+            print(f"check seed {'record' if seed is None else seed}:")
         rows = measure(paths, heights, settings.replace(check_seed=seed), cache=cache,
                        level="--no-level" not in argv, misses="--misses" in argv)
         print("\n".join(table(rows)), flush=True)
