@@ -42,7 +42,7 @@ def test_check_widths_layout():
     search's grid, the same for the same seed and different for another; the later stages put
     its widths where the widths run so far vary most from one to the next, or failed."""
     s = DEFAULT_SETTINGS
-    w, top = 1.0, 1.7                                  # the span ends at the no-uplift width
+    w, top = 1.0, 1.4          # the span ends at the no-uplift width (below check_span w = 1.5)
     x = check_widths(w, top, s, seed=5)
     n_follow = round(s.check_follow * s.check_runs)
     n1 = s.check_runs - n_follow
@@ -209,13 +209,13 @@ def test_check_uses_the_search_widths():
     from rocking.widths import _add_check
 
     s = DEFAULT_SETTINGS.replace(check_runs=500)
-    w, top = 1.0, 3.0                                 # the span is (1, 2]: bins of 0.01
+    w, top = 1.0, 3.0                                 # the span is (1, check_span]
 
     def flat(x):                                      # every width survives, ratio 0.5
         return np.zeros(np.size(x), dtype=bool), np.full(np.size(x), 0.5)
 
     k = s.check_bins
-    edges = np.linspace(w, 2.0 * w, k + 1)
+    edges = np.linspace(w, s.check_span * w, k + 1)
     j = int(0.4 * k)
     seen_x = np.concatenate([[0.5, 2.5], edges[j] + np.array([0.2, 0.4, 0.6, 0.8]) * (edges[1] - edges[0])])
     seen = (seen_x, np.zeros(seen_x.size, dtype=bool), np.array([0.9, 0.1, 0.2, 0.8, 0.3, 0.7]))
