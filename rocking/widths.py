@@ -546,6 +546,8 @@ def _add_check(res, top, evaluate, settings, seed, seen=None):
     above = np.asarray(seen[0], dtype=float) > res.width
     sx, sf, sr = (np.asarray(v)[above] for v in seen)
     left = int(settings.check_runs) - _first_runs(settings)
+    n_zoom = min(int(round(settings.check_zoom * int(settings.check_runs))), left)
+    left -= n_zoom
     stages = int(settings.check_stages)
     for stage in range(1, stages + 1):
         n = left // (stages - stage + 1)
@@ -556,7 +558,43 @@ def _add_check(res, top, evaluate, settings, seed, seen=None):
             fy, ry = evaluate(y)
             x, f, r = (np.concatenate([x, y]), np.concatenate([f, np.asarray(fy, dtype=bool)]),
                        np.concatenate([r, np.asarray(ry, dtype=float)]))
+    y = zoom_widths(res.width, top, np.concatenate([x, sx]), np.concatenate([r, sr]),
+                    np.concatenate([f, sf.astype(bool)]), n_zoom, settings, seed)
+    if y.size:
+        fy, ry = evaluate(y)
+        x, f, r = (np.concatenate([x, y]), np.concatenate([f, np.asarray(fy, dtype=bool)]),
+                   np.concatenate([r, np.asarray(ry, dtype=float)]))
     return x, f, r
+
+
+def zoom_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTINGS, seed=0):
+    """The ``n`` widths (m, ascending) of the check's last stage (docs/slivers.md): around the
+    surviving widths of the span that came nearest to failing (largest ``ratio``,
+    max|theta|/alpha over the level), ``settings.check_zoom_points`` jittered widths each within
+    ``settings.check_zoom_width`` relative (a failing sliver is often a cluster of thinner ones
+    flanked by widths that rock nearly as hard: Imperial Valley El Centro 180 at 6 m fails on
+    15 % of a stretch of 1.3e-4 of the width 5.7 % above the design width, the widths around it
+    reaching 0.8-0.9 against 0.7 further off).  Peaks closer than two zoom widths count once."""
+    hi = min(settings.check_span * width, top)
+    k = int(settings.check_zoom_points)
+    if n <= 0 or k <= 0 or not hi > width * (1.0 + settings.check_first):
+        return np.zeros(0)
+    widths, ratio = np.asarray(widths, dtype=float), np.asarray(ratio, dtype=float)
+    keep = (widths > width) & (widths <= hi) & ~np.asarray(failed, dtype=bool)
+    widths, ratio = widths[keep], ratio[keep]
+    d = settings.check_zoom_width
+    peaks = []
+    for j in np.argsort(-ratio, kind="stable"):
+        if len(peaks) * k >= n:
+            break
+        if all(abs(widths[j] / b - 1.0) > 2.0 * d for b in peaks):
+            peaks.append(float(widths[j]))
+    if not peaks:
+        return np.zeros(0)
+    rng = np.random.default_rng([seed, int(settings.check_stages) + 1])
+    x = [b * (1.0 + d * (2.0 * (np.arange(k) + rng.random(k)) / k - 1.0)) for b in peaks]
+    x = np.concatenate(x)
+    return np.sort(x[(x > width) & (x <= hi)])[:n]
 
 
 def _raise_to_failures(res, evaluate, seen, settings) -> None:

@@ -231,3 +231,25 @@ def test_check_uses_the_search_widths():
         # without the search's widths, the even share of one bin (within one: largest remainders)
         assert abs(in_bin - expect) <= 1.0, (known is None, in_bin, expect)
     assert not f.any()
+
+
+def test_zoom_widths_go_around_the_widths_nearest_to_failing():
+    """The last stage: check_zoom_points jittered widths within check_zoom_width (relative) of
+    each surviving width that rocked hardest, peaks closer than two zoom widths once, failed
+    widths and widths outside the span left out; the same for the same seed."""
+    from rocking.widths import zoom_widths
+
+    s = DEFAULT_SETTINGS.replace(check_zoom_points=4, check_zoom_width=1e-3)
+    w, top = 1.0, 3.0
+    widths = np.array([0.9, 1.1, 1.1005, 1.2, 1.3, 1.4, 1.6])
+    ratio = np.array([0.99, 0.9, 0.89, 0.3, 0.95, 0.97, 0.99])
+    failed = np.array([False, False, False, False, False, True, False])
+    y = zoom_widths(w, top, widths, ratio, failed, 8, s, seed=2)
+    # 0.9 is below w, 1.6 above the span (1.5), 1.4 failed: the peaks are 1.3 and 1.1 (1.1005 is
+    # within two zoom widths of 1.1), four widths around each
+    assert y.size == 8 and np.all(np.diff(y) > 0)
+    near = lambda b: np.sum(np.abs(y / b - 1.0) <= s.check_zoom_width)
+    assert near(1.3) == 4 and near(1.1) == 4
+    assert np.array_equal(y, zoom_widths(w, top, widths, ratio, failed, 8, s, seed=2))
+    assert not np.array_equal(y, zoom_widths(w, top, widths, ratio, failed, 8, s, seed=3))
+    assert zoom_widths(w, top, widths, ratio, failed, 0, s).size == 0
