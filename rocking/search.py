@@ -121,8 +121,8 @@ class SearchSettings:
     check_seed: int | None = None
     check_rounds: int = 2
     check_above: float = 0.0
-    check_zoom: float = 0.0
-    check_zoom_points: int = 6
+    check_zoom: float = 0.3
+    check_zoom_points: int = 4
     check_zoom_width: float = 2e-4
 
     def __post_init__(self):
