@@ -172,12 +172,8 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         ``max|theta|/alpha <= R`` (a width fails where it exceeds R or the column overturns);
         None (default): overturning, the paper's question (docs/design.md, "Performance levels").
     overturning : RequiredWidth, optional
-        With ``limit``: the overturning design of the same column and record (``limit=None``,
-        the same settings), already computed.  A width that overturns fails every level, so the
-        level's design width is made at least its width (one run there, and a bisection above it
-        where that width exceeds the level): ``width >= overturning.width`` by construction, at
-        no cost where the level's own design is already wider.  Under a record without a vertical
-        record only.
+        With ``limit`` under a record (no vertical): its overturning design, already computed;
+        the level's width is then at least its width (docs/design.md, "Performance levels").
     shape, lam : str (optional), float
         ``rule="envelope"``: the shape whose factor to use (default every shape); Eq. 20's lambda.
     n_scan, n_zone, rtol : int, int, float, optional
@@ -208,18 +204,8 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     >>> [round(rocking.required_width(7.5, pulse, rule=r).width, 3) for r in ("eq31", "exact")]
     [2.17, 1.736]
     """
-    height = float(height)
-    if not (math.isfinite(height) and height > 0):
-        raise ValueError(f"height must be positive, got {height!r} m")
-    if rule not in RULES:
-        raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
-    if overturning is not None and (rule != "exact" or limit is None or vertical is not None
-                                    or overturning.limit is not None
-                                    or getattr(excitation, "shape", "record") in SHAPES):
-        raise ValueError("overturning= goes with rule='exact' under a record, a limit and no "
-                         "vertical record: the overturning design (limit=None) of the same column "
-                         "and record")
+    height = _check_arguments(height, rule, overturning, limit, vertical, excitation)
     if rule == "exact":
         kw = dict(criterion=criterion, eta=eta, n_scan=n_scan, rtol=rtol, model=model,
                   n_zone=n_zone, settings=settings, gamma=gamma, limit=limit)
@@ -258,6 +244,23 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     return RequiredWidth(width=float(width), height=height, rule=rule, iterations=it,
                          method=f"fixed point of {rule} in B (p depends on B): "
                                 f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
+
+
+def _check_arguments(height, rule, overturning, limit, vertical, excitation) -> float:
+    """``height`` as a float; ValueError for a bad height or rule, or where ``overturning=``
+    cannot apply (see :func:`required_width`)."""
+    height = float(height)
+    if not (math.isfinite(height) and height > 0):
+        raise ValueError(f"height must be positive, got {height!r} m")
+    if rule not in RULES:
+        raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
+    if overturning is not None and (rule != "exact" or limit is None or vertical is not None
+                                    or overturning.limit is not None
+                                    or getattr(excitation, "shape", "record") in SHAPES):
+        raise ValueError("overturning= goes with rule='exact' under a record, a limit and no "
+                         "vertical record: the overturning design (limit=None) of the same column "
+                         "and record")
+    return height
 
 
 def governing(horizontal, with_vertical):
@@ -334,6 +337,8 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                 seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
             seen = _check_rounds(res, top, evaluate_record, settings, seed, seen)
         if overturning is not None and overturning.width > res.width:
+            # a width that overturns fails every level: one run at the overturning design width,
+            # and a bisection above it where that width exceeds the level
             _at_least(res, overturning, evaluate_record, seen, settings)
         return res
     res = _pulse_width(height, top, lambda idx, widths: _failed(run_widths(widths), criterion, limit),

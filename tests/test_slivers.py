@@ -208,7 +208,7 @@ def test_check_uses_the_search_widths():
     sends the later stages there; without them the stages spread evenly."""
     from rocking.widths import _add_check
 
-    s = DEFAULT_SETTINGS.replace(check_runs=500)
+    s = DEFAULT_SETTINGS.replace(check_runs=500, check_zoom=0.0)   # the later stages alone
     w, top = 1.0, 3.0                                 # the span is (1, check_span]
 
     def flat(x):                                      # every width survives, ratio 0.5
