@@ -403,7 +403,7 @@ def _paths(plan, say):
     not records are skipped with a note."""
     from .batch import peer_inputs
     from .reports.report import display
-    from .batch.tasks import expand_inputs
+    from .batch.tasks import expand_inputs, skipped_note
 
     if not plan.records and not plan.pair:
         raise ArgumentError("no records given: pipeline run RECORD... --block HxW")
@@ -411,9 +411,7 @@ def _paths(plan, say):
     skipped = []
     paths = [p for p in expand_inputs(others, skipped, plan.glob) if p not in set(plan.triplets.values())]
     if skipped:
-        shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
-        say(f"pipeline run: note: {len(skipped)} file(s) of the folders skipped, plainly not records "
-            f"({shown}); name a file to read it as a record, or choose files with --glob")
+        say(f"pipeline run: note: {skipped_note(skipped)}")
     if not paths and not plan.pair and not downloads:
         raise ArgumentError(f"no record files in {', '.join(map(display, plan.records))} "
                             "(a folder gives the files directly in it)")

@@ -40,10 +40,18 @@ def _check_worker_failure(out, reference, killer="good02"):
 def test_a_worker_killed_at_one_record_fails_that_record_only(how, six, reference, tmp_path, monkeypatch):
     if "--dask" in how:
         pytest.importorskip("dask.distributed")
+    import glob
+    import tempfile
+
+    leftovers = lambda: set(glob.glob(f"{tempfile.gettempdir()}/pipeline-record-*"))
+    before = leftovers()
     monkeypatch.setenv(runner.TEST_KILL_ENV, "good02")  # the worker running good02 SIGKILLs itself
     out = tmp_path / "out"
     assert main(["run", *six, *BATCH_ARGS, *how, "--out", str(out)]) == 1
     _check_worker_failure(out, reference)
+    # the killed dask worker's copy of good02 is in its own folder, which dask removes, not left
+    # in the system's temporary folder
+    assert leftovers() <= before
     # run again without the fault: only good02 is computed, and the files are the serial run's
     monkeypatch.delenv(runner.TEST_KILL_ENV)
     assert main(["run", *six, *BATCH_ARGS, *how, "--out", str(out)]) == 0

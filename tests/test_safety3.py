@@ -451,6 +451,20 @@ def test_files_of_a_folder_that_are_plainly_not_records_are_skipped_with_one_lin
     assert [r["record"] for r in read_rows(out / "design.csv")] == ["good"]
 
 
+def test_classify_names_the_files_of_a_folder_it_skips(tmp_path, capsys):
+    """classify skipped a folder's README without a word (run printed one line): now the same
+    line, without run's --glob hint, which classify does not have."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "good.AT2").write_text(at2_text(pulse_values(0), "0"))
+    (folder / "README.txt").write_text("Records of the 1994 event\n")
+    assert main(["classify", str(folder), "--pairs", "none"]) == 0
+    err = capsys.readouterr().err
+    (line,) = [ln for ln in err.splitlines() if "plainly not records" in ln]
+    assert line.startswith("pipeline classify: note: 1 file(s)") and "README.txt" in line
+    assert "--glob" not in line
+
+
 def test_records_not_downloaded_are_listed_not_failed(tmp_path, capsys):
     """A partial PEER download printed one "failed" line per record not downloaded, counted them as
     failures in report.html and exited 1 for the usual case; now one line and a list in --out, and
@@ -473,6 +487,14 @@ def test_records_not_downloaded_are_listed_not_failed(tmp_path, capsys):
     (fail,) = read_rows(out / "failures.csv")
     assert fail["reason"].startswith("RSN 3:") and fail["reason"].endswith("not in the download: M090.AT2")
     assert [r["peer_rsn"] for r in read_rows(out / "peer-not-downloaded.csv")] == ["2"]
+    # the list is one of the run's own files: --log may not name it, even before it exists (the
+    # log and the list would write over each other)
+    fresh = tmp_path / "fresh"
+    capsys.readouterr()
+    assert main(["run", str(path), *RUN_ARGS, "--out", str(fresh), "--log", str(fresh / "peer-not-downloaded.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "one of this run's own outputs" in err and "\n" not in err
+    assert not (fresh / "peer-not-downloaded.csv").exists()
 
 
 def test_all_of_a_files_missing_settings_in_one_message(tmp_path):

@@ -4,7 +4,7 @@ Width against height under each rule
 
 For one pulse, the width a column needs as its height grows, by each design rule: Eq. 31 of
 Makris & Vassiliou (2012), Eq. 20, the conservative envelope rule and the exact answer (the
-verified width under the pulse).  Taller columns are more stable for the same slenderness, so
+width found by time histories under the pulse).  Taller columns are more stable for the same slenderness, so
 the width grows less than in proportion to the height.
 """
 import matplotlib.pyplot as plt

@@ -34,6 +34,18 @@ def read_bytes(path: str) -> bytes | None:
         return None
 
 
+def _scratch() -> str | None:
+    """The dask worker's own folder (None outside a worker: the system's temporary folder).  A
+    worker killed while it works on a record cannot remove that record's files; dask removes a dead
+    worker's folder when the next worker starts, so they do not pile up in the temporary folder."""
+    try:
+        from distributed import get_worker
+
+        return get_worker().local_directory
+    except (ImportError, ValueError):
+        return None
+
+
 def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
     """Run on a worker: :func:`pipeline.batch.worker.work` on ``data`` (and ``data2``, the second file of
     a pair), written to private files named as the originals; the result names the original paths."""
@@ -41,7 +53,7 @@ def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
 
     if not worker._in_worker:
         worker.init_worker()  # also in a worker the nanny restarted after a death
-    folder = tempfile.mkdtemp(prefix="pipeline-record-")
+    folder = tempfile.mkdtemp(prefix="pipeline-record-", dir=_scratch())
     swaps = {}
     try:
         local = {}

@@ -144,19 +144,26 @@ def run(paths, columns, out, *, options: Options = Options(), jobs: int | None =
                            progress=progress, force=force, log=log, lists=lists or {})
 
 
-def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log, lists) -> RunSummary:
-    """:func:`run`, the folder locked."""
-    outputs = prepare_output(out, tasks, options.plots, options)
-    if log is not None:  # never onto an input or one of this run's own files (pipeline.reports.outpaths)
+def _check_log(log, out, tasks, own) -> None:
+    """``--log`` never onto an input or one of this run's own files ``own`` (paths relative to
+    ``out``; pipeline.reports.outpaths)."""
+    if log is not None:
         from ..reports.outpaths import check_output_file
 
         check_output_file(log, "--log", "log", inputs=[p for t in tasks for p in (t.path, t.path2)],
-                          reserved=[out / rel for rel in outfiles.own_files(tasks, options)], command="run")
+                          reserved=[out / rel for rel in own], command="run")
+
+
+def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log, lists) -> RunSummary:
+    """:func:`run`, the folder locked."""
+    outputs = prepare_output(out, tasks, options.plots, options)
+    own = outfiles.own_files(tasks, options) + list(lists)   # lists: such as peer-not-downloaded.csv
+    _check_log(log, out, tasks, own)
     try:
         journal = resume.Journal(out)
     except report.NotOurs as exc:
         raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
-    resume.remove_stale_temporaries(out, outfiles.own_files(tasks, options))  # left by a run killed while writing
+    resume.remove_stale_temporaries(out, own)  # left by a run killed while writing
 
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch

@@ -7,7 +7,7 @@ opposite give the same width: the column is symmetric).  The component at ``thet
 ``pulses.component(a1, a2, theta)``.
 
 After the run, the rows of every task are gathered here: ``pairs.csv`` (each pair's governing
-direction: the widest verified width), ``suite.csv`` (widths and survival shares over the records
+direction: the widest design width), ``suite.csv`` (widths and survival shares over the records
 of the suite) and, with ``--fragility``, ``fragility.csv`` and ``fragility_curve.csv``.  Nothing
 here re-implements the library: pairing, rotation and classification come from :mod:`pulses`,
 widths, simulations and critical scales from :mod:`rocking`.
@@ -203,7 +203,7 @@ PAIR_COLUMNS = Columns(
     ("n_directions", "-", "Directions designed for (rows of this pair and column in `summary.csv`)."),
     ("n_directions_failed", "-", "Directions of this pair that failed (in `failures.csv`): where not "
                                  "0, the governing direction is the widest of the others only."),
-    ("governing_direction_deg", "deg", "The direction whose verified width is widest (the first such "
+    ("governing_direction_deg", "deg", "The direction whose design width is widest (the first such "
                                        "in angle order); blank for a single component."),
 )
 
@@ -217,7 +217,7 @@ def _groups(rows):
 
 
 def governing_rows(rows, failed=None) -> list[dict]:
-    """One row per pair (or single record) and column: its direction with the widest verified width.
+    """One row per pair (or single record) and column: its direction with the widest design width.
     ``failed``: ``{pair: directions that failed}``."""
     out = []
     for (_, pair), group in _groups(rows).items():
@@ -240,18 +240,18 @@ SUITE_COLUMNS = Columns(
     ("width_all_m", "m", "Width that survives every record in every direction: the largest verified "
                          "width of the suite."),
     ("width_all_but_one_m", "m", "Width that survives all records but one (each record counted by its "
-                                 "governing direction): the second largest governing verified width "
+                                 "governing direction): the second largest governing design width "
                                  "(blank with fewer than two records)."),
-    ("verified_width_median_m", "m", "Median of the records' governing verified widths."),
-    ("verified_width_p84_m", "m", "84th percentile of the records' governing verified widths (linear "
+    ("verified_width_median_m", "m", "Median of the records' governing design widths."),
+    ("verified_width_p84_m", "m", "84th percentile of the records' governing design widths (linear "
                                   "interpolation between order statistics, numpy's default)."),
     ("eq31_width_max_m", "m", "Largest Eq. 31 width over the records and directions."),
     ("share_column_survives", "-", "Share of the records under which the column as it stands does not "
                                    "overturn, in any direction (blank for `--height`)."),
-    ("share_column_verified", "-", "Share of the records whose governing verified width the column as it "
+    ("share_column_verified", "-", "Share of the records whose governing design width the column as it "
                                    "stands reaches (so it survives them with no safe island)."),
-    ("share_column_checked", "-", "Share of the records whose governing verified width the column as it "
-                                  "stands reaches and that the check above the verified width "
+    ("share_column_checked", "-", "Share of the records whose governing design width the column as it "
+                                  "stands reaches and that the check above the search width "
                                   "(`failing_share`, docs/slivers.md) found no failing width at or above "
                                   "the column's width, in any direction: verified with the same check as "
                                   "each record's `widest_failing_width_m` (blank for `--height`)."),
@@ -262,7 +262,7 @@ SUITE_COLUMNS = Columns(
 
 
 def checked(row, width) -> bool:
-    """A column ``width`` wide reaches the row's verified width and is wider than every failing
+    """A column ``width`` wide reaches the row's design width and is wider than every failing
     width the check above it found (docs/slivers.md)."""
     widest = row.get("widest_failing_width_m")
     return (width is not None and float(width) >= float(row["verified_width_m"])
@@ -429,13 +429,13 @@ def columns_markdown() -> str:
 
     lines = table("Columns of `pairs.csv`",
                   "One row per record of the suite (a pair, or a single component) and column: the "
-                  "row of `summary.csv` of its governing direction (the widest verified width), "
+                  "row of `summary.csv` of its governing direction (the widest design width), "
                   "after these two columns.", PAIR_COLUMNS.columns)
     lines += table("Columns of `suite.csv`",
                    "One row per column, over every record of the suite (failed records left out; "
-                   "they are in `failures.csv`). A record's *governing* verified width is the widest "
+                   "they are in `failures.csv`). A record's *governing* design width is the widest "
                    "over its directions. `plots/suite.png`: share of the records whose governing "
-                   "verified width is at most a given width, with the column's width and the Eq. 31 "
+                   "design width is at most a given width, with the column's width and the Eq. 31 "
                    "widths marked.", SUITE_COLUMNS.columns)
     lines += table("Columns of `fragility.csv` (`--fragility`)",
                    "One row per column as it stands: the lognormal collapse fragility of the suite. "

@@ -155,6 +155,16 @@ def plainly_not_a_record(path) -> bool:
     return bool(head.strip()) and re.search(rb"[0-9]", head) is None
 
 
+def skipped_note(skipped, glob_option=True) -> str:
+    """The note that ``run`` and ``classify`` print for the files of folders left out by
+    :func:`expand_inputs` (the first five named; ``glob_option``: the command has ``--glob``)."""
+    from ..reports.report import display
+
+    shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
+    return (f"{len(skipped)} file(s) of the folders skipped, plainly not records ({shown}); name a "
+            "file to read it as a record" + (", or choose files with --glob" if glob_option else ""))
+
+
 def expand_inputs(items, skipped: list | None = None, pattern: str | None = None) -> list[str]:
     """File arguments as given; folders give their entries (sorted; not hidden ones, not folders,
     not files that are plainly no record, :func:`plainly_not_a_record`, which are appended to

@@ -159,7 +159,7 @@ def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None):
 
 def fields(block, record, up, shown_file, designed=None) -> dict:
     """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical); ``designed``: the
-    answer of :func:`design` (its ``vertical_width`` is the verified width with the vertical)."""
+    answer of :func:`design` (its ``vertical_width`` is the design width with the vertical)."""
     import numpy as np
 
     import rocking

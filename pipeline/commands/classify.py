@@ -43,13 +43,16 @@ def _message(path, exc) -> str:
 def main(args) -> int:
     import pulses
 
-    from ..batch.tasks import expand_inputs
+    from ..batch.tasks import expand_inputs, skipped_note
 
     if not args.files and not args.pair:
         raise ArgumentError("no records given: pipeline classify FILE... [--pair A B]")
     opts = record_options(args)
     args.pair = pair_files(args.pair)
-    files = expand_inputs(args.files)
+    skipped = []
+    files = expand_inputs(args.files, skipped)
+    if skipped:
+        print(f"pipeline classify: note: {skipped_note(skipped, glob_option=False)}", file=sys.stderr)
     inputs = files + [p for pair in args.pair for p in pair]
     _check_outputs(args, inputs)
     records, failures = {}, 0

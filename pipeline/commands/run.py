@@ -1,4 +1,4 @@
-"""``pipeline run``: records in, verified column designs out, for one record or a whole database."""
+"""``pipeline run``: records in, column designs checked under the full records out, for one record or a whole database."""
 from __future__ import annotations
 
 import argparse
@@ -38,7 +38,7 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
-        "run", help="records in, verified column designs out",
+        "run", help="records in, column designs checked under the full records out",
         description="For every record: read it, fit its pulse (every shape), size each column by "
                     "Eq. 31, the envelope rule and the exact criterion, and verify the designs with "
                     "time histories under the full record. Prints the answer (a table per record and "

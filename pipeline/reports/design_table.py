@@ -1,8 +1,8 @@
 """The answer of ``pipeline run`` in view: ``design.csv`` and the table printed at the end of a run.
 
-One row per record (a pair counts once, by its governing direction: the widest verified width) and
+One row per record (a pair counts once, by its governing direction: the widest design width) and
 column, with what an engineer decides on: is the record pulse-like, which pulse governs Eq. 31,
-the width Eq. 31 asks for, the verified width under the full record, and whether the column as it
+the width Eq. 31 asks for, the design width under the full record, and whether the column as it
 stands survives.  Computed from the rows of ``summary.csv`` as written (so a resumed run prints and
 writes the same), which stays complete.
 """
@@ -18,7 +18,7 @@ DESIGN_CSV = "design.csv"
 DESIGN_COLUMNS = Columns(
     ("record", "-", "The record (for a pair of components: the pair, `pair` in `summary.csv`)."),
     ("column", "-", "The column as given: `HxW` for `--block`, `H` for `--height`."),
-    ("direction_deg", "deg", "For a pair: the governing direction (the widest verified width); blank "
+    ("direction_deg", "deg", "For a pair: the governing direction (the widest design width); blank "
                              "for a single component."),
     ("n_directions", "-", "Directions designed for (1 for a single component)."),
     ("n_directions_failed", "-", "Directions that failed (in `failures.csv`); where not 0, the row "
@@ -39,10 +39,10 @@ DESIGN_COLUMNS = Columns(
     ("width_m", "m", "Width of the column as it stands (blank for `--height`)."),
     ("survives", "-", "The column as it stands does not overturn under the record (in any direction "
                       "of a pair); blank for `--height`."),
-    ("verified_adequate", "-", "The column as it stands is at least the verified width (it survives "
+    ("verified_adequate", "-", "The column as it stands is at least the design width (it survives "
                                "with no safe island); blank for `--height`."),
     ("max_theta_ratio", "-", "Largest max|theta|/alpha of the column as it stands over the directions."),
-    ("widest_failing_width_m", "m", "Widest width found to overturn above the verified width by the check "
+    ("widest_failing_width_m", "m", "Widest width found to overturn above the search width by the check "
                                     "after the search (over the directions; docs/slivers.md); blank where "
                                     "none was found, which does not prove there is none."),
     ("survives_vertical", "-", "The column as it stands does not overturn with the record's vertical "
@@ -94,7 +94,7 @@ def number(value):
 
 def _widest(values, above=None):
     """The largest of ``values`` if it is above ``above`` (a failing width of one direction below the
-    pair's verified width is no failure of the design), else None."""
+    pair's design width is no failure of the design), else None."""
     values = [v for v in map(number, values) if v is not None]
     if not values or (above is not None and max(values) <= above):
         return None
@@ -195,7 +195,7 @@ def excess_text(value, verified) -> str | None:
 
 
 def failing_text(value, verified, unit=" m") -> str | None:
-    """``0.608 m (+2.5 %)``: a failing width with how far it lies above the verified width
+    """``0.608 m (+2.5 %)``: a failing width with how far it lies above ``verified``
     (:func:`excess_text`; metres only where that is blank); None where ``value`` is blank.
     ``unit=""`` gives ``0.608 (+2.5 %)`` for a column headed in metres."""
     v = number(value)
@@ -324,7 +324,7 @@ def table_text(rows, failures=(), summary=()) -> str:
     headers = HEADERS
     body = [table_cells(r) for r in rows]
     if any(r.get("survives_vertical") is not None for r in rows):
-        # the verdict with the vertical, and the verified width with it (the widest over a pair's
+        # the verdict with the vertical, and the design width with it (the widest over a pair's
         # directions, from summary.csv's rows) beside the horizontal one
         widths = {}
         for r in summary:

@@ -28,7 +28,7 @@ def _governing(rows, label, key):
 
 
 def _governing_checked(rows, label):
-    """Per record (pair) of the column ``label``: the largest of its verified widths and the
+    """Per record (pair) of the column ``label``: the largest of its design widths and the
     failing widths the check above them found (docs/slivers.md), sorted."""
     out = {}
     for r in rows:
@@ -39,7 +39,7 @@ def _governing_checked(rows, label):
 
 
 def suite_figure(rows, suite):
-    """One panel per column: share of the records whose governing verified width is at most
+    """One panel per column: share of the records whose governing design width is at most
     ``B``, against ``B``; the column's width and the records' Eq. 31 widths marked."""
     from matplotlib.figure import Figure
 
@@ -53,11 +53,11 @@ def suite_figure(rows, suite):
         share = np.arange(1, widths.size + 1) / widths.size
         x = np.concatenate([[0.0], widths])
         y = np.concatenate([[0.0], share])
-        ax.step(x, y, where="post", color="C0", lw=2, label="records verified (governing direction)")
+        ax.step(x, y, where="post", color="C0", lw=2, label="records whose design width is at most B (governing direction)")
         checked = _governing_checked(rows, label)
         if checked.size and np.any(checked > widths):
             # the same share with each record's widest failing width (the check above its
-            # verified width, docs/slivers.md) as its requirement
+            # search width, docs/slivers.md) as its requirement
             ax.step(np.concatenate([[0.0], checked]), y, where="post", color="C0", lw=1, ls="--",
                     label="... and wider than every failing width the check found")
         for i, w in enumerate(eq31):
@@ -71,7 +71,7 @@ def suite_figure(rows, suite):
         ax.set_xlim(0.0, top)
         ax.set_ylim(0.0, 1.05)
         ax.set_xlabel("column width B (m)")
-        ax.set_ylabel("share of the suite verified")
+        ax.set_ylabel("share of the suite covered")
         ax.set_title(f"column {label}: {s['n_records']} records, {s['n_rows']} record directions")
         ax.grid(True, alpha=0.3)
         ax.legend(loc="lower right", fontsize=8)

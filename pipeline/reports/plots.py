@@ -28,7 +28,7 @@ TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE = 11, 10, 9, 8
 #: the best: at most one per shape, four shapes)
 MAX_PULSES = 4
 #: most curves per rotation-history panel (the column as it stands, the Eq. 31 design, the
-#: verified width)
+#: design width)
 MAX_CURVES = 3
 #: Okabe-Ito colours (apart with every common colour-vision deficiency); styles tell curves apart too
 PALETTE = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9"]
@@ -198,7 +198,7 @@ def summary_figure(rows) -> Figure:
     -------
     matplotlib.figure.Figure
         Two panels, 10 in wide: the columns as they stand (``column_kind`` "block"), and the Eq. 31
-        design against the verified width of every row.
+        design against the design width of every row.
     """
     # drawn once a run: a layout engine places the labels
     fig = _figure(10.0, 4.8, layout="constrained")

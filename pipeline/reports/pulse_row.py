@@ -54,7 +54,7 @@ def classify_fields(record, other=None) -> dict:
     return {k: row[k] for k in RUN_COLUMNS}
 
 
-NOT_PULSE_WARNING = "Eq. 31 assumes a pulse; the verified width does not"
+NOT_PULSE_WARNING = "Eq. 31 assumes a pulse; the design width does not"
 
 
 def classification_fields(record, other=None, pair_fields=None, result=None) -> tuple[dict, str | None]:

@@ -402,7 +402,7 @@ def record_plot_name(record_id: str) -> str:
 
 
 def record_widths_plot_name(record_id: str) -> str:
-    """Path of a record's barcode of the widths checked above its verified width (a folder of
+    """Path of a record's barcode of the widths checked above its search width (a folder of
     its own: ``plots/<record>_widths.png`` could be another record's figure)."""
     return f"plots/widths/{record_id}.png"
 
