@@ -118,7 +118,7 @@ def test_check_against_dense_scans_synthetic():
     # the check's 1500 runs include the refinement's: what it spent refining comes off the widths
     assert res.check_runs == res.check_widths.size
     assert res.check_runs + res.refine_runs <= DEFAULT_SETTINGS.check_runs < res.check_runs + 50
-    assert res.check_top == pytest.approx(min(2.0 * res.width, top), rel=1e-15)
+    assert res.check_top == pytest.approx(min(DEFAULT_SETTINGS.check_span * res.width, top), rel=1e-15)
     assert res.failing_share == pytest.approx(res.check_failed.mean(), abs=0)
     # the widest failing width overturns in the reference model too (an independent integrator)
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
