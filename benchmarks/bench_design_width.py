@@ -1,10 +1,11 @@
 """The design width against an independent dense grid, performance levels, and its sensitivity.
 
-    python benchmarks/bench_design_width.py                 # ~15 min on 2 busy cores; needs ../shared
+    python benchmarks/bench_design_width.py                 # 1-4 min a seed on 2 cores; needs ../shared
     python benchmarks/bench_design_width.py --heights 7.5   # one column height
     python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
     python benchmarks/bench_design_width.py --seeds record,1,2 --no-level --cache /tmp/dense --misses
-        # the check's seed set to each; overturning only; dense grids kept; where the misses lie
+        # the check's seed set to each ("record": the package's own); overturning only (~40 s a
+        # seed once the dense grids are kept); where the misses lie
 
 For every real record of ../shared/records (``raw/`` and its sub-folders, and the horizontal
 components of ``peer_download/`` that are not in ``raw/``: the check was sized on ``raw/`` at
