@@ -1,8 +1,11 @@
 """The design width against an independent dense grid, performance levels, and its sensitivity.
 
-    python benchmarks/bench_design_width.py                 # ~15 min on 2 busy cores; needs ../shared
+    python benchmarks/bench_design_width.py                 # 1-4 min a seed on 2 cores; needs ../shared
     python benchmarks/bench_design_width.py --heights 7.5   # one column height
     python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
+    python benchmarks/bench_design_width.py --seeds record,1,2 --no-level --cache /tmp/dense --misses
+        # the check's seed set to each ("record": the package's own); overturning only (~40 s a
+        # seed once the dense grids are kept); where the misses lie
 
 For every real record of ../shared/records (``raw/`` and its sub-folders, and the horizontal
 components of ``peer_download/`` that are not in ``raw/``: the check was sized on ``raw/`` at
@@ -40,6 +43,14 @@ DENSE = 6000
 SPAN = 3.0
 LEVEL = 0.5
 SEEDS = (1, 2, 3, 4)
+
+
+def _baseline():
+    from rocking.search import SearchSettings
+
+    # 0.5.0's search (fine zone 0.05 % apart up to 20 % above), no check: its answer is the width
+    # the floors are measured against, and anchors the dense grid
+    return SearchSettings(record_fine=5e-4, record_fine_span=0.2, check_runs=0)
 ETA_FACTORS = (0.95, 0.975, 1.025, 1.05)
 
 
@@ -60,13 +71,51 @@ def _verdicts(height, record, widths):
     return np.asarray(res.overturned, dtype=bool)
 
 
-def measure(paths, heights, settings=None):
+def samples_key(record) -> str:
+    """The record's samples and time step, hashed: two files of the same component (RSN77_2 and
+    the PEER download's RSN77_SFERN_PUL254) count once."""
+    import hashlib
+
+    h = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes())
+    h.update(repr(float(record.dt)).encode())
+    return h.hexdigest()[:16]
+
+
+def dense_failures(height, record, w, top, cache=None):
+    """The failing widths (m) of the dense grid of ``DENSE`` linear widths in ``(w, min(SPAN w,
+    top)]``; ``cache``: a folder where they are kept by record, height and ``w`` (the grid depends
+    on nothing else), so that runs with other check settings or seeds reuse it."""
+    x = np.linspace(w, min(SPAN * w, top), DENSE + 1)[1:]
+    path = None
+    if cache is not None:
+        path = pathlib.Path(cache) / f"{samples_key(record)}_{height:g}_{w:.17g}_{DENSE}_{SPAN:g}.npy"
+        if path.is_file():
+            return np.load(path)
+    fx = x[_verdicts(height, record, x)]
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        np.save(path, fx)
+    return fx
+
+
+def sliver_width(height, record, b, step):
+    """How thin the failing sliver at ``b`` is: the failing stretch around ``b``, found by
+    widening steps of ``step`` m (relative width of the failing run of a 21-point grid)."""
+    x = b + step * np.arange(-10, 11) / 10.0
+    f = _verdicts(height, record, x)
+    run = np.nonzero(f)[0]
+    return (x[run].max() - x[run].min() + step / 10.0) / b if run.size else 0.0
+
+
+def measure(paths, heights, settings=None, cache=None, level=True, misses=False):
     import pulses
     import rocking
     from pulses import G
     from rocking.search import DEFAULT_SETTINGS
 
     settings = settings or DEFAULT_SETTINGS
+    global BASELINE
+    BASELINE = _baseline()      # a global: measure() is the only user
 
     rows = []
     for path in paths:
@@ -76,24 +125,40 @@ def measure(paths, heights, settings=None):
             over = rocking.required_width(H, record, rule="exact", settings=settings)
             t_over = time.perf_counter() - t
             t = time.perf_counter()
-            half = rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
+            # the level alone (pipeline run --limit), and given the overturning design
+            alone = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
+                     if level else over)
+            half = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings,
+                                           overturning=over) if level else over)
             t_half = time.perf_counter() - t
-            w, W = over.search_width, over.width
+            # the reference: the search of 0.5.0 alone (its first transition, today's verified
+            # width), whatever the settings measured
+            base = rocking.required_width(H, record, rule="exact", settings=BASELINE)
+            w = base.search_width
+            W = over.width
             top = H * record.pga / G
-            x = np.linspace(w, min(SPAN * w, top), DENSE + 1)[1:]
-            f = _verdicts(H, record, x)
-            widest = float(x[f].max()) if f.any() else None
-            ratio = rocking.simulate(rocking.Block.from_dimensions(H, half.width), record,
-                                     history=False).max_rotation_ratio
-            fx = x[f]
-            row = dict(record=path.stem, height=H, w=w, W=W, widest_dense=widest,
+            fx = dense_failures(H, record, w, top, cache)
+            widest = float(fx.max()) if fx.size else None
+            ratio = max((rocking.simulate(rocking.Block.from_dimensions(H, h.width), record,
+                                          history=False).max_rotation_ratio if level else 0.0)
+                        for h in (alone, half))
+            if misses and widest and widest > 1.01 * W:
+                far = fx[fx > 1.01 * W]
+                step = (min(SPAN * w, top) - w) / DENSE
+                thin = [sliver_width(H, record, b, step) for b in far[:5]]
+                print(f"  MISS {path.stem} H {H:g}: W {W:.5f}; {far.size} dense failures above "
+                      f"1.01 W at W x " + " ".join(f"{b / W:.4f}" for b in far[:12])
+                      + "; sliver widths (rel.) " + " ".join(f"{t:.1e}" for t in thin), flush=True)
+            row = dict(record=path.stem, key=samples_key(record), height=H, w=w, W=W, widest_dense=widest,
                        far_old=bool(widest and widest > 1.01 * w),
                        far_new=bool(widest and widest > 1.01 * W),
                        # within the span the check covers: (w, 2 w] today, (W, 2 W] now
                        far_old_2=bool(np.any((fx > 1.01 * w) & (fx <= 2.0 * w))),
                        far_new_2=bool(np.any((fx > 1.01 * W) & (fx <= 2.0 * W))),
-                       runs=over.total_runs, runs_today=over.runs + settings.check_runs,
+                       runs=over.total_runs, runs_today=base.runs + 1500,
+                       w_search=over.search_width,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
+                       W_alone=alone.width, runs_alone=alone.total_runs,
                        t_over=t_over, t_half=t_half)
             rows.append(row)
             print(f"{path.stem:28s} H {H:4.1f}: w {w:.4f} W {W:.4f} (+{(W / w - 1) * 100:5.2f} %) "
@@ -103,13 +168,24 @@ def measure(paths, heights, settings=None):
     return rows
 
 
+def _unique(rows, name):
+    """Cases counted once per record's samples and height (``name`` true on any copy)."""
+    seen = {}
+    for r in rows:
+        seen[(r["key"], r["height"])] = seen.get((r["key"], r["height"]), False) or bool(r[name])
+    return sum(seen.values()), len(seen)
+
+
 def table(rows):
     n = len(rows)
     old = sum(r["far_old"] for r in rows)
     new = sum(r["far_new"] for r in rows)
+    (old_u, n_u), (new_u, _) = _unique(rows, "far_old"), _unique(rows, "far_new")
     raised = sum(r["W"] > r["w"] for r in rows)
     bad_half = [r for r in rows if r["ratio_half"] > LEVEL]
     below = [r for r in rows if r["W_half"] < r["W"]]
+    below_alone = [r for r in rows if r["W_alone"] < r["W"]]
+    runs_a = np.array([r["runs_alone"] for r in rows])
     runs = np.array([r["runs"] for r in rows])
     today = np.array([r["runs_today"] for r in rows])
     runs_h = np.array([r["runs_half"] for r in rows])
@@ -118,17 +194,23 @@ def table(rows):
         f"{n} cases (records x heights); dense grid {DENSE} linear widths in (w, min({SPAN:g} w, top)].",
         f"- failing widths more than 1 % above the search's answer w (today's width): {old} cases; "
         f"more than 1 % above the design width W: {new} cases",
+        f"- counted once per record's samples ({n_u} cases): above 1.01 w {old_u}; above 1.01 W "
+        f"{new_u} (" + ", ".join(f"{r['record']} {r['height']:g} m" for r in rows if r["far_new"]) + ")",
         f"- within the check's span: failing widths in (1.01 w, 2 w]: "
         f"{sum(r['far_old_2'] for r in rows)} cases; in (1.01 W, 2 W]: "
         f"{sum(r['far_new_2'] for r in rows)} cases ("
         + ", ".join(f"{r['record']} {r['height']:g} m" for r in rows if r["far_new_2"]) + ")",
         f"- W above w on {raised} cases (median +{np.median(up[up > 0]) if raised else 0:.2f} %, "
         f"max +{up.max():.2f} %)",
-        f"- limit {LEVEL}: max|theta|/alpha at W_R above {LEVEL} on {len(bad_half)} cases "
-        f"({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W on {len(below)}",
+        f"- limit {LEVEL}: max|theta|/alpha above {LEVEL} at W_R (alone or given W) on "
+        f"{len(bad_half)} cases ({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W: "
+        f"alone on {len(below_alone)}"
+        + "".join(f" ({r['record']} {r['height']:g} m: {r['W_alone']:.5f} < {r['W']:.5f})" for r in below_alone)
+        + f", given the overturning design on {len(below)}",
+        f"- runs per level width alone: median {np.median(runs_a):.0f} (max {runs_a.max()})",
         f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
         f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
-        f"limit {LEVEL} median {np.median(runs_h):.0f} (max {runs_h.max()})",
+        f"limit {LEVEL} given W median {np.median(runs_h):.0f} (max {runs_h.max()})",
     ]
 
 
@@ -193,15 +275,26 @@ def main(argv=None):
     if "--sensitivity" in argv:
         print("\n".join(sensitivity(paths, heights)))
         return 0
-    settings = None
-    if "--settings" in argv:       # e.g. --settings check_rounds=3,check_runs=1500
-        from rocking.search import DEFAULT_SETTINGS
+    from rocking.search import DEFAULT_SETTINGS
 
+    settings = DEFAULT_SETTINGS
+    if "--settings" in argv:       # e.g. --settings check_rounds=3,check_runs=1500
         pairs = (kv.split("=") for kv in argv[argv.index("--settings") + 1].split(","))
         settings = DEFAULT_SETTINGS.replace(**{k: (int if getattr(DEFAULT_SETTINGS, k) is None
                                                    else type(getattr(DEFAULT_SETTINGS, k)))(v)
                                                for k, v in pairs})
-    print("\n".join(table(measure(paths, heights, settings))))
+    # --cache DIR: keep the dense grids there (they depend on the search's width only)
+    cache = argv[argv.index("--cache") + 1] if "--cache" in argv else None
+    # --seeds 1,2,3: the check's seed (SearchSettings.check_seed) set to each in turn
+    # ("record": the package's own seed, made from the record and the column)
+    seeds = ([None if k == "record" else int(k) for k in argv[argv.index("--seeds") + 1].split(",")]
+             if "--seeds" in argv else [settings.check_seed])
+    for seed in seeds:
+        if len(seeds) > 1 or seed is not None:
+            print(f"check seed {'record' if seed is None else seed}:")
+        rows = measure(paths, heights, settings.replace(check_seed=seed), cache=cache,
+                       level="--no-level" not in argv, misses="--misses" in argv)
+        print("\n".join(table(rows)), flush=True)
     return 0
 
 

@@ -66,7 +66,12 @@ class SearchSettings:
     failing slivers far above ``w`` are points where the response jumps, and they lie where it
     is irregular from one width to the next, not where the block rocks hardest (on the shared
     records the ratio next to a failing width is often that of the smooth surroundings, 0.3-0.6,
-    while the bin's spread is among the span's largest).  0 runs switch the check off; so does
+    while the bin's spread is among the span's largest).  The last stage (a share
+    ``check_zoom`` of ``check_runs``, taken from the later stages' share) zooms in: around the
+    surviving widths of the span that came nearest to failing (the largest
+    ``max|theta|/alpha``), ``check_zoom_points`` jittered widths each within
+    ``check_zoom_width`` relative (failing slivers come in clusters flanked by widths that rock
+    nearly as hard; :func:`rocking.widths.zoom_widths`).  0 runs switch the check off; so does
     ``check_above`` (m; a pair's design width found in other directions, pipeline/batch/passes.py) at
     or above ``min(check_span ** check_rounds w, no-uplift width)``, the widest width the
     rounds could reach (each round's span is at most ``check_span`` times the width the round
@@ -105,7 +110,7 @@ class SearchSettings:
     record_rounds: int = 12
     record_chunk: int = 32
     check_runs: int = 1500
-    check_span: float = 2.0
+    check_span: float = 1.5
     check_near: float = 0.5
     check_first: float = 1e-4
     check_follow: float = 0.8
@@ -116,6 +121,9 @@ class SearchSettings:
     check_seed: int | None = None
     check_rounds: int = 2
     check_above: float = 0.0
+    check_zoom: float = 0.3
+    check_zoom_points: int = 4
+    check_zoom_width: float = 2e-4
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -134,6 +142,12 @@ class SearchSettings:
             raise ValueError("SearchSettings.check_follow must be in [0, 1), check_bins and "
                              f"check_stages at least 1, got {self.check_follow!r}, "
                              f"{self.check_bins!r}, {self.check_stages!r}")
+        if not (0.0 <= self.check_zoom < self.check_follow or self.check_zoom == 0.0) \
+                or self.check_zoom_points < 0 or not 0.0 < self.check_zoom_width < 1.0:
+            raise ValueError("SearchSettings.check_zoom must be in [0, check_follow), "
+                             "check_zoom_points 0 or more, check_zoom_width in (0, 1), got "
+                             f"{self.check_zoom!r}, {self.check_zoom_points!r}, "
+                             f"{self.check_zoom_width!r}")
         if self.check_rounds < 1:
             raise ValueError(f"SearchSettings.check_rounds must be at least 1, got {self.check_rounds!r}")
         if not 0.0 < self.design_rtol < 1.0:

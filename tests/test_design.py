@@ -425,7 +425,14 @@ def test_record_width_search_not_below_brute_force_real(name, height):
     top = height * rec.pga / G
     brute, step = _brute_verified_width(height, rec, top / 1500, top, 1500)
     assert fast.width >= brute - step
-    assert fast.width <= 1.05 * brute
+    assert fast.search_width <= 1.05 * brute
+    # the design width may lie further up only above a failing width the check found (which
+    # the uniform scan stepped over: El Centro 180 at 6 m, a sliver 5.7 % above the search's
+    # answer that a 6000-width grid finds too): it must overturn in an independent run
+    if fast.width > 1.05 * brute:
+        assert fast.widest_failing_width is not None and fast.widest_failing_width > 1.05 * brute
+        blk = Block.from_dimensions(height, fast.widest_failing_width)
+        assert rocking.simulate(blk, rec, history=False).overturned
     # (no check that it fails just below: these top slivers can be thinner than 1e-6 relative;
     # Kern Taft at 6 m survives at 1 - 1e-6 of the answer, failing within its 1e-9 bracket)
 

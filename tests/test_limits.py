@@ -146,3 +146,59 @@ def test_pipeline_run_limit(tmp_path):
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
     assert widths["half"] >= widths["over"]
+
+
+def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
+    """fragility.csv: without a level the records that fail count as overturned; with --limit R
+    (critical scales where max|theta|/alpha first exceeds R) they go to n_failed_at_level and
+    n_overturned is blank (a level's critical scale does not say the column overturns)."""
+    from pipeline.batch.site import fragility_tables
+
+    def rows(limit):
+        # four records of one column, three with a critical scale (log-moments: a fit exists)
+        return [dict(column="7.5x0.8", pair=f"r{k}", column_kind="block", critical_scale=s,
+                     fragility_up_to=4.0, uplift_scale=0.3, pga_g=0.4, design_limit=limit)
+                for k, s in enumerate((1.2, 1.8, 2.5, None))]
+
+    (over,), _, _ = fragility_tables(rows(None))
+    (level,), _, _ = fragility_tables(rows(0.5))
+    assert over["n_overturned"] == 3 and over["n_failed_at_level"] is None
+    assert level["n_overturned"] is None and level["n_failed_at_level"] == 3
+    assert over["n_records"] == level["n_records"] == 4
+    assert over["median_scale"] is not None and not over["error"]
+
+
+def test_level_given_the_overturning_design_is_at_least_it():
+    """Kern County, Taft 021 (real, 6 m), check seed 7: the level 0.5's own design (0.5519 m when
+    measured) fell below the overturning design (0.5525 m: its check found an overturning sliver
+    the level's check, with other widths, did not sample).  Given the overturning design, the
+    level's width is at least it by construction (a width that overturns fails every level), it
+    keeps max|theta|/alpha <= 0.5 under the record (an independent run), and it cost at most a
+    bisection more than the level alone."""
+    rec = pulses.read_record(shared_record("RSN15_KERN_TAF021.AT2"))
+    s = DEFAULT_SETTINGS.replace(check_seed=7)
+    over = rocking.required_width(6.0, rec, rule="exact", settings=s)
+    alone = rocking.required_width(6.0, rec, rule="exact", limit=0.5, settings=s)
+    given = rocking.required_width(6.0, rec, rule="exact", limit=0.5, settings=s, overturning=over)
+    assert given.width >= over.width and given.width >= alone.width
+    toppled, ratio = _ratio(6.0, given.width, rec)
+    assert not toppled and ratio <= 0.5
+    # the same search and check as alone; at most one run at the overturning width and a
+    # bisection to design_rtol of a bracket above it (log2(1/1e-6) = 20 halvings)
+    assert given.runs == alone.runs and given.check_runs == alone.check_runs
+    assert given.total_runs - alone.total_runs <= 1 + 20
+    if alone.width >= over.width:                       # nothing to add: the same answer
+        assert given.width == alone.width
+
+
+@pytest.mark.parametrize("kw", [dict(limit=None), dict(limit=0.5, rule="eq31"),
+                                dict(limit=0.5, vertical="same")])
+def test_overturning_design_goes_with_a_level_only(kw):
+    rec = pulses.Record(np.sin(np.linspace(0, 20, 2000)) * 3.0, 0.01)
+    over = rocking.RequiredWidth(0.5, 7.5, "exact", 0, "test")
+    kw = dict(kw)
+    rule = kw.pop("rule", "exact")
+    if kw.get("vertical") == "same":
+        kw["vertical"] = pulses.Record(np.zeros(2000), 0.01)
+    with pytest.raises(ValueError, match="overturning="):
+        rocking.required_width(7.5, rec, rule=rule, overturning=over, **kw)

@@ -42,7 +42,7 @@ def test_check_widths_layout():
     search's grid, the same for the same seed and different for another; the later stages put
     its widths where the widths run so far vary most from one to the next, or failed."""
     s = DEFAULT_SETTINGS
-    w, top = 1.0, 1.7                                  # the span ends at the no-uplift width
+    w, top = 1.0, 1.4          # the span ends at the no-uplift width (below check_span w = 1.5)
     x = check_widths(w, top, s, seed=5)
     n_follow = round(s.check_follow * s.check_runs)
     n1 = s.check_runs - n_follow
@@ -118,7 +118,7 @@ def test_check_against_dense_scans_synthetic():
     # the check's 1500 runs include the refinement's: what it spent refining comes off the widths
     assert res.check_runs == res.check_widths.size
     assert res.check_runs + res.refine_runs <= DEFAULT_SETTINGS.check_runs < res.check_runs + 50
-    assert res.check_top == pytest.approx(min(2.0 * res.width, top), rel=1e-15)
+    assert res.check_top == pytest.approx(min(DEFAULT_SETTINGS.check_span * res.width, top), rel=1e-15)
     assert res.failing_share == pytest.approx(res.check_failed.mean(), abs=0)
     # the widest failing width overturns in the reference model too (an independent integrator)
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
@@ -208,14 +208,14 @@ def test_check_uses_the_search_widths():
     sends the later stages there; without them the stages spread evenly."""
     from rocking.widths import _add_check
 
-    s = DEFAULT_SETTINGS.replace(check_runs=500)
-    w, top = 1.0, 3.0                                 # the span is (1, 2]: bins of 0.01
+    s = DEFAULT_SETTINGS.replace(check_runs=500, check_zoom=0.0)   # the later stages alone
+    w, top = 1.0, 3.0                                 # the span is (1, check_span]
 
     def flat(x):                                      # every width survives, ratio 0.5
         return np.zeros(np.size(x), dtype=bool), np.full(np.size(x), 0.5)
 
     k = s.check_bins
-    edges = np.linspace(w, 2.0 * w, k + 1)
+    edges = np.linspace(w, s.check_span * w, k + 1)
     j = int(0.4 * k)
     seen_x = np.concatenate([[0.5, 2.5], edges[j] + np.array([0.2, 0.4, 0.6, 0.8]) * (edges[1] - edges[0])])
     seen = (seen_x, np.zeros(seen_x.size, dtype=bool), np.array([0.9, 0.1, 0.2, 0.8, 0.3, 0.7]))
@@ -231,3 +231,25 @@ def test_check_uses_the_search_widths():
         # without the search's widths, the even share of one bin (within one: largest remainders)
         assert abs(in_bin - expect) <= 1.0, (known is None, in_bin, expect)
     assert not f.any()
+
+
+def test_zoom_widths_go_around_the_widths_nearest_to_failing():
+    """The last stage: check_zoom_points jittered widths within check_zoom_width (relative) of
+    each surviving width that rocked hardest, peaks closer than two zoom widths once, failed
+    widths and widths outside the span left out; the same for the same seed."""
+    from rocking.widths import zoom_widths
+
+    s = DEFAULT_SETTINGS.replace(check_zoom_points=4, check_zoom_width=1e-3)
+    w, top = 1.0, 3.0
+    widths = np.array([0.9, 1.1, 1.1005, 1.2, 1.3, 1.4, 1.6])
+    ratio = np.array([0.99, 0.9, 0.89, 0.3, 0.95, 0.97, 0.99])
+    failed = np.array([False, False, False, False, False, True, False])
+    y = zoom_widths(w, top, widths, ratio, failed, 8, s, seed=2)
+    # 0.9 is below w, 1.6 above the span (1.5), 1.4 failed: the peaks are 1.3 and 1.1 (1.1005 is
+    # within two zoom widths of 1.1), four widths around each
+    assert y.size == 8 and np.all(np.diff(y) > 0)
+    near = lambda b: np.sum(np.abs(y / b - 1.0) <= s.check_zoom_width)
+    assert near(1.3) == 4 and near(1.1) == 4
+    assert np.array_equal(y, zoom_widths(w, top, widths, ratio, failed, 8, s, seed=2))
+    assert not np.array_equal(y, zoom_widths(w, top, widths, ratio, failed, 8, s, seed=3))
+    assert zoom_widths(w, top, widths, ratio, failed, 0, s).size == 0

@@ -16,6 +16,7 @@ import time
 from pulses.shapes import AntisymmetricRicker
 
 from . import memo, peer_inputs, site, vertical
+from ..reports.design_table import check_reach_words
 from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
@@ -405,7 +406,7 @@ CHECK_COLUMNS = Columns(
                            "failing slivers thinner than the search's 0.05 % grid may lie above it. "
                            "After the search, a check runs `check_runs` jittered widths (seeded from "
                            "the record, off the search's grid) in two rounds, each from the design "
-                           "width so far up to twice it or the no-uplift width (height x PGA / g), "
+                           f"width so far up to {check_reach_words()} or the no-uplift width (height x PGA / g), "
                            "whichever is smaller: this is the share of them that fail (0: none did; "
                            "blank: no check, as in a direction of a pair whose check could not reach "
                            "the pair's design width, docs/site.md). The design width `verified_width_m` lies just above the "

@@ -310,20 +310,27 @@ FRAGILITY_SUMMARY_COLUMNS = Columns(
     ("n_records", "-", "Records fitted; each record counts by its weakest direction (the smallest "
                        "critical scale over its directions)."),
     ("n_overturned", "-", "Records that overturn the column at some factor up to `fragility_up_to` "
-                          "(the others are right-censored there)."),
+                          "(the others are right-censored there); blank with `--limit` (the critical "
+                          "scales are then those of the level: `n_failed_at_level`)."),
+    ("n_failed_at_level", "-", "With `--limit` R: records that make max|theta|/alpha exceed R (or "
+                               "overturn the column) at some factor up to `fragility_up_to` (the "
+                               "others are right-censored there); blank without `--limit`."),
     ("median_scale", "-", "Median critical scale factor (lognormal fit by maximum likelihood, "
                           "`rocking.fragility`)."),
     ("beta_scale", "-", "Lognormal dispersion of the critical scale factors."),
     ("median_pga_g", "g", "Median critical PGA (PGA of the critically scaled records)."),
     ("beta_pga", "-", "Lognormal dispersion of the critical PGAs."),
-    ("error", "-", "Why no curve could be fitted (e.g. fewer than two records overturn); else blank."),
+    ("error", "-", "Why no curve could be fitted (e.g. fewer than two records overturn, or exceed "
+                   "the level); else blank."),
 )
 FRAGILITY_CURVE_COLUMNS = Columns(
     ("column", "-", "The column as it stands."),
     ("scale", "-", "Scale factor on the records."),
-    ("p_overturn_scale", "-", "Fitted probability of overturning at this scale factor."),
+    ("p_overturn_scale", "-", "Fitted probability of overturning (with `--limit` R: of exceeding "
+                              "max|theta|/alpha = R) at this scale factor."),
     ("pga_g", "g", "Scaled PGA."),
-    ("p_overturn_pga", "-", "Fitted probability of overturning at this PGA."),
+    ("p_overturn_pga", "-", "Fitted probability of overturning (with `--limit` R: of exceeding R) "
+                            "at this PGA."),
 )
 #: points of each fragility curve in ``fragility_curve.csv``
 CURVE_POINTS = 60
@@ -358,10 +365,14 @@ def fragility_tables(rows):
     summary, curve, fits = [], [], {}
     for label, crows in by_column.items():
         entries = [_critical(g) for g in _groups(crows).values()]
-        n_over = sum(e.scale is not None for e in entries)
-        base = {"column": label, "n_records": len(entries), "n_overturned": n_over}
+        n_failed = sum(e.scale is not None for e in entries)
+        level = entries[0].limit if entries else None
+        # a critical scale under a level is where max|theta|/alpha first exceeds it: it does not
+        # say whether the column overturns, so the count goes to its own column
+        base = {"column": label, "n_records": len(entries),
+                "n_overturned": n_failed if level is None else None,
+                "n_failed_at_level": n_failed if level is not None else None}
         try:
-            level = entries[0].limit if entries else None
             fs = rocking.fragility(entries, measure="scale", limit=level)
             fp = rocking.fragility(entries, measure="pga", limit=level)
         except ValueError as exc:

@@ -397,6 +397,15 @@ def verdict_lines(rows) -> list[str]:
     return out
 
 
+def check_reach_words() -> str:
+    """How far above the width it starts from each round of the check looks, in words ("1.5
+    times it"; ``rocking.search.SearchSettings.check_span``)."""
+    from rocking.search import DEFAULT_SETTINGS
+
+    span = float(DEFAULT_SETTINGS.check_span)
+    return "twice it" if span == 2.0 else f"{span:g} times it"
+
+
 def fine_print(rows) -> str | None:
     """What was tested above the design width (None where no check ran)."""
     runs = [number(r.get("check_runs")) for r in rows if number(r.get("check_runs"))]
@@ -405,8 +414,8 @@ def fine_print(rows) -> str | None:
     return ("Design width: at least every width the search and the check above it found to "
             f"fail, refined just above the widest; the check ran {min(runs):.0f}"
             + (f"-{max(runs):.0f}" if max(runs) > min(runs) else "")
-            + " widths per record from the search width up to twice it (or the no-uplift "
-            "width); thinner failing slivers may remain (docs/slivers.md). Search width: the "
+            + f" widths per record from the search width up to {check_reach_words()} (or the "
+            "no-uplift width) in each round; thinner failing slivers may remain (docs/slivers.md). Search width: the "
             "search's first transition, with how far the design width lies above it.")
 
 

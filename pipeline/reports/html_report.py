@@ -16,7 +16,7 @@ import pathlib
 import urllib.parse
 
 from . import report
-from .design_table import (eq31_text, failing_text, metadata_text, pulse_text, search_text,
+from .design_table import (check_reach_words, eq31_text, failing_text, metadata_text, pulse_text, search_text,
                            survives_text, verdict_lines, fine_print, vertical_text)
 from .design_table import number as _num
 from .report import FIT_TOLERANCE
@@ -204,8 +204,8 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
-                parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to twice "
-                             "it (or the no-uplift width), "
+                parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to "
+                             f"{check_reach_words()} (or the no-uplift width), "
                              + (f"{100 * share:.2g} % fail, the widest at "
                                 + (failing_text(r.get("widest_failing_width_m"), r.get("search_width_m")) or "-")
                                 + " (the design width lies just above it)"
