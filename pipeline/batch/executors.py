@@ -280,6 +280,7 @@ def renderer(away: bool):
         return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures import TimeoutError as Waiting  # the builtin one only from Python 3.11
 
     pool = None
 
@@ -294,7 +295,7 @@ def renderer(away: bool):
         while True:  # a short wait, so that Ctrl-C stops the run
             try:
                 return fut.result(timeout=0.25)
-            except TimeoutError:
+            except Waiting:
                 interrupts.check()
 
     try:
