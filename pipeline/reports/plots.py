@@ -211,8 +211,8 @@ def summary_figure(rows) -> Figure:
         yv = np.array([_num(r, "verified_tan_alpha") for r in blocks])
         over = np.array([bool(r.get("overturns")) for r in blocks])
         ax1.scatter(x, y31, marker="o", facecolors="none", edgecolors=PALETTE[0], label="Eq. 31 (governing pulse)")
-        ax1.scatter(x[~over], yv[~over], marker="x", color=PALETTE[2], label="verified, column survives")
-        ax1.scatter(x[over], yv[over], marker="x", color=PALETTE[3], label="verified, column overturns")
+        ax1.scatter(x[~over], yv[~over], marker="x", color=PALETTE[2], label="design width, column survives")
+        ax1.scatter(x[over], yv[over], marker="x", color=PALETTE[3], label="design width, column overturns")
         hi = np.nanmax(np.concatenate([x, y31, yv, [0.0]]))
     hi = 1.1 * hi if hi > 0 else 1.0
     ax1.plot([0, hi], [0, hi], "k-", lw=0.6)
@@ -239,8 +239,8 @@ def summary_figure(rows) -> Figure:
     ax2.set_xlim(0, hi2)
     ax2.set_ylim(0, hi2)
     ax2.set_xlabel("Eq. 31 design tan(alpha)", fontsize=LABEL_SIZE)
-    ax2.set_ylabel("verified tan(alpha) (full record)", fontsize=LABEL_SIZE)
-    ax2.set_title("Eq. 31 against verification (below the line: Eq. 31 conservative)", fontsize=TITLE_SIZE - 1)
+    ax2.set_ylabel("design tan(alpha) (full record)", fontsize=LABEL_SIZE)
+    ax2.set_title("Eq. 31 against the design width (below the line: Eq. 31 conservative)", fontsize=TITLE_SIZE - 1)
     for ax in (ax1, ax2):
         _style(ax)
     return fig
