@@ -16,7 +16,39 @@ import hashlib
 
 import numpy as np
 
-_kept: collections.OrderedDict = collections.OrderedDict()
+class Kept:
+    """The last ``size`` results by key, kept as deep copies and handed out as deep copies (a
+    caller may change what it gets); ``size`` 0 keeps nothing."""
+
+    def __init__(self, size: int = 0):
+        self._items: collections.OrderedDict = collections.OrderedDict()
+        self.size = 0
+        self.resize(size)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def resize(self, size: int) -> None:
+        """Keep at most ``size`` results (the oldest dropped)."""
+        self.size = max(0, int(size))
+        while len(self._items) > self.size:
+            self._items.popitem(last=False)
+
+    def remembered(self, k, compute):
+        """``compute()``, or a copy of the result kept for ``k``."""
+        if self.size:
+            hit = self._items.get(k)
+            if hit is not None:
+                self._items.move_to_end(k)
+                return copy.deepcopy(hit)
+        res = compute()
+        if self.size:
+            self._items[k] = copy.deepcopy(res)
+            self.resize(self.size)
+        return res
+
+
+_kept = Kept()
 _size = 0
 
 
@@ -24,12 +56,12 @@ def keep(n: int) -> None:
     """Keep the last ``n`` record searches of this process (0: none, the default; the kept ones
     are dropped)."""
     global _size
-    _size = max(0, int(n))
-    while len(_kept) > _size:
-        _kept.popitem(last=False)
+    _kept.resize(n)
+    _size = _kept.size
 
 
-def _digest(samples) -> str:
+def digest(samples) -> str:
+    """A hash of the samples (as little-endian float64)."""
     return hashlib.sha256(np.ascontiguousarray(samples, dtype="<f8").tobytes()).hexdigest()
 
 
@@ -38,20 +70,10 @@ def key(excitation, vertical, settings, *column) -> tuple:
     search's settings (without the check's ``check_*``) and the column's (height, criterion, ...)."""
     search = tuple((f.name, getattr(settings, f.name)) for f in dataclasses.fields(settings)
                    if not f.name.startswith("check_"))
-    up = None if vertical is None else (_digest(vertical.acc), float(vertical.dt))
-    return (_digest(excitation.acc), float(excitation.dt), up, search, column)
+    up = None if vertical is None else (digest(vertical.acc), float(vertical.dt))
+    return (digest(excitation.acc), float(excitation.dt), up, search, column)
 
 
 def remembered(k, search):
     """``search()``'s result ``(RequiredWidth, widths run)``, or a copy of the one kept for ``k``."""
-    if _size:
-        hit = _kept.get(k)
-        if hit is not None:
-            _kept.move_to_end(k)
-            return copy.deepcopy(hit)
-    res = search()
-    if _size:
-        _kept[k] = copy.deepcopy(res)
-        while len(_kept) > _size:
-            _kept.popitem(last=False)
-    return res
+    return _kept.remembered(k, search)

@@ -8,17 +8,13 @@ same rows to the last bit, without the repeated work.
 """
 from __future__ import annotations
 
-import collections
-import copy
-import hashlib
-
-import numpy as np
+from rocking.searches import Kept, digest
 
 #: results kept per kind in a worker: a pool's tasks come back for their next pass after the
 #: pass's other tasks, so this covers a few pairs of 38 directions and two heights
 KEPT = 256
 
-_kept: dict[str, collections.OrderedDict] = {}
+_kept: dict[str, Kept] = {}
 
 
 def on() -> None:
@@ -26,8 +22,8 @@ def on() -> None:
     from rocking import searches
 
     searches.keep(KEPT)
-    _kept.setdefault("fit", collections.OrderedDict())
-    _kept.setdefault("slenderness", collections.OrderedDict())
+    _kept.setdefault("fit", Kept(KEPT))
+    _kept.setdefault("slenderness", Kept(KEPT))
 
 
 def off() -> None:
@@ -40,21 +36,10 @@ def off() -> None:
 
 def samples_key(record) -> tuple:
     """A record's samples, time axis and name, as a key."""
-    digest = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes()).hexdigest()
-    return digest, float(record.dt), float(record.t_start), str(record.name)
+    return digest(record.acc), float(record.dt), float(record.t_start), str(record.name)
 
 
 def remembered(kind: str, key, compute):
     """``compute()``, or a copy of the result kept for ``key`` (kept only after :func:`on`)."""
     kept = _kept.get(kind)
-    if kept is None:
-        return compute()
-    hit = kept.get(key)
-    if hit is not None:
-        kept.move_to_end(key)
-        return copy.deepcopy(hit)
-    res = compute()
-    kept[key] = copy.deepcopy(res)
-    while len(kept) > KEPT:
-        kept.popitem(last=False)
-    return res
+    return compute() if kept is None else kept.remembered(key, compute)

@@ -237,7 +237,7 @@ SUITE_COLUMNS = Columns(
     ("cap_mass_ratio", "-", "Cap beam mass over the columns' mass (0: a lone column)."),
     ("n_records", "-", "Records of the suite with results: a pair counts once, whatever its directions."),
     ("n_rows", "-", "Record directions with results (rows of `summary.csv` for this column)."),
-    ("width_all_m", "m", "Width that survives every record in every direction: the largest verified "
+    ("width_all_m", "m", "Width that survives every record in every direction: the largest design "
                          "width of the suite."),
     ("width_all_but_one_m", "m", "Width that survives all records but one (each record counted by its "
                                  "governing direction): the second largest governing design width "
