@@ -240,7 +240,7 @@ def summary_figure(rows) -> Figure:
     ax2.set_ylim(0, hi2)
     ax2.set_xlabel("Eq. 31 design tan(alpha)", fontsize=LABEL_SIZE)
     ax2.set_ylabel("design tan(alpha) (full record)", fontsize=LABEL_SIZE)
-    ax2.set_title("Eq. 31 against the design width (below the line: Eq. 31 conservative)", fontsize=TITLE_SIZE - 1)
+    ax2.set_title("Eq. 31 against the design width (below the line: conservative)", fontsize=TITLE_SIZE - 1)
     for ax in (ax1, ax2):
         _style(ax)
     return fig
