@@ -124,6 +124,12 @@ class SearchSettings:
     check_zoom: float = 0.3
     check_zoom_points: int = 4
     check_zoom_width: float = 2e-4
+    check_layout: str = "rounds"
+    check_bin_width: float = 0.005
+    check_scale: float = 0.1
+    check_bin_runs: float = 6.0
+    check_zoom_ratio: float = 0.9
+    check_zoom_peaks: int = 2
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -148,6 +154,12 @@ class SearchSettings:
                              "check_zoom_points 0 or more, check_zoom_width in (0, 1), got "
                              f"{self.check_zoom!r}, {self.check_zoom_points!r}, "
                              f"{self.check_zoom_width!r}")
+        if self.check_layout not in ("rounds", "bins") or not 0.0 < self.check_bin_width \
+                or not self.check_scale > 0.0 or self.check_bin_runs < 0 or self.check_zoom_peaks < 0:
+            raise ValueError("SearchSettings.check_layout must be 'rounds' or 'bins', check_bin_width "
+                             "and check_scale positive, check_bin_runs and check_zoom_peaks 0 or more, "
+                             f"got {self.check_layout!r}, {self.check_bin_width!r}, "
+                             f"{self.check_scale!r}, {self.check_bin_runs!r}, {self.check_zoom_peaks!r}")
         if self.check_rounds < 1:
             raise ValueError(f"SearchSettings.check_rounds must be at least 1, got {self.check_rounds!r}")
         if not 0.0 < self.design_rtol < 1.0:

@@ -49,6 +49,15 @@ def _bracket_step() -> float:
     return (1.0 / s.record_low) ** (1.0 / (s.record_scan - 1))
 
 
+def reach(settings) -> float:
+    """How far above its search width ``w`` a direction's check looks, over ``w``: one span
+    (``check_span``) for the binned layout, ``check_span ** check_rounds`` for the rounds (each
+    round's span is at most ``check_span`` times the width the round before left)."""
+    if settings.check_layout == "bins":
+        return float(settings.check_span)
+    return float(settings.check_span) ** int(settings.check_rounds)
+
+
 def staged(task, options) -> bool:
     """Whether ``task`` is computed in passes: a direction of a pair, without ``--thorough``."""
     return task.direction is not None and not options.thorough
@@ -82,6 +91,8 @@ class _Direction:
     plotted: bool
     #: per column label: (verified width, check top, widest failing width or None)
     columns: dict
+    #: checked in full (not only above a bound)
+    full: bool = True
 
 
 class Plan:
@@ -91,8 +102,13 @@ class Plan:
         from rocking.search import DEFAULT_SETTINGS
 
         self.options = options
-        self.span = float(DEFAULT_SETTINGS.check_span) ** int(DEFAULT_SETTINGS.check_rounds)
+        #: the check's layout is separable in a threshold: a check above a bound runs only there
+        self.separable = DEFAULT_SETTINGS.check_layout == "bins"
+        self.span = reach(DEFAULT_SETTINGS)
         self.step = _bracket_step()
+        #: what a lower bound of the pair's design width is divided by to give check_above: the
+        #: binned check refines its own bracket across the bound; the rounds' is allowed for here
+        self.below = 1.0 if self.separable else self.step
         self.pairs: dict[str, dict[int, _Direction]] = {}
         #: the directions held back from the first pass (indices)
         self.held = set(held)
@@ -114,7 +130,8 @@ class Plan:
                                  for k in ("verified_width_m", "height_m", "pga_g", "widest_failing_width_m"))
             # the widest design width its check could set (above the reach of its rounds)
             cols[r["column"]] = (w, self.step * min(self.span * w, H * pga), widest)
-        group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols)
+        full = bool(task.check) and not (self.separable and any(task.check_above))
+        group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols, full)
 
     def next_pass(self, tasks) -> list:
         """The tasks to compute next (their switches set), from ``tasks`` (the run's tasks, by
@@ -123,11 +140,11 @@ class Plan:
             return self._second_pass(tasks)
         out = []
         for group in self.pairs.values():
-            want, design = _wanted(group, bool(self.options.plots))
+            want, design, whole = _wanted(group, bool(self.options.plots))
             for i, plot in sorted(want.items()):
                 # the governing direction's check whole; the others' rounds where they could reach
                 # above the pair's design width so far
-                above = () if plot else tuple(design.get(c.label, 0.0) * (1.0 - MARGIN) / self.step
+                above = () if plot or i in whole else tuple(design.get(c.label, 0.0) * (1.0 - MARGIN) / self.below
                                               for c in tasks[i].columns)
                 out.append(dataclasses.replace(tasks[i], check=True, check_above=above, plot=plot or tasks[i].plot))
         return out
@@ -145,25 +162,26 @@ class Plan:
             for d in group.values():
                 for label, (w, _, _) in d.columns.items():
                     lower[label] = max(lower.get(label, 0.0), w)
-            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) / self.step for c in t.columns)
+            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) / self.below for c in t.columns)
             out.append(dataclasses.replace(t, check=True, check_above=above))
         self.held = set()
         return out
 
 
-def _wanted(group, plots: bool) -> tuple[dict, dict]:
+def _wanted(group, plots: bool) -> tuple[dict, dict, set]:
     """``{index: draw}`` of the directions of one pair to compute (checked) next, and the pair's
     design width so far by column label (where its governing direction is checked)."""
-    want, designs = {}, {}
+    want, designs, whole = {}, {}, set()
     labels = {c for d in group.values() for c in d.columns}
     for label in labels:
         dirs = [d for d in sorted(group.values(), key=lambda d: d.index) if label in d.columns]
         gov = max(dirs, key=lambda d: d.columns[label][0])  # the first of equal widths
-        if not gov.checked or (plots and not gov.plotted):
+        if not gov.full or (plots and not gov.plotted):
             want[gov.index] = plots
+            whole.add(gov.index)
             continue
         design = designs[label] = max(max(w, f or 0.0) for d in dirs if d.checked for w, _, f in [d.columns[label]])
         for d in dirs:
             if not d.checked and d.columns[label][1] > design * (1.0 - MARGIN):
                 want.setdefault(d.index, False)
-    return want, designs
+    return want, designs, whole
