@@ -520,6 +520,8 @@ def _check_bins(res, top, evaluate, settings, seed, seen):
     xs, fs, rs = (np.asarray(v) for v in seen)
     above = float(settings.check_above)
     (cx, cf, cr), hi = binned.check(res.width, top, evaluate, (xs, fs, rs), settings, seed, above)
+    if not cx.size:   # no bin above check_above: as unchecked (the search's runs are above w)
+        return xs, fs, rs
     xs, fs, rs = np.concatenate([xs, cx]), np.concatenate([fs, cf]), np.concatenate([rs, cr])
     _raise_to_failures(res, evaluate, (xs, fs), settings)
     where = f"above {above:.6g} m " if above > res.search_width else ""

@@ -91,8 +91,12 @@ class _Direction:
     plotted: bool
     #: per column label: (verified width, check top, widest failing width or None)
     columns: dict
-    #: checked in full (not only above a bound)
-    full: bool = True
+    #: checked in full, not only above a bound (None: as ``checked``)
+    full: bool | None = None
+
+    def __post_init__(self):
+        if self.full is None:
+            self.full = self.checked
 
 
 class Plan:
