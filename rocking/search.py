@@ -80,6 +80,19 @@ class SearchSettings:
     sizes were chosen from
     ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
 
+    ``check_layout="bins"`` (the default; :mod:`rocking.binned`, docs/slivers.md, "A check
+    separable in a threshold"): one span ``(w, min(check_span w, top)]`` cut into bins
+    ``check_bin_width w`` wide.  The first stage as above; then ``check_stages`` stages giving
+    each bin ``floor(check_bin_runs q**check_power + u)`` widths, ``q`` its spread over the fixed
+    ``check_scale`` (at most 1; 1 where a width in it failed), ``u`` a seeded uniform draw; then a
+    zoom around at most ``check_zoom_peaks`` surviving widths of each bin with
+    ``max|theta|/alpha >= check_zoom_ratio``.  A bin's widths depend only on its own runs, so
+    ``check_above`` runs only the bins above it (and below it down to the first with a width run
+    at or below it), and gives exactly the full check's widths, verdicts and design width above it
+    (pipeline/batch/passes.py).  The number of runs varies from record to record (only the first
+    stage's, ``check_runs (1 - check_follow)``, is fixed); ``check_zoom`` and ``check_rounds``
+    belong to the rounds layout (``check_layout="rounds"``, the former default, described above).
+
     The design width: where the check finds a failing width above the search's answer, the
     bracket above the widest failing width (up to the next width run, which survived) is bisected
     to ``design_rtol`` relative, and its surviving end is the design width
@@ -124,10 +137,10 @@ class SearchSettings:
     check_zoom: float = 0.3
     check_zoom_points: int = 4
     check_zoom_width: float = 2e-4
-    check_layout: str = "rounds"
+    check_layout: str = "bins"
     check_bin_width: float = 0.005
-    check_scale: float = 0.1
-    check_bin_runs: float = 6.0
+    check_scale: float = 0.07
+    check_bin_runs: float = 20.0
     check_zoom_ratio: float = 0.9
     check_zoom_peaks: int = 2
 
