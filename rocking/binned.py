@@ -69,6 +69,15 @@ def first_widths(width, hi, settings, seed) -> np.ndarray:
     return np.sort(np.concatenate([near, spread]))
 
 
+def most_runs(width, hi, settings) -> int:
+    """The most widths the check can run over ``(width, hi]``: the first stage, and in every bin
+    ``check_bin_runs`` a later stage and ``check_zoom_peaks check_zoom_points`` in the zoom."""
+    k = edges(width, hi, settings).size - 1
+    per_bin = int(settings.check_stages) * int(math.floor(settings.check_bin_runs)) \
+        + int(settings.check_zoom_peaks) * int(settings.check_zoom_points)
+    return first_widths(width, hi, settings, 0).size + max(k, 0) * per_bin
+
+
 def bin_of(e, widths) -> np.ndarray:
     """The bin of each width (-1 below the span or at its foot, ``len(e) - 1`` above it)."""
     return np.searchsorted(e, np.asarray(widths, dtype=float), side="left") - 1
