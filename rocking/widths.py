@@ -519,6 +519,8 @@ def _check_bins(res, top, evaluate, settings, seed, seen):
 
     xs, fs, rs = (np.asarray(v) for v in seen)
     above = float(settings.check_above)
+    if res.limit:   # the ratios are over the level: their spread is measured in max|theta|/alpha
+        settings = settings.replace(check_scale=settings.check_scale / res.limit)
     (cx, cf, cr), hi = binned.check(res.width, top, evaluate, (xs, fs, rs), settings, seed, above)
     if not cx.size:   # no bin above check_above: as unchecked (the search's runs are above w)
         return xs, fs, rs
