@@ -13,7 +13,10 @@ and which widths a bin runs depends only on the search width, the seed and the v
    widths, ``q = min(s / check_scale, 1)``, ``s`` the standard deviation of ``min(max|theta|/alpha,
    1)`` over the widths run so far in the bin (1 where one of them failed), ``u`` a uniform draw of
    the seed's per bin and stage: a fixed scale, not the span's largest bin, so that a bin's share
-   does not depend on the others (the total varies from record to record);
+   does not depend on the others (the total varies from record to record; with a performance
+   level R the ratios are over R, and :func:`rocking.widths._check_bins` divides the scale by R;
+   ``check_bin_runs`` is scaled down where the search's runs alone promise more than
+   ``check_budget``, :func:`budgeted`: the search is run whole in every direction);
 3. a zoom stage: in each bin, around at most ``check_zoom_peaks`` surviving widths that came
    nearest to failing (``max|theta|/alpha >= check_zoom_ratio``, the largest first, peaks closer
    than two zoom widths counted once), ``check_zoom_points`` jittered widths within
@@ -87,6 +90,21 @@ def follow_widths(e, on, widths, ratio, failed, settings, seed, stage) -> np.nda
     """One later stage's widths (m, ascending) in the bins ``on`` (bool per bin), each bin's count
     from its own runs (``widths``, ``ratio``, ``failed``) against the fixed scale."""
     k = e.size - 1
+    most = int(math.ceil(settings.check_bin_runs)) + 1
+    rng = np.random.default_rng([seed, stage])
+    u = rng.random(k)                       # drawn for every bin: a bin's draws never depend on
+    v = rng.random((k, most))               # which other bins run
+    alloc = np.floor(settings.check_bin_runs * weights(e, widths, ratio, failed, settings) + u).astype(int)
+    alloc[~on] = 0
+    # strata (e_j, e_j+1]: a width on a lower edge would belong to the bin below
+    x = [e[j] + (e[j + 1] - e[j]) * (np.arange(a) + 1.0 - v[j, :a]) / a
+         for j, a in enumerate(alloc) if a > 0]
+    return np.sort(np.concatenate(x)) if x else np.zeros(0)
+
+
+def weights(e, widths, ratio, failed, settings) -> np.ndarray:
+    """Each bin's ``q ** check_power`` from its own runs (``widths``, ``ratio``, ``failed``)."""
+    k = e.size - 1
     idx = bin_of(e, widths)
     inside = (idx >= 0) & (idx < k)
     idx = idx[inside]
@@ -98,16 +116,19 @@ def follow_widths(e, on, widths, ratio, failed, settings, seed, stage) -> np.nda
     spread = np.where(count >= 2, np.sqrt(np.maximum(var, 0.0)), 0.0)
     q = np.minimum(spread / settings.check_scale, 1.0)
     q[np.bincount(idx[failed], minlength=k) > 0] = 1.0
-    most = int(math.ceil(settings.check_bin_runs)) + 1
-    rng = np.random.default_rng([seed, stage])
-    u = rng.random(k)                       # drawn for every bin: a bin's draws never depend on
-    v = rng.random((k, most))               # which other bins run
-    alloc = np.floor(settings.check_bin_runs * q ** settings.check_power + u).astype(int)
-    alloc[~on] = 0
-    # strata (e_j, e_j+1]: a width on a lower edge would belong to the bin below
-    x = [e[j] + (e[j + 1] - e[j]) * (np.arange(a) + 1.0 - v[j, :a]) / a
-         for j, a in enumerate(alloc) if a > 0]
-    return np.sort(np.concatenate(x)) if x else np.zeros(0)
+    return q ** settings.check_power
+
+
+def budgeted(e, seen, settings):
+    """``settings`` with ``check_bin_runs`` scaled down where the search's own runs (run whole in
+    every direction, so still separable) promise more than ``check_budget`` widths to the later
+    stages: a record irregular everywhere gets the budget, not 20 widths a stage in every bin."""
+    if settings.check_budget <= 0 or e.size < 2:
+        return settings
+    expected = int(settings.check_stages) * settings.check_bin_runs * weights(e, *seen, settings).sum()
+    if expected <= settings.check_budget:
+        return settings
+    return settings.replace(check_bin_runs=settings.check_bin_runs * settings.check_budget / expected)
 
 
 def zoom_widths(e, on, widths, ratio, failed, settings, seed) -> np.ndarray:
@@ -180,6 +201,7 @@ def check(width, top, evaluate, seen, settings, seed, above=0.0):
     if not e.size:
         return (np.zeros(0), np.zeros(0, dtype=bool), np.zeros(0)), hi
     first = first_widths(width, hi, settings, seed)
+    settings = budgeted(e, seen, settings)
     k = e.size - 1
     lowest = int(np.searchsorted(e[1:], above, side="right"))   # first bin whose top is above
     on = np.zeros(k, dtype=bool)

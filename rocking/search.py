@@ -86,7 +86,11 @@ class SearchSettings:
     each bin ``floor(check_bin_runs q**check_power + u)`` widths, ``q`` its spread over the fixed
     ``check_scale`` (at most 1; 1 where a width in it failed), ``u`` a seeded uniform draw; then a
     zoom around at most ``check_zoom_peaks`` surviving widths of each bin with
-    ``max|theta|/alpha >= check_zoom_ratio``.  A bin's widths depend only on its own runs, so
+    ``max|theta|/alpha >= check_zoom_ratio``.  Where the search's own runs (``check_budget`` > 0)
+    promise the later stages more than ``check_budget`` widths (``check_stages check_bin_runs
+    sum(q**check_power)`` over the bins, from the search's runs alone), ``check_bin_runs`` is scaled
+    down to it: a record irregular everywhere gets the budget.  A bin's widths depend only on its
+    own runs and the search's, so
     ``check_above`` runs only the bins above it (and below it down to the first with a width run
     at or below it), and gives exactly the full check's widths, verdicts and design width above it
     (pipeline/batch/passes.py).  The number of runs varies from record to record (only the first
@@ -143,6 +147,7 @@ class SearchSettings:
     check_bin_runs: float = 20.0
     check_zoom_ratio: float = 0.9
     check_zoom_peaks: int = 2
+    check_budget: float = 0.0
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -168,7 +173,8 @@ class SearchSettings:
                              f"{self.check_zoom!r}, {self.check_zoom_points!r}, "
                              f"{self.check_zoom_width!r}")
         if self.check_layout not in ("rounds", "bins") or not 0.0 < self.check_bin_width \
-                or not self.check_scale > 0.0 or self.check_bin_runs < 0 or self.check_zoom_peaks < 0:
+                or not self.check_scale > 0.0 or self.check_bin_runs < 0 or self.check_zoom_peaks < 0 \
+                or self.check_budget < 0:
             raise ValueError("SearchSettings.check_layout must be 'rounds' or 'bins', check_bin_width "
                              "and check_scale positive, check_bin_runs and check_zoom_peaks 0 or more, "
                              f"got {self.check_layout!r}, {self.check_bin_width!r}, "
