@@ -52,7 +52,8 @@ class SearchSettings:
     record_near``: isolated failing bands of real records sit where the block nearly overturns);
     at most ``record_rounds`` rounds (a failure found above the candidate moves it up).
 
-    The check above a record's verified width ``w`` (docs/slivers.md;
+    The check in rounds above a record's verified width ``w`` (``check_layout="rounds"``, the former
+    default; docs/slivers.md;
     :func:`rocking.widths.check_widths`, :func:`rocking.widths.follow_widths`): ``check_runs``
     widths from ``w`` to ``check_span`` times ``w`` or the no-uplift width, whichever is smaller,
     jittered (one random width in each of equal strata; seeded from the record, so a re-run gives
@@ -100,7 +101,7 @@ class SearchSettings:
     The design width: where the check finds a failing width above the search's answer, the
     bracket above the widest failing width (up to the next width run, which survived) is bisected
     to ``design_rtol`` relative, and its surviving end is the design width
-    (:attr:`rocking.widths.RequiredWidth.width`).  The check runs in ``check_rounds`` rounds sharing
+    (:attr:`rocking.widths.RequiredWidth.width`).  The rounds layout runs ``check_rounds`` rounds sharing
     ``check_runs``, each above the design width the rounds before it left (its span starts
     there).  ``check_seed``: the check's seed (None: made
     from the record's samples and the column, so a re-run gives the same widths).
