@@ -56,7 +56,7 @@ WRAPPER = ("import json, os, resource, sys\n"
            "s = resource.getrusage(resource.RUSAGE_SELF)\n"
            "print(json.dumps({'code': code, 'self': s.ru_utime + s.ru_stime, 'pid': os.getpid()}))\n")
 #: the check's columns and the verdicts compared row by row
-COMPARED = ["verified_width_m", "overturns", "eq31_width_m", "eq31_width_overturns", "failing_share",
+COMPARED = ["design_width_m", "overturns", "eq31_width_m", "eq31_width_overturns", "failing_share",
             "widest_failing_width_m", "check_runs", "pulse_shape", "pulse_ap_g", "pulse_tp_s"]
 
 
@@ -100,7 +100,7 @@ def run_one(python, pair, out, jobs, extra=(), log=False) -> dict:
 
 def design_width(rows) -> float:
     """The pair's design width: the widest verified or failing width over its directions (m)."""
-    return max(max(float(r["verified_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
+    return max(max(float(r["design_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
 
 
 def same_rows(a, b) -> bool:

@@ -349,7 +349,7 @@ def test_cli_spectrum_and_chart_mark_your_column(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------------- fast searches
-def _brute_verified_width(height, record, lo, hi, n):
+def _brute_design_width(height, record, lo, hi, n):
     """Brute force: ``n`` uniform widths on ``[lo, hi]`` (every one run), the verified width is the
     scanned width just above the widest failing one; also returns the scan step."""
     xs = np.linspace(lo, hi, n)
@@ -379,7 +379,7 @@ def test_record_width_search_matches_brute_force_synthetic(height):
     rec = _near_fault_record()
     fast = rocking.required_width(height, rec, rule="exact")
     top = height * rec.pga / G
-    brute, step = _brute_verified_width(height, rec, top / 1500, top, 1500)
+    brute, step = _brute_design_width(height, rec, top / 1500, top, 1500)
     # the same transition, to the brute force's resolution (the fast one is refined to 1e-9)
     assert abs(fast.width - brute) <= step
     # 132 scanned widths, ~365 of the fine zone (0.05 % apart over 20 %), ~25 bisection steps
@@ -404,7 +404,7 @@ def test_record_width_search_matches_brute_force_rinaldi(shared_records):
     rec = pulses.read_record(shared_records / "NGA_no_1063_RRS228.AT2")
     fast = rocking.required_width(7.5, rec, rule="exact")
     assert fast.width == pytest.approx(1.64991, abs=1e-5)
-    brute, step = _brute_verified_width(7.5, rec, 1.3, 2.3, 1000)
+    brute, step = _brute_design_width(7.5, rec, 1.3, 2.3, 1000)
     assert abs(fast.width - brute) <= step
     assert len(fast.transitions) >= 3      # a safe island below the answer is reported
 
@@ -423,7 +423,7 @@ def test_record_width_search_not_below_brute_force_real(name, height):
     rec = pulses.read_record(shared_record(name))
     fast = rocking.required_width(height, rec, rule="exact")
     top = height * rec.pga / G
-    brute, step = _brute_verified_width(height, rec, top / 1500, top, 1500)
+    brute, step = _brute_design_width(height, rec, top / 1500, top, 1500)
     assert fast.width >= brute - step
     assert fast.search_width <= 1.05 * brute
     # the design width may lie further up only above a failing width the check found (which

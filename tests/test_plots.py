@@ -119,12 +119,12 @@ def test_summary_figure_plots_the_rows():
     """The summary's points are the rows' numbers: required against actual tan(alpha) for columns as
     they stand, split by verdict, and verified against Eq. 31 design for every row."""
     rows = [
-        {"column_kind": "block", "tan_alpha": 0.24, "governing_eq31_tan_alpha": 0.2, "verified_tan_alpha": 0.18,
+        {"column_kind": "block", "tan_alpha": 0.24, "governing_eq31_tan_alpha": 0.2, "design_tan_alpha": 0.18,
          "overturns": False, "eq31_width_tan_alpha": 0.2, "eq31_width_overturns": False},
         {"column_kind": "block", "tan_alpha": "0.15", "governing_eq31_tan_alpha": "0.3",
-         "verified_tan_alpha": "0.33", "overturns": True, "eq31_width_tan_alpha": "0.3",
+         "design_tan_alpha": "0.33", "overturns": True, "eq31_width_tan_alpha": "0.3",
          "eq31_width_overturns": True},
-        {"column_kind": "height", "tan_alpha": "", "eq31_width_tan_alpha": 0.25, "verified_tan_alpha": 0.21,
+        {"column_kind": "height", "tan_alpha": "", "eq31_width_tan_alpha": 0.25, "design_tan_alpha": 0.21,
          "eq31_width_overturns": False},
     ]
     fig = plots.summary_figure(rows)
@@ -162,7 +162,7 @@ def test_record_figure_velocity_pulse_and_verified_width(tmp_path):
     (label, curves), = histories
     assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "design width"]
     _, block_v, res_v = curves[2]
-    assert block_v.width == pytest.approx(rows[0]["verified_width_m"], rel=1e-12)
+    assert block_v.width == pytest.approx(rows[0]["design_width_m"], rel=1e-12)
     assert not res_v.overturned  # the verified width survives the record
     cls = pulses.classify_pulse(record)
     fig = plots.record_figure(task.record_id, record, fit, fitting, histories, velocity=cls)

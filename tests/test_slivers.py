@@ -187,15 +187,15 @@ def test_pipeline_reports_the_check(tmp_path):
     assert ver.search_width <= width < ver.widest_failing_width < ver.width
     assert main(["run", str(path), "--block", f"7.5x{width}", "--out", str(out), "-q"]) == 0
     row = next(csv.DictReader(open(out / "chaotic.csv")))
-    assert float(row["verified_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
+    assert float(row["design_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
     assert float(row["search_width_m"]) == pytest.approx(ver.search_width, rel=1e-5)
     assert float(row["failing_share"]) == pytest.approx(ver.failing_share, rel=1e-5)
     assert float(row["widest_failing_width_m"]) == pytest.approx(ver.widest_failing_width, rel=1e-5)
     assert int(float(row["check_runs"])) == ver.check_runs
     assert ver.check_runs + ver.refine_runs <= DEFAULT_SETTINGS.check_runs < ver.check_runs + 50
-    assert row["verified_adequate"] == "False"
+    assert row["design_adequate"] == "False"
     suite = next(csv.DictReader(open(out / "suite.csv")))
-    assert suite["share_column_verified"] == "0" and suite["share_column_checked"] == "0"
+    assert suite["share_column_adequate"] == "0" and suite["share_column_checked"] == "0"
     assert (out / "plots" / "widths" / "chaotic.png").stat().st_size > 10_000
     text = (out / "columns.md").read_text()
     assert "`widest_failing_width_m`" in text and "docs/slivers.md" in text

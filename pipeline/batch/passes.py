@@ -111,7 +111,7 @@ class Plan:
         for r in rows:
             # as the report holds them (6 digits): a resumed run decides as the first did
             w, H, pga, widest = (None if r.get(k) in (None, "") else float(fmt(float(r[k])))
-                                 for k in ("verified_width_m", "height_m", "pga_g", "widest_failing_width_m"))
+                                 for k in ("design_width_m", "height_m", "pga_g", "widest_failing_width_m"))
             # the widest design width its check could set (above the reach of its rounds)
             cols[r["column"]] = (w, self.step * min(self.span * w, H * pga), widest)
         group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols)
