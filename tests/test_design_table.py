@@ -3,9 +3,9 @@ verdict with the vertical, from rows of summary.csv."""
 from pipeline.reports.design_table import design_rows, excess_text, failing_text, metadata_text, table_text
 
 
-def _row(direction, verified, failing, overturns=False, vertical=None, search=None):
+def _row(direction, design, failing, overturns=False, vertical=None, search=None):
     return {"record": f"p@{direction}", "pair": "p", "column": "7.5x1.8", "column_kind": "block",
-            "direction_deg": direction, "design_width_m": verified, "widest_failing_width_m": failing,
+            "direction_deg": direction, "design_width_m": design, "widest_failing_width_m": failing,
             "overturns": overturns, "vertical_overturns": vertical, "width_m": 1.8,
             "design_adequate": True, "max_theta_ratio": 0.5, "search_width_m": search,
             "check_runs": 1500}
@@ -41,7 +41,7 @@ def test_metadata_line_of_a_peer_record():
     assert metadata_text({"record": "x"}) is None
 
 
-def test_excess_above_the_verified_width_is_shown_in_percent():
+def test_excess_above_the_search_width_is_shown_in_percent():
     # far above: 0.608 over 0.593 is +2.53 %; a tenth of a percent step resolves it
     assert excess_text(0.608, 0.593) == "+2.5 %"
     assert excess_text(0.75, 0.6) == "+25 %"

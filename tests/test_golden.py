@@ -30,7 +30,7 @@ Its peaks are compared at 2e-6 relative (a build whose rounding differs as much 
 record, 25 times the engines' difference), its verdicts exactly (no flip in 36 perturbed runs up
 to 1e-11), and its impact counts, those of the tiny hops of blocks coming to rest, within 50 %
 (measured: up to 27 % apart between perturbed runs, 7 % between the engines).  Critical amplitudes, slenderness transitions and islands are
-bisected on the same verdicts: 1e-9 relative.  Verified widths and critical scales of real
+bisected on the same verdicts: 1e-9 relative.  Exact widths and critical scales of real
 records: the issue's 0.5 % (measured: identical), with the same number of transitions.  The
 demo's summary: 2e-5 relative (6 significant digits printed).
 """

@@ -164,7 +164,7 @@ def test_failures_listed(tmp_path):
 
 
 def test_design_rows_of_a_pair():
-    """A pair counts once: its governing direction (widest verified width), survival over every
+    """A pair counts once: its governing direction (widest design width), survival over every
     direction."""
     base = dict(column="7.5x1.8", column_kind="block", width_m=1.8, scale=1.0, pulse_like=True,
                 velocity_tp_s=1.2, governing_shape="sine", governing_ap_g=0.5, governing_tp_s=0.8,

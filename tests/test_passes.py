@@ -1,4 +1,4 @@
-"""A pair's directions in passes (pipeline/batch/passes.py): the check above the verified width and the
+"""A pair's directions in passes (pipeline/batch/passes.py): the check above the search width and the
 figures only where they decide, the same design width as ``--thorough``.
 
 The synthetic pairs are those of tests/test_site.py (8 s, one-sine pulses in noise); the real
@@ -28,7 +28,7 @@ def _rows(out):
 
 
 def _design(rows) -> float:
-    """The pair's design width: the widest verified or failing width over its directions."""
+    """The pair's design width: the widest design or failing width over its directions."""
     return max(max(float(r["design_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
 
 
@@ -107,7 +107,7 @@ def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
                               "pga_g": 0.5, "widest_failing_width_m": None}])
     second = plan.next_pass(first)
     assert [t.index for t in second] == [1, 2, 5, 7]
-    # each checked where its check could reach above 1.3 m, the scouts' widest verified width
+    # each checked where its check could reach above 1.3 m, the scouts' widest design width
     step = passes._bracket_step()
     assert all(t.check and t.check_above == pytest.approx((1.3 / step,), rel=1e-5) for t in second)
     assert plan.held == set()

@@ -324,7 +324,7 @@ def test_cli_end_to_end_numbers_match_library(tmp_path):
     sim31 = rocking.simulate(rocking.Block.from_dimensions(7.5, w31), record)
     assert r["eq31_width_overturns"] == str(bool(sim31.overturned))
     assert close(r["eq31_width_max_theta_ratio"], sim31.max_rotation_ratio)
-    # the verified width under the full record
+    # the design width under the full record
     ver = rocking.required_width(7.5, record, rule="exact")
     assert close(r["design_width_m"], ver.width)
     assert r["design_adequate"] == str(1.8 >= ver.width)
@@ -386,7 +386,7 @@ def test_rinaldi_eq31_and_survival_of_the_temple_column(paper_run):
     # Fig. 11: the column (tan alpha 0.24) survives the full record ...
     assert r["overturns"] == "False"
     assert float(r["max_theta_ratio"]) < 1.0
-    # ... though only just: the verified width (survives at that and every larger width) is a few
+    # ... though only just: the design width (survives at that and every larger width) is a few
     # cm wider, 1.8 m stands on a safe island of the full record
     assert 1.7 <= float(r["design_width_m"]) <= 2.0
     assert r["design_adequate"] == str(1.8 >= float(r["design_width_m"]))

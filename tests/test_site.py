@@ -117,11 +117,11 @@ def test_pair_rows_governing_and_suite(pairs, pair_run, tmp_path):
         kinds = {r["direction_kind"] for r in mine}
         assert {"component-1", "component-2"} <= kinds
         assert all(r["file2"] for r in mine)
-        # the floor: the governing width is at least each recorded component's verified width
+        # the floor: the governing width is at least each recorded component's design width
         for r in mine:
             assert _f(g["design_width_m"]) >= _f(r["design_width_m"])
         assert _f(g["design_width_m"]) == max(_f(r["design_width_m"]) for r in mine)
-    # width_all_m is the largest verified width of the suite; all-but-one the second largest governing
+    # width_all_m is the largest design width of the suite; all-but-one the second largest governing
     widths = [_f(r["design_width_m"]) for r in rows]
     s = suite[0]
     assert _f(s["width_all_m"]) == max(widths)
@@ -159,7 +159,7 @@ def test_direction_equals_rotated_record_file(pairs, pair_run, tmp_path):
     assert _run(out, path, "--block", f"{H}x{B}") == 0
     (ref,) = _read(out / "summary.csv")
     # SAC stores float32: samples come back to a relative 6e-8, so the fit and the widths agree to
-    # far better than the 1e-4 asked here (the verified width's own bracket is 1e-3 relative)
+    # far better than the 1e-4 asked here (the search's own bracket is 1e-3 relative)
     for key in ("pga_g", "pgv_m_s", "design_width_m", "eq31_width_m", "envelope_width_m",
                 "max_theta_ratio", "pulse_tp_s"):
         assert _f(row[key]) == pytest.approx(_f(ref[key]), rel=1e-4), key
@@ -200,7 +200,7 @@ def test_scale_and_scales(pairs, tmp_path):
     (r1,), (r2,) = _read(out1 / "summary.csv"), _read(out2 / "summary.csv")
     assert r1["scale"] == "1" and r2["scale"] == "2"
     assert _f(r2["pga_g"]) == pytest.approx(2 * _f(r1["pga_g"]), rel=1e-5)
-    # the verified width of the scaled record, from the library on the record scaled here
+    # the design width of the scaled record, from the library on the record scaled here
     rec = pulses.read_record(a1).scaled(2.0)
     ref = rocking.required_width(H, rec, rule="exact").width
     assert _f(r2["design_width_m"]) == pytest.approx(ref, rel=1e-5)
@@ -284,7 +284,7 @@ def test_fragility_outputs(pairs, tmp_path):
 
 @pytest.mark.slow
 def test_suite_and_fragility_plots():
-    """The suite plot draws the share of records verified at each width (step curve through the
+    """The suite plot draws the share of records whose design width is at most each width (step curve through the
     sorted governing widths) and marks the column; PNGs are at least 1000 px wide."""
     import io
 

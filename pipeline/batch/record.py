@@ -60,7 +60,7 @@ def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
            "failure": None, "plot": None, "widths_plot": None}
     try:
-        rows, fit_parts, verified = _process(task)
+        rows, fit_parts, designs = _process(task)
         out["rows"] = rows
     except StageError as err:
         out["failure"] = failure(task, err.stage, err.exc)
@@ -75,18 +75,18 @@ def _process_record(task: Task) -> dict:
 
         try:
             out["plot"] = _stage("plot", run_figure_png, task.record_id, *fit_parts)
-            out["widths_plot"] = _stage("plot", _widths_png, task.record_id, verified)
+            out["widths_plot"] = _stage("plot", _widths_png, task.record_id, designs)
         except StageError as err:
             out["failure"] = failure(task, err.stage, err.exc)
     return out
 
 
-def _widths_png(record_id, verified):
-    """``plots/widths/<record>.png`` where the check above a verified width found failing widths
+def _widths_png(record_id, designs):
+    """``plots/widths/<record>.png`` where the check above a search width found failing widths
     (docs/slivers.md); None elsewhere."""
     from ..reports.plot_widths import record_widths_png
 
-    return record_widths_png(record_id, {f"{H:g} m": v for H, v in verified.items()})
+    return record_widths_png(record_id, {f"{H:g} m": v for H, v in designs.items()})
 
 
 FAILURE_COLUMNS = Columns(
@@ -378,7 +378,7 @@ DESIGN_WIDTH_COLUMNS = Columns(
     ("design_tan_alpha", "-", "tan(alpha) of the design width, design_width_m / height_m."),
     ("design_adequate", "-", "The column as it stands is at least as wide as the design width "
                                "(blank for `--height`). A column that survives (`overturns` False) "
-                               "but is not verified-adequate stands on a safe island: some slightly "
+                               "but is not design-adequate stands on a safe island: some slightly "
                                "wider column of the same height overturns under the same record."),
     ("search_width_m", "m", "Diagnostic: the search's first transition (the smallest width above "
                             "which every width the search examined survives; `search_width`), "
@@ -415,7 +415,7 @@ CHECK_COLUMNS = Columns(
                                     "the search width (a failing sliver; blank where none was found, "
                                     "which does not prove there is none); the design width lies just "
                                     "above it."),
-    ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width (0: "
+    ("check_runs", "-", "Number of widths (solver runs) of the check above the search width (0: "
                         "not checked; fewer than its 1500 where its later rounds could not reach the "
                         "pair's design width, docs/site.md)."),
 )

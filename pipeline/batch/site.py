@@ -253,7 +253,7 @@ SUITE_COLUMNS = Columns(
     ("share_column_checked", "-", "Share of the records whose governing design width the column as it "
                                   "stands reaches and that the check above the search width "
                                   "(`failing_share`, docs/slivers.md) found no failing width at or above "
-                                  "the column's width, in any direction: verified with the same check as "
+                                  "the column's width, in any direction: judged with the same check as "
                                   "each record's `widest_failing_width_m` (blank for `--height`)."),
     ("share_eq31_survives", "-", "Share of the records under which the column's Eq. 31 design (for each "
                                  "direction, its own Eq. 31 width) does not overturn, in any direction."),

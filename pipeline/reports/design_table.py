@@ -177,15 +177,16 @@ def _m(value):
     return "-" if v is None else f"{v:.3f}"
 
 
-def excess_text(value, verified) -> str | None:
-    """``+2.5 %``: how far the width ``value`` lies above the ``verified`` width, relative to it.
+def excess_text(value, reference) -> str | None:
+    """``+2.5 %``: how far the width ``value`` lies above the ``reference`` width (the search
+    width, in the reports), relative to it.
 
     Whole percent from 10 % (``+25 %``), tenths from 1 % (``+2.5 %``), hundredths below
     (``+0.25 %``, ``+0.02 %``) and ``<+0.01 %`` below 0.01 %, so that a failing width a hair above
-    the verified one never reads as ``+0.0 %``.  None when either is blank or ``value`` is not
-    above ``verified``.
+    the reference never reads as ``+0.0 %``.  None when either is blank or ``value`` is not
+    above ``reference``.
     """
-    v, ref = number(value), number(verified)
+    v, ref = number(value), number(reference)
     if v is None or ref is None or ref <= 0 or v <= ref:
         return None
     pct = 100.0 * (v - ref) / ref
@@ -194,14 +195,14 @@ def excess_text(value, verified) -> str | None:
     return f"+{pct:.{0 if pct >= 10 else 1 if pct >= 1 else 2}f} %"
 
 
-def failing_text(value, verified, unit=" m") -> str | None:
-    """``0.608 m (+2.5 %)``: a failing width with how far it lies above ``verified``
+def failing_text(value, reference, unit=" m") -> str | None:
+    """``0.608 m (+2.5 %)``: a failing width with how far it lies above ``reference``
     (:func:`excess_text`; metres only where that is blank); None where ``value`` is blank.
     ``unit=""`` gives ``0.608 (+2.5 %)`` for a column headed in metres."""
     v = number(value)
     if v is None:
         return None
-    excess = excess_text(v, verified)
+    excess = excess_text(v, reference)
     return f"{v:.3f}{unit}" + (f" ({excess})" if excess else "")
 
 
@@ -333,7 +334,7 @@ def table_text(rows, failures=(), summary=()) -> str:
             if w is not None:
                 widths[key] = max(w, widths.get(key, w))
         headers = HEADERS + (VERTICAL_HEADER,)
-        body = [c + (vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
+        body = [c + (vertical_text(r) + (f", design {widths[(r['record'], r.get('column'))]:.3f} m"
                                           if (r["record"], r.get("column")) in widths else ""),)
                 for c, r in zip(body, rows)]
     body = _align_failing(body, FAILS_COLUMN)

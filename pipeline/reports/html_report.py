@@ -286,7 +286,7 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
                        + "</tr>")
         out.append("</tbody></table>")
     site = [(k, label) for k, label in (("summary", "Required against actual slenderness"),
-                                        ("suite", "Suite: share of records verified against width"),
+                                        ("suite", "Suite: share of records whose design width a column of width B reaches"),
                                         ("fragility", "Collapse fragility")) if figures.get(k)]
     if site:
         out.append("<h2>Batch figures</h2>")

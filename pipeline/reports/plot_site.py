@@ -1,4 +1,4 @@
-"""Plots of a suite (``pipeline run``): share of the suite verified against width, and the collapse
+"""Plots of a suite (``pipeline run``): share of the suite covered against width, and the collapse
 fragility curves.  matplotlib's public object API only (a new :class:`matplotlib.figure.Figure` per
 plot, saved without the software-version text, so a re-run gives the same bytes)."""
 from __future__ import annotations
