@@ -148,7 +148,7 @@ def test_pipeline_run_limit(tmp_path):
         out = tmp_path / name
         assert main(["run", path, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"] + extra) == 0
         row = next(csv.DictReader(open(out / "design.csv")))
-        widths[name] = float(row["verified_width_m"])
+        widths[name] = float(row["design_width_m"])
         assert row["design_limit"] == ("0.5" if extra else "")
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
