@@ -93,11 +93,11 @@ class RequiredWidth:
     #: a level designed given its overturning design (``overturning=``): that design's width (m;
     #: with a vertical, the wider of the two motions'); :attr:`width` is at least it
     overturning_width: float | None = None
-    #: widths of :attr:`total_runs` whose run the overturning design had made (same column,
-    #: record and solver: the same outcome to rounding), answered from it, not run again
+    #: widths of :attr:`total_runs` that the overturning design had run in the same batch (same
+    #: column, record and solver: the same computation), answered from it, not run again
     shared_runs: int = 0
-    #: every width a record's exact design ran, ascending, with whether it overturned and its
-    #: max|theta|/alpha: ``(widths, overturned, ratio)`` (a level given this design reuses them)
+    #: a record's overturning design: every batch it ran, in order, as ``(widths, overturned,
+    #: max|theta|/alpha)`` arrays (a level given this design reuses the same batches)
     outcomes: tuple | None = field(default=None, repr=False, compare=False)
     #: what the runs depend on (record and vertical hashed, height, restitution, frame, model):
     #: a level may reuse only the runs of the same inputs
@@ -370,17 +370,19 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
 
 
 class _Runs:
-    """The solver runs of one record's exact design: ``outcomes(widths)`` gives whether each
-    overturned and its max|theta|/alpha, answering the widths the overturning design
-    (``overturning``, same ``inputs``) ran from its :attr:`RequiredWidth.outcomes` and running
-    the others; it counts the widths so answered and keeps every outcome.
+    """The solver runs of one record's exact design: ``outcomes(widths)`` gives whether each width
+    of a batch overturned and its max|theta|/alpha.  A batch the overturning design
+    (``overturning``, same ``inputs``) ran, the same widths in the same order, is answered from
+    its :attr:`RequiredWidth.outcomes`, the others are run; it counts the widths so answered and
+    keeps every batch.
 
-    A width's outcome is the solver's whichever batch ran it, to rounding (a batch's lanes share
-    their Taylor order and its forcing grid follows its stiffest block: the last bits of
-    max|theta|/alpha may differ, ~1e-13): a verdict could change only for a width within
-    rounding of the level or of overturning.  The widths shared most are the search's scan,
-    the same batch in both designs (bit for bit).  Measured: the same design width with and
-    without the sharing on every case of benchmarks/bench_design_width.py (``--identical``)."""
+    Only whole batches are shared: a run's last bits depend on its batch (its lanes share their
+    Taylor order, its forcing grid follows its stiffest block), so the same width run in another
+    batch agrees only to rounding, and the check's later stages, which rank widths by
+    max|theta|/alpha, could then pick other widths (measured: 1 of 62 cases).  The same batch is
+    the same computation, so the answer is the same as without the sharing, bit for bit.  The
+    batch both designs run is the search's geometric scan (131 widths), and the single widths
+    at either end of their bisections where they meet."""
 
     def __init__(self, run_widths, overturning, inputs):
         self.run_widths, self.shared = run_widths, 0
@@ -389,31 +391,21 @@ class _Runs:
             if overturning.inputs != inputs:
                 raise ValueError("overturning= is the design of another record, vertical, column "
                                  "or model: the overturning design of the same ones")
-            self.known = {float(b): (bool(o), float(r)) for b, o, r in zip(*overturning.outcomes)}
-        self.log = {}
+            self.known = {x.tobytes(): (o, r) for x, o, r in overturning.outcomes}
+        self.log = []
 
     def outcomes(self, widths):
-        widths = np.asarray(widths, dtype=float)
-        new = np.array([float(b) not in self.known for b in widths], dtype=bool)
-        over = np.zeros(widths.size, dtype=bool)
-        ratio = np.zeros(widths.size)
-        if new.any():
-            res = self.run_widths(widths[new])
-            over[new] = np.asarray(res.overturned, dtype=bool)
-            ratio[new] = np.asarray(res.max_rotation_ratio, dtype=float)
-        for i in np.nonzero(~new)[0]:
-            over[i], ratio[i] = self.known[float(widths[i])]
-        self.shared += int((~new).sum())
-        self.log.update((float(b), (bool(o), float(r))) for b, o, r in zip(widths, over, ratio))
-        return over, ratio
-
-    def table(self, extra=()):
-        """Every outcome kept (and ``extra``: ``(widths, overturned, ratio)``), ascending."""
-        rows = dict(self.log)
-        rows.update((float(b), (bool(o), float(r))) for b, o, r in zip(*extra) if float(b) not in rows)
-        x = np.array(sorted(rows), dtype=float)
-        return (x, np.array([rows[b][0] for b in x], dtype=bool),
-                np.array([rows[b][1] for b in x], dtype=float))
+        widths = np.ascontiguousarray(widths, dtype=float)
+        hit = self.known.get(widths.tobytes())
+        if hit is not None:
+            self.shared += widths.size
+            over, ratio = hit
+        else:
+            res = self.run_widths(widths)
+            over = np.asarray(res.overturned, dtype=bool).copy()
+            ratio = np.asarray(res.max_rotation_ratio, dtype=float).copy()
+        self.log.append((widths.copy(), over, ratio))
+        return over.copy(), ratio.copy()
 
 
 def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limit, model, vertical,
@@ -432,12 +424,12 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
 
     def search():
         out = _record_search(height, top, evaluate_record, criterion=criterion, eta=eta, settings=settings)
-        out[0].shared_runs = runs.shared
+        out[0].shared_runs, out[0].outcomes = runs.shared, tuple(runs.log)   # kept with it
         return out
 
     res, seen = searches.remembered(  # a batch's later pass: the same search (rocking.searches)
         searches.key(excitation, vertical, settings, height, criterion, eta, gamma, limit, model), search)
-    shared, runs.shared = res.shared_runs, 0
+    shared, runs.shared, runs.log = res.shared_runs, 0, list(res.outcomes or ())
     res.cap_mass_ratio, res.limit, res.search_width = gamma, limit, res.width
     if vertical is not None:
         res.method += "; with the vertical record (compiled engine, fast-vertical)"
@@ -456,10 +448,8 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
             # and a bisection above it where that width exceeds the level
             _at_least(res, overturning, evaluate_record, seen, settings)
     res.shared_runs = shared + runs.shared
-    if limit is None and criterion == "overturn":
-        # the search's widths (but ``top``, which it knows survives unrun) when it was kept
-        x, f, r = (np.asarray(v) for v in seen)
-        res.outcomes = runs.table((x[x < top], f[x < top], r[x < top]))
+    # the batches run, for a level given this design (none kept otherwise: they serve no other)
+    res.outcomes = tuple(runs.log) if limit is None and criterion == "overturn" else None
     return res
 
 
