@@ -143,9 +143,12 @@ def test_pipeline_run_limit(tmp_path):
         row = next(csv.DictReader(open(out / "design.csv")))
         widths[name] = float(row["verified_width_m"])
         assert row["design_limit"] == ("0.5" if extra else "")
+        widths[name + " overturning"] = row["overturning_width_m"]
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
     assert widths["half"] >= widths["over"]
+    # the level's run computed the overturning run's design width (the same text, 6 digits)
+    assert widths["half overturning"] == f"{widths['over']:g}" and widths["over overturning"] == ""
 
 
 def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
