@@ -13,7 +13,7 @@ For every real record of ../shared/records (``raw/`` and its sub-folders, and th
 components of ``peer_download/`` that are not in ``raw/``: the check was sized on ``raw/`` at
 7.5 m, so those and the other heights are records and columns it was not tuned on), and each
 column height, ``rocking.required_width(H, record, rule="exact")`` gives the search's first
-transition ``w`` (``search_width``, the former verified width) and the design width ``W``
+transition ``w`` (``search_width``, called the verified width before 0.5) and the design width ``W``
 (``width``).  An independent dense grid of ``DENSE`` linear widths in ``(w, min(SPAN w, top)]``
 (``top``: the no-uplift width) counts the records with a failing width more than 1 % above ``w``
 (today's answer) and more than 1 % above ``W``.  With ``limit=0.5``: the design width ``W_R`` is
@@ -137,7 +137,7 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
             t = time.perf_counter()
             half = design_width(record, None, H, 0.0, LEVEL, settings) if level else over
             t_half = time.perf_counter() - t
-            # the reference: the search of 0.5.0 alone (its first transition, today's verified
+            # the reference: the search of 0.5.0 alone (its first transition, today's search
             # width), whatever the settings measured
             base = rocking.required_width(H, record, rule="exact", settings=BASELINE)
             w = base.search_width

@@ -25,8 +25,8 @@ process's CPU of each, and this version's share.
 
 Reported per pair: CPU seconds per direction, by stage (the stages' times from ``--log``),
 PNG bytes, and the answers compared:
-the pair's design width (the widest verified width or failing width the checks found, over its
-directions) of the default against ``--thorough``'s, and whether every direction's verified
+the pair's design width (the widest design width or failing width the checks found, over its
+directions) of the default against ``--thorough``'s, and whether every direction's design
 width, verdicts and check columns equal the baseline's (``--thorough`` against its ``--thorough``,
 the default against its default).
 Then the projection for 10,000 pairs on 64 cores (at this machine's CPU per direction).
@@ -56,7 +56,7 @@ WRAPPER = ("import json, os, resource, sys\n"
            "s = resource.getrusage(resource.RUSAGE_SELF)\n"
            "print(json.dumps({'code': code, 'self': s.ru_utime + s.ru_stime, 'pid': os.getpid()}))\n")
 #: the check's columns and the verdicts compared row by row
-COMPARED = ["verified_width_m", "overturns", "eq31_width_m", "eq31_width_overturns", "failing_share",
+COMPARED = ["design_width_m", "overturns", "eq31_width_m", "eq31_width_overturns", "failing_share",
             "widest_failing_width_m", "check_runs", "pulse_shape", "pulse_ap_g", "pulse_tp_s"]
 
 
@@ -99,8 +99,8 @@ def run_one(python, pair, out, jobs, extra=(), log=False) -> dict:
 
 
 def design_width(rows) -> float:
-    """The pair's design width: the widest verified or failing width over its directions (m)."""
-    return max(max(float(r["verified_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
+    """The pair's design width: the widest design or failing width over its directions (m)."""
+    return max(max(float(r["design_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
 
 
 def same_rows(a, b) -> bool:

@@ -1,8 +1,8 @@
-"""Could the verified width's fine zone be thinned?  Where failing slivers sit, measured.
+"""Could the width search's fine zone be thinned?  Where failing slivers sit, measured.
 
     python benchmarks/bench_fine_zone.py        # about a minute; real records need ../shared
 
-The verified width (``rocking.required_width(..., rule="exact")`` on a record) runs every width
+The width search (``rocking.required_width(..., rule="exact")`` on a record) runs every width
 0.05 % apart up to 20 % above its candidate (the *fine zone*, ~365 full-record runs of the ~530
 per column), and that is most of what ``pipeline run`` costs.  A cheaper search would run a
 coarser grid (every ``k``-th width) and fill in only the gaps next to a width that came near to
@@ -28,7 +28,7 @@ NEAR = (0.3, 0.5, 0.7)
 
 
 def _zones(record, height):
-    """Every batch of the fine zone of one verified-width search: ``(widths, failed, ratio)``
+    """Every batch of the fine zone of one width search: ``(widths, failed, ratio)``
     sorted widest first, with each width's index ``k`` on the grid ``top (1 + record_fine)^-k``
     (the search run with the whole zone in one batch, ``record_chunk`` unbounded, not stopped
     at its first failure; every batch logged)."""

@@ -1,4 +1,4 @@
-"""The batch engine's lanes on columns near their verified width (issue 34), two builds side by side.
+"""The batch engine's lanes on columns near their design width (issue 34), two builds side by side.
 
     python benchmarks/bench_lanes.py [--build NAME=PATH ...] [--rounds N] [--records NAME ...]
 

@@ -8,7 +8,7 @@
   cold (a fresh ``pipeline`` process, as a user runs it).
 - The same with plots, ``--jobs 2``.
 - Record length: 4 records each of 10, 20, 40, 80 s, ``--jobs 1``: seconds per record.
-- Where the time goes: median seconds per record in each stage (fit, exact slenderness, verified
+- Where the time goes: median seconds per record in each stage (fit, exact slenderness, design
   width, time histories, plot), 10 records, one process.
 
 Every run is one repeat by default (``run(repeats=...)``): on this machine the whole takes minutes.

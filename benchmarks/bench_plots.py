@@ -55,7 +55,7 @@ def run(repeat: int = 5) -> dict:
     fig = plots.record_figure(*parts[0])
     width, height = (round(v) for v in fig.get_size_inches() * plots.DPI)
     rows = [{"column_kind": "block", "tan_alpha": 0.24, "governing_eq31_tan_alpha": 0.2 + 0.02 * k,
-             "verified_tan_alpha": 0.18 + 0.03 * k, "overturns": k % 2 == 0,
+             "design_tan_alpha": 0.18 + 0.03 * k, "overturns": k % 2 == 0,
              "eq31_width_tan_alpha": 0.2 + 0.02 * k, "eq31_width_overturns": k % 3 == 0}
             for k in range(10)]
     summary = _median_seconds(lambda: plots.summary_figure_png(rows), repeat)

@@ -7,8 +7,8 @@
    normal), for ``--directions 36``, and for the default directions with ``--fragility``
    (critical scale of the column as it stands in each direction, up to 10).
 2. Miss of the default set: on every pair of ``../shared/records/raw`` (paired by
-   ``pulses.pair_files``), the governing verified width (``rocking.required_width``, rule exact:
-   the function the pipeline's verified width comes from) over the default directions against
+   ``pulses.pair_files``), the governing design width (``rocking.required_width``, rule exact:
+   the function the pipeline's design width comes from) over the default directions against
    that over the default directions plus 36 evenly spaced ones (every 5 deg).
 """
 from __future__ import annotations
@@ -88,7 +88,7 @@ def main(argv=None):
             print(f"{pathlib.Path(pair[0]).name + ' + ' + pathlib.Path(pair[1]).name:46s} " + " ".join(cells))
     if args.skip_miss:
         return
-    print(f"\ngoverning verified width: default directions vs default + {args.n} even (m)")
+    print(f"\ngoverning design width: default directions vs default + {args.n} even (m)")
     print(f"{'pair':46s} {'H':>5s} {'default':>8s} {'all':>8s} {'miss %':>7s} {'at deg':>7s} {'pulse deg':>9s}")
     worst = 0.0
     for pair in pairs:

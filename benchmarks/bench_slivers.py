@@ -1,4 +1,4 @@
-"""How big must the check above the verified width be?  Its findings against a dense grid.
+"""How big must the check above the search width be?  Its findings against a dense grid.
 
     python benchmarks/bench_slivers.py            # ~20 min on 2 busy cores; needs ../shared
     python benchmarks/bench_slivers.py --quick    # the 15 top-level records, one seed
@@ -8,7 +8,7 @@
     python benchmarks/bench_slivers.py --figure docs/slivers_barcode.png
     python benchmarks/bench_slivers.py --variants "near + stages (default)" --ns 1500 --seeds 8 --height 12
 
-The verified width ``w`` (``rocking.required_width(H, record, rule="exact")``) is followed by a
+The search width ``w`` (``rocking.required_width(H, record, rule="exact").search_width``) is followed by a
 check of ``check_runs`` jittered widths above it (docs/slivers.md).  For every real record of
 ../shared/records/raw (or ``$ROCKING_RECORDS``; the top level and its sub-folders), column height
 7.5 m, this script runs
@@ -22,7 +22,7 @@ and prints, per ``(q, N)``: on the records where the dense grid finds a failing 
 1 % above ``w``, on how many (of all seeds) the check's widest failing width is at least
 ``1.01 w``, and on how many it found none; on every record where the dense grid finds any
 failure, how often the check finds one; the median ratio ``(widest found - w) / (dense widest -
-w)``.  It also prints the verified width's own runs per record (today's cost, the 4x budget's
+w)``.  It also prints the search's own runs per record (today's cost, the 4x budget's
 base).  The table in docs/slivers.md is this script's output.
 """
 from __future__ import annotations
@@ -74,7 +74,7 @@ def _verdicts(record, widths):
 
 
 def _check(record, v, seen, top, layout, n, seed):
-    """The package's check (``rocking.widths``) with these sizes above the verified width ``v``."""
+    """The package's check (``rocking.widths``) with these sizes above the search width of ``v``."""
     import dataclasses
 
     import rocking
@@ -87,7 +87,7 @@ def _check(record, v, seen, top, layout, n, seed):
 
 
 def measure(paths, seeds=SEEDS, ns=NS, nears=NEARS):
-    """One dict per record: ``w``, ``runs`` (the verified width's), the dense grid's failing
+    """One dict per record: ``w``, ``runs`` (the search's), the dense grid's failing
     widths, and per ``(near, n, seed)`` the check's share and widest failing width."""
     import pulses
     import rocking
@@ -160,25 +160,26 @@ def table(rows, seeds=SEEDS, ns=NS, nears=NEARS):
             lines.append(f"| {q} | {n} | {ge}/{nf} | {none}/{nf} | {found}/{na} | "
                          f"{np.median(ratios):.2f} | {np.median(shares):.4f} |")
     runs = np.array([r["runs"] for r in rows])
-    lines += ["", f"Verified width's own search: {runs.min()}-{runs.max()} runs per record, median "
+    lines += ["", f"The search's own runs: {runs.min()}-{runs.max()} runs per record, median "
               f"{np.median(runs):.0f} (4x: {4 * np.median(runs):.0f})."]
     return lines
 
 
 def figure(path, name="RSN879_LANDERS_LCN345.AT2", n=6000):
     """docs/slivers_barcode.png: the verdict against the width for one record, on ``n`` linear
-    widths from 0.6 to 1.6 times the verified width and the check's own widths."""
+    widths from 0.6 to 1.6 times the search width and the check's own widths."""
     import pulses
     import rocking
     from pipeline.reports.plot_widths import widths_figure_png
 
     record = pulses.read_record(RECORDS / name)
     v = rocking.required_width(HEIGHT, record, rule="exact")
-    x = np.concatenate([np.linspace(0.6 * v.width, 1.6 * v.width, n), v.check_widths])
+    w = v.search_width
+    x = np.concatenate([np.linspace(0.6 * w, 1.6 * w, n), v.check_widths])
     f = np.concatenate([_verdicts(record, x[:n]), v.check_failed])
     pathlib.Path(path).write_bytes(widths_figure_png(
-        f"{pathlib.Path(name).stem}, column height {HEIGHT} m", v.width, x, f))
-    print(f"{path}: verified width {v.width:.4f} m, check: share {v.failing_share:.4f}, widest "
+        f"{pathlib.Path(name).stem}, column height {HEIGHT} m", w, x, f))
+    print(f"{path}: search width {w:.4f} m, design width {v.width:.4f} m, check: share {v.failing_share:.4f}, widest "
           f"failing {v.widest_failing_width} m")
 
 

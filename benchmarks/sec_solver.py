@@ -355,7 +355,7 @@ def headline(quick):
         t_many_rk8.append(timed(lambda: rocking.simulate_many([blk] * 200, exc, method="rk8"))[1] / 200)
         t_usual.append(timed(lambda: simulate_usual(blk, exc, **USUAL_DEFAULT))[1])
     # batch engine (rocking.lanes) against the same runs one by one, one core (< 256 runs: no
-    # threads): 200 widths of the column up to 20 % wider, as a verified-width search runs them
+    # threads): 200 widths of the column up to 20 % wider, as a width search runs them
     wide = [rocking.Block.from_dimensions(7.5, 1.8 * (1.0 + 0.2 * k / 199)) for k in range(200)]
     t_lanes, t_one = [], []
     for _ in range(max(2, n_round // 2)):

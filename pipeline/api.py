@@ -317,7 +317,7 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     >>> from pipeline.commands.demo import bundled_records
     >>> with bundled_records() as paths:
     ...     run = pipeline.design(paths[1:2], blocks="7.5x1.8", shapes="sine")
-    >>> run.design[["record", "column", "verified_width_m"]].shape
+    >>> run.design[["record", "column", "design_width_m"]].shape
     (1, 3)
     >>> pipeline.design(paths, blocks=7.5)
     Traceback (most recent call last):

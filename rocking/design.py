@@ -13,7 +13,7 @@ One module per idea, gathered here:
     overturning intervals and safe islands of Fig. 5).
 :mod:`rocking.widths`
     :func:`required_width`: sizing a column of given height by a closed form or by time-history
-    analysis under a pulse or a whole record (the verified width).
+    analysis under a pulse or a whole record (the design width).
 """
 from .closed_forms import ENVELOPE, ENVELOPE_RANGE, envelope_rule, eq20, eq31
 from .search import CRITERIA, DEFAULT_SETTINGS, SearchSettings

@@ -24,7 +24,7 @@ CRITERIA = ("overturn", "exceed")
 class SearchSettings:
     """Settings of the exact design searches (a value: pass a changed copy, ``replace(...)``).
 
-    Pulses (minimum slenderness, critical amplitudes, a pulse's verified width): ``n_scan``
+    Pulses (minimum slenderness, critical amplitudes, a pulse's search width): ``n_scan``
     uniformly spaced scan points plus a geometric tail of ``n_tail`` points towards zero (the
     smallest uniform point divided by 2, 4, ... ``2**n_tail``); above the highest failing point
     found, ``zone_points`` more points over ``zone_fraction`` of its value, repeated while failures
@@ -34,7 +34,7 @@ class SearchSettings:
     agreement 5e-4 relative on 240 hard cases); brackets cut in ``ksection`` parts per step
     (fewer batch calls than bisection) until narrower than ``rtol`` relative.
 
-    Records (the verified width, :func:`rocking.widths.record_width`): ``record_scan`` widths
+    Records (the search width, :func:`rocking.widths.record_width`): ``record_scan`` widths
     geometric from ``top record_low`` to the no-uplift width ``top`` (neighbours 3.3 % apart with
     the defaults), plus a tail of ``record_tail`` widths halving towards zero
     (``record_spacing="uniform"``: ``record_scan`` uniform widths up to ``top``, the former scan,
@@ -52,7 +52,7 @@ class SearchSettings:
     record_near``: isolated failing bands of real records sit where the block nearly overturns);
     at most ``record_rounds`` rounds (a failure found above the candidate moves it up).
 
-    The check above a record's verified width ``w`` (docs/slivers.md;
+    The check above a record's search width ``w`` (docs/slivers.md;
     :func:`rocking.widths.check_widths`, :func:`rocking.widths.follow_widths`): ``check_runs``
     widths from ``w`` to ``check_span`` times ``w`` or the no-uplift width, whichever is smaller,
     jittered (one random width in each of equal strata; seeded from the record, so a re-run gives

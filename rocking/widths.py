@@ -1,6 +1,6 @@
 """Sizing a column of given height (docs/theory.md section 5): the width it needs by a closed-form rule
 (solved as a fixed point in the width, since ``p`` depends on it) or by time-history analysis
-(the *verified width*, under a pulse or a whole record)."""
+(the *design width*, under a pulse or a whole record)."""
 from __future__ import annotations
 
 import dataclasses
@@ -25,9 +25,10 @@ class RequiredWidth:
     """Width a column of given height needs.
 
     ``p`` depends on the width (``R = sqrt(H^2 + B^2)/2``), so the closed-form rules are solved
-    as a fixed point in ``B`` (:attr:`iterations` steps); ``rule="exact"`` is the *verified
-    width*: the smallest width that survives at that width and at every larger one, found by a
-    scan over widths and bracketed refinement of every verdict change (:attr:`transitions`).
+    as a fixed point in ``B`` (:attr:`iterations` steps); ``rule="exact"`` searches by
+    time-history analysis for the smallest width that survives at that width and at every larger
+    one, by a scan over widths and bracketed refinement of every verdict change
+    (:attr:`transitions`; the answer is :attr:`search_width`).
     Under a record, failing slivers thinner than the scan's resolution can lie above it (the
     response is chaotic near the verge of overturning): a check of jittered widths above it
     reports what it finds (:attr:`failing_share`, :attr:`widest_failing_width`; docs/slivers.md).
@@ -60,7 +61,7 @@ class RequiredWidth:
     #: answer is at most that width (the search halves the width down to ``2**-DOWN_HALVINGS``
     #: of the scan's narrowest before it gives up looking for a failure)
     below_scan: bool = False
-    #: the check above the verified width (a record's ``rule="exact"`` only; docs/slivers.md): the
+    #: the check above the search width (a record's ``rule="exact"`` only; docs/slivers.md): the
     #: share of the checked widths that fail (``None``: not checked), the widest of them (m;
     #: ``None`` where none failed), the number of widths checked (runs on top of :attr:`runs`),
     #: and the widest width checked (m)
@@ -75,7 +76,7 @@ class RequiredWidth:
     #: or :attr:`criterion`)
     limit: float | None = None
     #: the search's answer (m): the smallest width above which every width the search examined
-    #: survives (the former "verified width"); :attr:`width` is at least this
+    #: survives (called the verified width before 0.5); :attr:`width` is at least this
     search_width: float | None = None
     #: solver runs of the refinement above the widest failing width (on top of :attr:`runs` and
     #: :attr:`check_runs`)
@@ -135,7 +136,7 @@ class RequiredWidth:
         return fields_dict(self, properties=("tan_alpha", "p"))
 
     def to_frame(self):
-        """The check above the verified width, one row per width checked (``width_m``,
+        """The check above the search width, one row per width checked (``width_m``,
         ``failed``); empty where there was no check."""
         import pandas as pd
 
@@ -180,7 +181,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         ``"eq31"``/``"envelope"``/``"eq20"``: the closed form, solved as a fixed point in the
         width because ``p`` depends on it (``B = H tan(alpha_min(p(B)))``, a contraction; the
         iteration count is reported).  ``"exact"``: time-history analysis across widths (the
-        *verified width*, see :class:`RequiredWidth`); works for pulses and records.
+        *design width*, see :class:`RequiredWidth`); works for pulses and records.
     criterion : {"overturn", "exceed"}
         Failure criterion of ``rule="exact"`` (``limit`` takes precedence).
     eta : float, optional
@@ -329,7 +330,7 @@ def _uplift_ratio(record, vertical) -> float:
     if np.min(gravity) <= 0.0:
         raise RockingInputError(f"the vertical reaches {np.max(-vertical.acc) / G:.3g} g downward: "
                                 "the block would leave the ground, which the rocking model does "
-                                "not describe; no width is verified")
+                                "not describe; no design width can be found")
     return float(np.max(np.abs(record.acc) / gravity))
 
 
@@ -454,7 +455,7 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
 
 
 def _pulse_width(height, top, evaluate, settings):
-    """A pulse's verified width (scan and refinement of every verdict change)."""
+    """A pulse's search width (scan and refinement of every verdict change)."""
     x = _scan_points(np.array([top]), settings.n_scan, settings.n_tail)
     known = np.zeros(x.shape, dtype=bool)
     known[:, -1] = True
@@ -485,7 +486,7 @@ def _pulse_width(height, top, evaluate, settings):
             width, below_scan = down[-1], True
     return RequiredWidth(
         width=float(width), height=height, rule="exact", iterations=n_iter,
-        method=(f"verified width: scan of {x.shape[1]} widths up to the no-uplift width "
+        method=(f"search width: scan of {x.shape[1]} widths up to the no-uplift width "
                 f"{top:.4g} m (denser just above the widest failure), then bracketed "
                 f"refinement of {len(br)} verdict change(s) ({scan.runs} solver runs in "
                 f"{scan.calls} batches)"
@@ -501,7 +502,7 @@ def _first_runs(settings) -> int:
 
 
 def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
-    """The widths (m, ascending) of the first stage of the check above a verified ``width``
+    """The widths (m, ascending) of the first stage of the check above a search ``width``
     (docs/slivers.md).
 
     ``settings.check_runs`` less the later stages' share (``settings.check_follow``, see
@@ -509,7 +510,7 @@ def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
     top)`` (``top``: the no-uplift width, above which nothing rocks): a share
     ``settings.check_near`` of them uniform in ``log d``, ``d = B / width - 1`` from
     ``settings.check_first`` to ``hi / width - 1`` (failing slivers cluster just above the
-    verified width: ``benchmarks/bench_slivers.py``), the others uniform in ``B`` over the whole
+    search width: ``benchmarks/bench_slivers.py``), the others uniform in ``B`` over the whole
     span.  Each part is *jittered*: one uniformly random point in each of its equal strata, drawn
     from ``numpy.random.default_rng(seed)``, so that the widths are spread evenly, never lie on
     the search's fixed grid, and are the same for the same seed.  Empty where ``hi <= width``.
@@ -538,7 +539,7 @@ def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTING
     ``q ** settings.check_power``, ``q`` the standard deviation of ``min(max|theta|/alpha, 1)``
     (``ratio``) over the ``widths`` run so far in the bin (those outside the span are left
     out), divided by the largest bin's, and 1 in
-    a bin where one of them ``failed``: failing slivers far above the verified width are isolated
+    a bin where one of them ``failed``: failing slivers far above the search width are isolated
     jumps of the response, found where it is irregular from one width to the next (or next to a
     failure), not where the block merely rocks hard.  Uniform where no bin varies.  Each bin's
     widths are jittered within it (``seed`` as for :func:`check_widths`; ``stage`` numbers the
@@ -725,18 +726,18 @@ def _raise_to_failures(res, evaluate, seen, settings) -> None:
     res.width, res.widest_failing_width = hi, lo
 
 
-#: how far below the scan's narrowest width (in halvings) the verified width looks for a failure
+#: how far below the scan's narrowest width (in halvings) the search looks for a failure
 #: when nothing scanned failed
 DOWN_HALVINGS = 40
 
 
 def _record_width(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SETTINGS):
-    """Verified width under a record (:func:`_record_search`'s answer without its widths)."""
+    """The search width under a record (:func:`_record_search`'s answer without its widths)."""
     return _record_search(height, top, evaluate, criterion=criterion, eta=eta, settings=settings)[0]
 
 
 def _record_search(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SETTINGS):
-    """Verified width under a record: the smallest width above which every scanned width survives.
+    """The search width under a record: the smallest width above which every scanned width survives.
     Returns ``(RequiredWidth, (widths, failed, ratio))``, the second the widths run (ascending)
     with their verdicts and ``max|theta|/alpha``.
 
@@ -882,7 +883,7 @@ def _near_gaps(pts, w, s):
 
 def _method(n_scanned, top, rounds, limited, below_scan, pts, s) -> str:
     n_zone = s.record_zone_points
-    return (f"verified width: scan of {n_scanned} widths up to the no-uplift width {top:.4g} m, "
+    return (f"search width: scan of {n_scanned} widths up to the no-uplift width {top:.4g} m, "
             f"then {rounds} round(s) of bisection above the widest failure and checks above "
             f"it (widths {s.record_fine:.2%} apart up to {s.record_fine_span:.0%} above, "
             + (f"a zone of {int(n_zone)} widths up to {s.record_zone_fraction:.0%} above, " if n_zone else "")

@@ -105,7 +105,7 @@ def test_out_none_writes_nothing_and_out_writes_the_reports(tmp_path, monkeypatc
     import json
 
     d = json.loads(json.dumps(run.as_dict(), allow_nan=False))  # plain data, no NaN
-    assert d["design"][0]["verified_width_m"] == run.design_rows[0]["verified_width_m"] and d["out"] is None
+    assert d["design"][0]["design_width_m"] == run.design_rows[0]["design_width_m"] and d["out"] is None
 
 
 def test_not_quiet_prints_pipeline_runs_table_and_names_no_private_folder(tmp_path, capsys):

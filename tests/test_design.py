@@ -254,7 +254,7 @@ def test_required_width_rules_consistent_with_design(capsys):
     ex = rocking.required_width(h, pulse, rule="exact")
     # the envelope is conservative (wider than the exact width) yet narrower than Eq. 31 here
     assert ex.width < env.width < w31.width
-    # verified width: survives just above, fails just below (fast and reference agree)
+    # the exact width: survives just above, fails just below (fast and reference agree)
     for f, expect in [(1 + 1e-6, False), (1 - 1e-6, True)]:
         r = rocking.simulate(Block.from_dimensions(h, ex.width * f), pulse, model="reference",
                              history=False)
@@ -349,8 +349,8 @@ def test_cli_spectrum_and_chart_mark_your_column(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------------- fast searches
-def _brute_verified_width(height, record, lo, hi, n):
-    """Brute force: ``n`` uniform widths on ``[lo, hi]`` (every one run), the verified width is the
+def _brute_design_width(height, record, lo, hi, n):
+    """Brute force: ``n`` uniform widths on ``[lo, hi]`` (every one run), the design width is the
     scanned width just above the widest failing one; also returns the scan step."""
     xs = np.linspace(lo, hi, n)
     res = rocking.simulate_many([Block.from_dimensions(height, float(b)) for b in xs], record)
@@ -375,11 +375,11 @@ def _near_fault_record(seed=3, duration=25.0, dt=0.01):
 @pytest.mark.slow
 @pytest.mark.parametrize("height", [7.5, 6.0])
 def test_record_width_search_matches_brute_force_synthetic(height):
-    """The verified-width search (~520 runs) against 1500 runs of a uniform scan."""
+    """The width search (~520 runs) against 1500 runs of a uniform scan."""
     rec = _near_fault_record()
     fast = rocking.required_width(height, rec, rule="exact")
     top = height * rec.pga / G
-    brute, step = _brute_verified_width(height, rec, top / 1500, top, 1500)
+    brute, step = _brute_design_width(height, rec, top / 1500, top, 1500)
     # the same transition, to the brute force's resolution (the fast one is refined to 1e-9)
     assert abs(fast.width - brute) <= step
     # 132 scanned widths, ~365 of the fine zone (0.05 % apart over 20 %), ~25 bisection steps
@@ -404,7 +404,7 @@ def test_record_width_search_matches_brute_force_rinaldi(shared_records):
     rec = pulses.read_record(shared_records / "NGA_no_1063_RRS228.AT2")
     fast = rocking.required_width(7.5, rec, rule="exact")
     assert fast.width == pytest.approx(1.64991, abs=1e-5)
-    brute, step = _brute_verified_width(7.5, rec, 1.3, 2.3, 1000)
+    brute, step = _brute_design_width(7.5, rec, 1.3, 2.3, 1000)
     assert abs(fast.width - brute) <= step
     assert len(fast.transitions) >= 3      # a safe island below the answer is reported
 
@@ -423,7 +423,7 @@ def test_record_width_search_not_below_brute_force_real(name, height):
     rec = pulses.read_record(shared_record(name))
     fast = rocking.required_width(height, rec, rule="exact")
     top = height * rec.pga / G
-    brute, step = _brute_verified_width(height, rec, top / 1500, top, 1500)
+    brute, step = _brute_design_width(height, rec, top / 1500, top, 1500)
     assert fast.width >= brute - step
     assert fast.search_width <= 1.05 * brute
     # the design width may lie further up only above a failing width the check found (which
@@ -449,7 +449,7 @@ def test_min_slenderness_top_bisection_same_answer():
 
 
 @pytest.mark.slow
-def test_verified_width_never_zero_for_a_very_tall_column(shared_records):
+def test_design_width_never_zero_for_a_very_tall_column(shared_records):
     """Issue 19: a 1000 m x 1 m column under Rinaldi 228 was reported at width 0 ("adequate"):
     every width of the scan survived (its floor is the no-uplift width / 1024, 0.8 m).  The
     search now goes on below the scan until a failure is bracketed: the answer is positive and

@@ -3,11 +3,11 @@ verdict with the vertical, from rows of summary.csv."""
 from pipeline.reports.design_table import design_rows, excess_text, failing_text, metadata_text, table_text
 
 
-def _row(direction, verified, failing, overturns=False, vertical=None, search=None):
+def _row(direction, design, failing, overturns=False, vertical=None, search=None):
     return {"record": f"p@{direction}", "pair": "p", "column": "7.5x1.8", "column_kind": "block",
-            "direction_deg": direction, "verified_width_m": verified, "widest_failing_width_m": failing,
+            "direction_deg": direction, "design_width_m": design, "widest_failing_width_m": failing,
             "overturns": overturns, "vertical_overturns": vertical, "width_m": 1.8,
-            "verified_adequate": True, "max_theta_ratio": 0.5, "search_width_m": search,
+            "design_adequate": True, "max_theta_ratio": 0.5, "search_width_m": search,
             "check_runs": 1500}
 
 
@@ -15,11 +15,11 @@ def test_a_pairs_widest_failing_width_is_one_above_its_governing_search_width():
     # direction 0 governs (design 1.0 m, search 0.95 m); a sliver of direction 90 at 0.9 m lies
     # below the governing search width: no failure of the design's direction
     d, = design_rows([_row(0, 1.0, None, search=0.95), _row(90, 0.8, 0.9, search=0.7)])
-    assert d["direction_deg"] == 0 and d["verified_width_m"] == 1.0
+    assert d["direction_deg"] == 0 and d["design_width_m"] == 1.0
     assert d["widest_failing_width_m"] is None and d["search_width_m"] == 0.95
     # one at 0.99 m (the governing direction's own, just below its design width) is reported
     d, = design_rows([_row(0, 1.0, 0.99, search=0.95), _row(90, 0.8, None, search=0.7)])
-    assert d["widest_failing_width_m"] == 0.99 < d["verified_width_m"]
+    assert d["widest_failing_width_m"] == 0.99 < d["design_width_m"]
 
 
 def test_the_verdict_with_the_vertical_covers_every_direction():
@@ -41,7 +41,7 @@ def test_metadata_line_of_a_peer_record():
     assert metadata_text({"record": "x"}) is None
 
 
-def test_excess_above_the_verified_width_is_shown_in_percent():
+def test_excess_above_the_search_width_is_shown_in_percent():
     # far above: 0.608 over 0.593 is +2.53 %; a tenth of a percent step resolves it
     assert excess_text(0.608, 0.593) == "+2.5 %"
     assert excess_text(0.75, 0.6) == "+25 %"
@@ -79,8 +79,8 @@ def test_eq31_safe_island_and_the_suite_answer():
     the run ends with the width covering every record."""
     base = dict(_row(0, 1.0, None, search=1.0), eq31_width_m=0.8, eq31_width_overturns=True)
     rows = [dict(base, record="a", pair="a"),                                   # Eq. 31 below, overturns
-            dict(base, record="b", pair="b", verified_width_m=2.2, search_width_m=2.0,
-                 verified_adequate=False, eq31_width_m=2.5, eq31_width_overturns=False),
+            dict(base, record="b", pair="b", design_width_m=2.2, search_width_m=2.0,
+                 design_adequate=False, eq31_width_m=2.5, eq31_width_overturns=False),
             dict(base, record="c", pair="c", eq31_width_m=1.2, eq31_width_overturns=False)]
     d = design_rows(rows)
     assert [r["eq31_below_design"] for r in d] == [True, False, False]
@@ -122,7 +122,7 @@ def test_a_levels_overturning_width_is_the_widest_over_directions_and_in_the_fin
     rows = [dict(_row(0, 1.0, None, search=0.95), design_limit=0.5, overturning_width_m=0.7),
             dict(_row(90, 0.9, None, search=0.85), design_limit=0.5, overturning_width_m=0.8)]
     d, = design_rows(rows)
-    assert d["overturning_width_m"] == 0.8 and d["verified_width_m"] == 1.0
+    assert d["overturning_width_m"] == 0.8 and d["design_width_m"] == 1.0
     text = table_text([d])
     assert "1.000 m for max theta/alpha <= 0.5" in text
     assert "at least the overturning design width (overturning_width_m, 0.800 m here)" in text

@@ -243,7 +243,7 @@ def theory_formulas() -> int:
     return len(re.findall(r"\\tag\{", (DOCS / "theory.md").read_text(encoding="utf-8")))
 
 
-# -- one name and one verified width per record file ---------------------------------------------
+# -- one name and one design width per record file -----------------------------------------------
 def _records_table() -> list[dict]:
     """The rows of "The records these pages use" in docs/records.md."""
     text = (DOCS / "records.md").read_text(encoding="utf-8")
@@ -283,8 +283,8 @@ def test_each_record_file_has_one_name_and_one_release():
         assert not found, f"{base!r} without its release: {found}"
 
 
-def test_each_record_file_has_one_verified_width_across_the_docs():
-    """Every sentence that names a record (or its file) and states its verified (design) width, and every
+def test_each_record_file_has_one_design_width_across_the_docs():
+    """Every sentence that names a record (or its file) and states its design width, and every
     row of the demo's table, gives the width of docs/records.md's table (at the digits printed)."""
     checked = 0
     for row in _records_table():

@@ -63,15 +63,15 @@ def test_printed_table_and_design_csv(demo):
     # every value comes from summary.csv unchanged (a single component: its only direction)
     for d, s in zip(rows, summary):
         for key in ("pulse_like", "governing_shape", "governing_ap_g", "governing_tp_s", "eq31_width_m",
-                    "verified_width_m", "width_m", "verified_adequate", "max_theta_ratio",
+                    "design_width_m", "width_m", "design_adequate", "max_theta_ratio",
                     "search_width_m", "check_runs"):
             assert d[key] == s[key], key
         assert d["survives"] == str(s["overturns"] == "False")
         # the design width is above every failing width found, and at least the search's
-        assert float(d["verified_width_m"]) >= float(d["search_width_m"])
+        assert float(d["design_width_m"]) >= float(d["search_width_m"])
         if d["widest_failing_width_m"]:   # above it by at most design_rtol 1e-6: equal to 6 digits
-            assert float(d["verified_width_m"]) >= float(d["widest_failing_width_m"])
-        assert d["eq31_below_design"] == str(float(d["eq31_width_m"]) < float(d["verified_width_m"]))
+            assert float(d["design_width_m"]) >= float(d["widest_failing_width_m"])
+        assert d["eq31_below_design"] == str(float(d["eq31_width_m"]) < float(d["design_width_m"]))
     # the printed table: a header, a rule and one line per record and column, then the verdict
     # lines, before the last line
     lines = proc.stdout.splitlines()
@@ -81,10 +81,10 @@ def test_printed_table_and_design_csv(demo):
     assert lines[head + 2 + len(rows)] == ""
     for line, row in zip(body, rows):
         assert line.startswith(row["record"])
-        assert f"{float(row['verified_width_m']):.3f} m" in line
+        assert f"{float(row['design_width_m']):.3f} m" in line
         assert f"{float(row['eq31_width_m']):.3f} m" in line
         # the search width with the design width's excess over it, or no percentage
-        design, search = float(row["verified_width_m"]), float(row["search_width_m"])
+        design, search = float(row["design_width_m"]), float(row["search_width_m"])
         if design > search:
             m = re.search(re.escape(f"{search:.3f} m (") + r"(<?)\+([\d.]+) %\)", line)
             assert m, line
@@ -96,10 +96,10 @@ def test_printed_table_and_design_csv(demo):
                 assert abs(float(m.group(2)) - pct) <= 0.5 * 10 ** -decimals + 1e-9, (m.group(0), pct)
         else:
             assert "%)" not in line
-        assert line.rstrip().endswith({"True": "yes" if row["verified_adequate"] == "True" else "NO: safe island",
+        assert line.rstrip().endswith({"True": "yes" if row["design_adequate"] == "True" else "NO: safe island",
                                        "False": "NO"}[row["survives"]])
-    widest = max(rows, key=lambda r: float(r["verified_width_m"]))
-    assert (f"the design width covering all 5 record(s) is {float(widest['verified_width_m']):.3f} m "
+    widest = max(rows, key=lambda r: float(r["design_width_m"]))
+    assert (f"the design width covering all 5 record(s) is {float(widest['design_width_m']):.3f} m "
             f"(set by {widest['record']})") in proc.stdout
     below = sum(r["eq31_below_design"] == "True" for r in rows)
     over = sum(r["eq31_width_overturns"] == "True" for r in rows)
@@ -166,21 +166,21 @@ def test_failures_listed(tmp_path):
 
 
 def test_design_rows_of_a_pair():
-    """A pair counts once: its governing direction (widest verified width), survival over every
+    """A pair counts once: its governing direction (widest design width), survival over every
     direction."""
     base = dict(column="7.5x1.8", column_kind="block", width_m=1.8, scale=1.0, pulse_like=True,
                 velocity_tp_s=1.2, governing_shape="sine", governing_ap_g=0.5, governing_tp_s=0.8,
                 eq31_width_m=2.0, eq31_width_overturns=False, record="x", pair="A+B")
-    rows = [dict(base, direction_deg=0.0, verified_width_m=1.2, overturns=False, verified_adequate=True,
+    rows = [dict(base, direction_deg=0.0, design_width_m=1.2, overturns=False, design_adequate=True,
                  max_theta_ratio=0.3),
-            dict(base, direction_deg=90.0, verified_width_m=1.9, overturns=False, verified_adequate=False,
+            dict(base, direction_deg=90.0, design_width_m=1.9, overturns=False, design_adequate=False,
                  max_theta_ratio=0.8),
-            dict(base, direction_deg=45.0, verified_width_m=1.5, overturns=True, verified_adequate=True,
+            dict(base, direction_deg=45.0, design_width_m=1.5, overturns=True, design_adequate=True,
                  max_theta_ratio=5.0)]
     (d,) = design_table.design_rows(rows, {"A+B": 1})
-    assert d["record"] == "A+B" and d["direction_deg"] == 90.0 and d["verified_width_m"] == 1.9
+    assert d["record"] == "A+B" and d["direction_deg"] == 90.0 and d["design_width_m"] == 1.9
     assert d["n_directions"] == 3 and d["n_directions_failed"] == 1
-    assert d["survives"] is False and d["verified_adequate"] is False and d["max_theta_ratio"] == 5.0
+    assert d["survives"] is False and d["design_adequate"] is False and d["max_theta_ratio"] == 5.0
     assert design_table.survives_text(d) == "NO" and d["verdict"] == "NO"
     text = design_table.table_text([d])
     assert "A+B @90deg" in text and "1.900 m" in text
@@ -193,15 +193,15 @@ def test_report_html_says_how_far_above_the_search_width_a_column_fails():
     base = dict(column="7.5x1.8", column_kind="block", width_m=1.8, scale=1.0, pulse_like=True,
                 velocity_tp_s=1.2, governing_shape="sine", governing_ap_g=0.5, governing_tp_s=0.8,
                 eq31_width_m=2.0, eq31_width_overturns=False, direction_deg=None, overturns=False,
-                verified_adequate=True, max_theta_ratio=0.3, search_width_m=0.593, check_runs=40)
-    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05, verified_width_m=0.6081),
+                design_adequate=True, max_theta_ratio=0.3, search_width_m=0.593, check_runs=40)
+    rows = [dict(base, record="far", widest_failing_width_m=0.608, failing_share=0.05, design_width_m=0.6081),
             dict(base, record="tiny", widest_failing_width_m=0.593 * 1.00012, failing_share=0.025,
-                 verified_width_m=0.593 * 1.00013),
-            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0, verified_width_m=0.593),
-            dict(base, record="island", widest_failing_width_m=None, failing_share=0.0, verified_width_m=2.1,
-                 search_width_m=2.1, verified_adequate=False, eq31_width_m=1.5),
-            dict(base, record="over", widest_failing_width_m=None, failing_share=0.0, verified_width_m=2.2,
-                 search_width_m=2.2, verified_adequate=False, overturns=True, max_theta_ratio=5.36)]
+                 design_width_m=0.593 * 1.00013),
+            dict(base, record="none", widest_failing_width_m=None, failing_share=0.0, design_width_m=0.593),
+            dict(base, record="island", widest_failing_width_m=None, failing_share=0.0, design_width_m=2.1,
+                 search_width_m=2.1, design_adequate=False, eq31_width_m=1.5),
+            dict(base, record="over", widest_failing_width_m=None, failing_share=0.0, design_width_m=2.2,
+                 search_width_m=2.2, design_adequate=False, overturns=True, max_theta_ratio=5.36)]
     ids = [r["record"] for r in rows]
     design = design_table.design_rows(rows)
     page = html_report.report_html(design, rows, [], ids, {})

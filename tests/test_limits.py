@@ -141,7 +141,7 @@ def test_pipeline_run_limit(tmp_path):
         out = tmp_path / name
         assert main(["run", path, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"] + extra) == 0
         row = next(csv.DictReader(open(out / "design.csv")))
-        widths[name] = float(row["verified_width_m"])
+        widths[name] = float(row["design_width_m"])
         assert row["design_limit"] == ("0.5" if extra else "")
         widths[name + " overturning"] = row["overturning_width_m"]
     rec = pulses.read_record(path)
@@ -295,8 +295,8 @@ def test_pipeline_design_limit_is_at_least_the_overturning_design():
     for table in (run.design, run.summary):
         row = table.iloc[0]
         assert float(row["overturning_width_m"]) == pytest.approx(over.width, rel=1e-6)
-        assert float(row["verified_width_m"]) >= float(row["overturning_width_m"])
-    toppled, ratio = _ratio(6.0, float(run.design.iloc[0]["verified_width_m"]), rec)
+        assert float(row["design_width_m"]) >= float(row["overturning_width_m"])
+    toppled, ratio = _ratio(6.0, float(run.design.iloc[0]["design_width_m"]), rec)
     assert not toppled and ratio <= 0.5
     # without a level the column is blank
     plain = pipeline.design([str(path)], heights=6.0, shapes="sine")

@@ -1,4 +1,4 @@
-"""A pair's directions in passes (pipeline/batch/passes.py): the check above the verified width and the
+"""A pair's directions in passes (pipeline/batch/passes.py): the check above the search width and the
 figures only where they decide, the same design width as ``--thorough``.
 
 The synthetic pairs are those of tests/test_site.py (8 s, one-sine pulses in noise); the real
@@ -19,7 +19,7 @@ from .test_site import H, B, _pair
 CHECK = list(CHECK_COLUMNS.names)
 #: what the check decides besides its own columns: the direction's design width (the search's
 #: width where it found no failing width above it)
-DESIGN = CHECK + ["verified_width_m", "verified_tan_alpha", "verified_adequate"]
+DESIGN = CHECK + ["design_width_m", "design_tan_alpha", "design_adequate"]
 #: and with ``--limit``, the overturning design's width (its check runs where the level's does)
 LEVEL_DESIGN = DESIGN + ["overturning_width_m"]
 
@@ -30,13 +30,13 @@ def _rows(out):
 
 
 def _design(rows) -> float:
-    """The pair's design width: the widest verified or failing width over its directions."""
-    return max(max(float(r["verified_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
+    """The pair's design width: the widest design or failing width over its directions."""
+    return max(max(float(r["design_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
 
 
 def _top(row) -> float:
     """The widest width the check of this row's direction would look at (rocking.widths)."""
-    w = float(row["verified_width_m"])
+    w = float(row["design_width_m"])
     return passes._bracket_step() * min(DEFAULT_SETTINGS.check_span ** DEFAULT_SETTINGS.check_rounds * w,
                                         float(row["height_m"]) * float(row["pga_g"]))
 
@@ -63,17 +63,17 @@ def _same_answer(default, thorough):
         elif r["check_runs"] not in ("", "0"):  # its last round could not reach the design width
             n_checked += 1
             assert {k: v for k, v in r.items() if k not in DESIGN} == {k: v for k, v in ref.items() if k not in DESIGN}
-            assert float(r["verified_width_m"]) <= design and int(r["check_runs"]) < int(ref["check_runs"])
+            assert float(r["design_width_m"]) <= design and int(r["check_runs"]) < int(ref["check_runs"])
         else:
             assert {k: v for k, v in r.items() if k not in DESIGN} == {k: v for k, v in ref.items() if k not in DESIGN}
             assert r["failing_share"] == "" and r["widest_failing_width_m"] == ""
             assert r["search_width_m"] == ref["search_width_m"]
             if r["overturning_width_m"]:       # --limit: at least the overturning design's
-                assert float(r["verified_width_m"]) >= max(float(r["search_width_m"]),
-                                                           float(r["overturning_width_m"]))
+                assert float(r["design_width_m"]) >= max(float(r["search_width_m"]),
+                                                         float(r["overturning_width_m"]))
                 assert float(r["overturning_width_m"]) <= float(ref["overturning_width_m"])
             else:
-                assert r["verified_width_m"] == r["search_width_m"]
+                assert r["design_width_m"] == r["search_width_m"]
             assert _top(r) <= design * (1.0 + passes.MARGIN)
     return n_checked
 
@@ -113,11 +113,11 @@ def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
     assert all(not first[i].check and not first[i].plot for i in range(9)) and first[9] == tasks[9]
     plan = passes.Plan(options, held)
     for i in sorted(set(range(9)) - held):
-        plan.note(first[i], [{"column": "7.5x1.8", "verified_width_m": 0.5 + 0.1 * i, "height_m": 7.5,
+        plan.note(first[i], [{"column": "7.5x1.8", "design_width_m": 0.5 + 0.1 * i, "height_m": 7.5,
                               "pga_g": 0.5, "widest_failing_width_m": None}])
     second = plan.next_pass(first)
     assert [t.index for t in second] == [1, 2, 5, 7]
-    # each checked where its check could reach above 1.3 m, the scouts' widest verified width
+    # each checked where its check could reach above 1.3 m, the scouts' widest design width
     step = passes._bracket_step()
     assert all(t.check and t.check_above == pytest.approx((1.3 / step,), rel=1e-5) for t in second)
     assert plan.held == set()
@@ -159,12 +159,12 @@ def test_a_level_gives_the_thorough_design_width_and_its_overturning_design(pair
     default, thorough = _rows(tmp_path / "default"), _rows(tmp_path / "thorough")
     assert 1 <= _same_answer(default, thorough) <= len(default)
     for r in default + thorough:
-        assert float(r["verified_width_m"]) >= float(r["overturning_width_m"]) > 0
+        assert float(r["design_width_m"]) >= float(r["overturning_width_m"]) > 0
     for out, rows in (("default", default), ("thorough", thorough)):
         with open(tmp_path / out / "design.csv", newline="") as fh:
             (row,) = list(csv.DictReader(fh))
         assert float(row["overturning_width_m"]) == max(float(r["overturning_width_m"]) for r in rows)
-        assert float(row["overturning_width_m"]) <= float(row["verified_width_m"])
+        assert float(row["overturning_width_m"]) <= float(row["design_width_m"])
 
 
 def test_plots_all_draws_every_direction_and_no_plots_none(pair, tmp_path):

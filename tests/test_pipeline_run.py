@@ -118,7 +118,7 @@ def test_batch_with_bad_records_reports_failures_and_exits_1(batch_run, batch20)
     for k in range(15):
         rows = read_csv(out / f"good{k:02d}.csv")
         assert len(rows) == 1 and rows[0]["column"] == "7.5x1.8"
-        assert rows[0]["verified_width_m"] and rows[0]["eq31_width_m"] and rows[0]["exact_tan_alpha"]
+        assert rows[0]["design_width_m"] and rows[0]["eq31_width_m"] and rows[0]["exact_tan_alpha"]
     assert not list(out.glob("missing*.csv")) and not list(out.glob(".*"))  # no stray temp files
     # every column of the reports is explained in columns.md, with a unit
     md = (out / "columns.md").read_text()
@@ -205,7 +205,7 @@ def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
     assert main(["run", str(rec), "--height", "6", "--out", str(out), "--no-plots", "-q"]) == 0
     assert read_csv(out / "failures.csv") == []
     row = read_csv(out / "summary.csv")[0]
-    assert row["column_kind"] == "height" and row["width_m"] == "" and float(row["verified_width_m"]) > 0
+    assert row["column_kind"] == "height" and row["width_m"] == "" and float(row["design_width_m"]) > 0
     capsys.readouterr()
     for bad in (["--block", "7.5x0"], ["--block", "abc"], [], ["--block", "7.5x1.8", "--jobs", "-1"],
                 ["--block", "7.5x1.8", "--units", "cm/s"], ["--block", "7.5x1.8", "--shapes", "square"]):
@@ -256,7 +256,7 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
     files = [p for p in files if p.name not in (report.MANIFEST, resume.RESUME)]
     for path in files:  # every report written is whole: the header and one row
         rows = read_csv(path)
-        assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
+        assert len(rows) == 1 and rows[0]["design_adequate"] in ("True", "False")
 
 
 @pytest.mark.slow
@@ -324,11 +324,11 @@ def test_cli_end_to_end_numbers_match_library(tmp_path):
     sim31 = rocking.simulate(rocking.Block.from_dimensions(7.5, w31), record)
     assert r["eq31_width_overturns"] == str(bool(sim31.overturned))
     assert close(r["eq31_width_max_theta_ratio"], sim31.max_rotation_ratio)
-    # the verified width under the full record
+    # the design width under the full record
     ver = rocking.required_width(7.5, record, rule="exact")
-    assert close(r["verified_width_m"], ver.width)
-    assert r["verified_adequate"] == str(1.8 >= ver.width)
-    assert close(rows[2]["verified_width_m"], rocking.required_width(9.0, record, rule="exact").width)
+    assert close(r["design_width_m"], ver.width)
+    assert r["design_adequate"] == str(1.8 >= ver.width)
+    assert close(rows[2]["design_width_m"], rocking.required_width(9.0, record, rule="exact").width)
     # every fitting shape has its design; the governing one is the widest Eq. 31 design
     fitting = r["shapes_fitting"].split(";")
     assert fitting[0] == best.shape
@@ -386,10 +386,10 @@ def test_rinaldi_eq31_and_survival_of_the_temple_column(paper_run):
     # Fig. 11: the column (tan alpha 0.24) survives the full record ...
     assert r["overturns"] == "False"
     assert float(r["max_theta_ratio"]) < 1.0
-    # ... though only just: the verified width (survives at that and every larger width) is a few
+    # ... though only just: the design width (survives at that and every larger width) is a few
     # cm wider, 1.8 m stands on a safe island of the full record
-    assert 1.7 <= float(r["verified_width_m"]) <= 2.0
-    assert r["verified_adequate"] == str(1.8 >= float(r["verified_width_m"]))
+    assert 1.7 <= float(r["design_width_m"]) <= 2.0
+    assert r["design_adequate"] == str(1.8 >= float(r["design_width_m"]))
     # the Eq. 31 design for the Temple column's height survives the full record
     assert r["eq31_width_overturns"] == "False"
 
@@ -404,7 +404,7 @@ def test_pacoima_processed_with_its_pulse_shapes(paper_run):
         k = shape.replace("-", "_")
         assert float(r[f"{k}_eq31_tan_alpha"]) > 0 and float(r[f"{k}_exact_tan_alpha"]) >= 0
         assert float(r[f"{k}_eq31_width_m"]) > 0
-    assert float(r["verified_width_m"]) > 0 and r["overturns"] in ("True", "False")
+    assert float(r["design_width_m"]) > 0 and r["overturns"] in ("True", "False")
 
 
 def test_erzincan_ns_plain_text_processed(paper_run):
@@ -413,7 +413,7 @@ def test_erzincan_ns_plain_text_processed(paper_run):
     assert float(r["pga_g"]) == pytest.approx(0.5154, abs=0.001)  # MANIFEST: N-S peak
     assert float(r["dt_s"]) == 0.005 and int(r["npts"]) == 4260
     assert r["pulse_shape"] in pulses.SHAPES and r["shapes_fitting"]
-    assert float(r["verified_width_m"]) > 0
+    assert float(r["design_width_m"]) > 0
 
 
 # -- dask -----------------------------------------------------------------------------------------
@@ -772,7 +772,7 @@ def _check_reports_whole(out):
     for path in files:
         if path.name not in (report.MANIFEST, resume.RESUME):
             rows = read_csv(path)
-            assert len(rows) == 1 and rows[0]["verified_adequate"] in ("True", "False")
+            assert len(rows) == 1 and rows[0]["design_adequate"] in ("True", "False")
 
 
 @pytest.mark.slow

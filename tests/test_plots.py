@@ -117,14 +117,14 @@ def test_long_records_are_thinned_for_drawing_only():
 @pytest.mark.slow
 def test_summary_figure_plots_the_rows():
     """The summary's points are the rows' numbers: required against actual tan(alpha) for columns as
-    they stand, split by verdict, and verified against Eq. 31 design for every row."""
+    they stand, split by verdict, and the design width's against Eq. 31's for every row."""
     rows = [
-        {"column_kind": "block", "tan_alpha": 0.24, "governing_eq31_tan_alpha": 0.2, "verified_tan_alpha": 0.18,
+        {"column_kind": "block", "tan_alpha": 0.24, "governing_eq31_tan_alpha": 0.2, "design_tan_alpha": 0.18,
          "overturns": False, "eq31_width_tan_alpha": 0.2, "eq31_width_overturns": False},
         {"column_kind": "block", "tan_alpha": "0.15", "governing_eq31_tan_alpha": "0.3",
-         "verified_tan_alpha": "0.33", "overturns": True, "eq31_width_tan_alpha": "0.3",
+         "design_tan_alpha": "0.33", "overturns": True, "eq31_width_tan_alpha": "0.3",
          "eq31_width_overturns": True},
-        {"column_kind": "height", "tan_alpha": "", "eq31_width_tan_alpha": 0.25, "verified_tan_alpha": 0.21,
+        {"column_kind": "height", "tan_alpha": "", "eq31_width_tan_alpha": 0.25, "design_tan_alpha": 0.21,
          "eq31_width_overturns": False},
     ]
     fig = plots.summary_figure(rows)
@@ -151,19 +151,19 @@ def test_summary_figure_without_columns_says_so():
 
 
 @pytest.mark.slow
-def test_record_figure_velocity_pulse_and_verified_width(tmp_path):
+def test_record_figure_velocity_pulse_and_design_width(tmp_path):
     """The run's figure adds the record's velocity with the extracted velocity pulse (the
-    classification's own arrays) and the column at its verified width (the row's width)."""
+    classification's own arrays) and the column at its design width (the row's width)."""
     import pulses
 
     path = write_good(tmp_path, 4)
     task, = make_tasks([str(path)], [Column(7.5, 1.8)], Options())
-    rows, (record, fit, fitting, histories, _velocity), _verified = _process(task)
+    rows, (record, fit, fitting, histories, _velocity), _designs = _process(task)
     (label, curves), = histories
     assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "design width"]
     _, block_v, res_v = curves[2]
-    assert block_v.width == pytest.approx(rows[0]["verified_width_m"], rel=1e-12)
-    assert not res_v.overturned  # the verified width survives the record
+    assert block_v.width == pytest.approx(rows[0]["design_width_m"], rel=1e-12)
+    assert not res_v.overturned  # the design width survives the record
     cls = pulses.classify_pulse(record)
     fig = plots.record_figure(task.record_id, record, fit, fitting, histories, velocity=cls)
     top, vel, rot = fig.axes

@@ -1,6 +1,7 @@
 """``pipeline run`` resumed: a batch killed halfway and run again computes only what is missing."""
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
@@ -124,3 +125,36 @@ def test_a_resume_journal_not_written_by_the_tool_is_an_argument_error(batch, tm
     assert main(["run", batch[0], *BATCH_ARGS, "--out", str(out)]) == 2
     assert "was not written by pipeline run" in capsys.readouterr().err
     assert (out / resume.RESUME).read_text() == "my notes\n"
+
+
+def _earlier_header(head):
+    """A header line of 0.6's reports: the design width's columns under their names of then."""
+    for new, old in (("vertical_design_width_m", "vertical_verified_width_m"), ("design_width_m", "verified_width_m"),
+                     ("design_tan_alpha", "verified_tan_alpha"), ("design_adequate", "verified_adequate")):
+        head = re.sub(rf"(^|,){new}(,|$)", rf"\g<1>{old}\g<2>", head)
+    return head
+
+
+@pytest.mark.slow
+def test_a_report_with_the_column_names_of_an_earlier_version_is_computed_again(batch, tmp_path, capsys):
+    """0.7 renamed ``verified_width_m`` and its siblings (``design_width_m`` ...).  A report written
+    with the earlier header, even under a journal line that matches it, is not read back (its
+    columns would be misplaced): the record is computed again and the folder is as a fresh run's."""
+    out = tmp_path / "out"
+    assert main(["run", batch[0], *BATCH_ARGS, "--out", str(out)]) == 0
+    first = tree(out)
+    name = report.record_csv_name("good00")
+    manifest = out / report.MANIFEST
+    for rel in (name, "summary.csv"):  # as the earlier run wrote them, and listed in its manifest
+        head, _, rows = first[rel].decode("utf-8").partition("\n")
+        assert "design_width_m" in head.split(",") and "verified_width_m" not in head.split(",")
+        raw = (_earlier_header(head) + "\n" + rows).encode("utf-8")
+        assert "verified_width_m" in raw.decode("utf-8").split("\n")[0].split(",")
+        (out / rel).write_bytes(raw)
+        manifest.write_text(manifest.read_text().replace(
+            f"{hashlib.sha256(first[rel]).hexdigest()}  {rel}\n", f"{hashlib.sha256(raw).hexdigest()}  {rel}\n"))
+    journal = resume.Journal(out)  # the journal vouches for the report
+    journal.add("good00", journal.entries["good00"][0], (out / name).read_bytes(), None)
+    assert main(["run", batch[0], *[a for a in BATCH_ARGS if a != "--quiet"], "--out", str(out)]) == 0
+    assert _counts(capsys.readouterr().out) == (1, 1, 0, 1)
+    assert tree(out) == first

@@ -389,7 +389,7 @@ def test_stale_temporaries_are_not_removed_through_a_link(tmp_path):
 # -- the smaller wrongs ---------------------------------------------------------------------------------
 def test_a_constant_offset_is_reported_and_a_constant_refused(tmp_path):
     """A record with a 1 g offset was designed as if the offset were ground motion, silently (the
-    verified width went from 1.84 to 8.30 m).  Now every report of it says so; a record that is
+    design width went from 1.84 to 8.30 m).  Now every report of it says so; a record that is
     one constant throughout has no motion and is refused."""
     import numpy as np
 

@@ -99,7 +99,7 @@ def test_a_failed_direction_is_counted_in_pairs_csv(pairs, pair_run, tmp_path, m
     reference = {g["pair"]: g for g in _read(pair_run / "pairs.csv")}
     others = [r for r in rows if r["pair"] == first and r["record"] != killed]
     assert int(gov[first]["n_directions_failed"]) == 1 and int(gov[first]["n_directions"]) == len(others)
-    assert _f(gov[first]["verified_width_m"]) == max(_f(r["verified_width_m"]) for r in others)
+    assert _f(gov[first]["design_width_m"]) == max(_f(r["design_width_m"]) for r in others)
     second = next(p for p in gov if p != first)
     assert int(gov[second]["n_directions_failed"]) == 0 and gov[second] == reference[second]
 
@@ -117,15 +117,15 @@ def test_pair_rows_governing_and_suite(pairs, pair_run, tmp_path):
         kinds = {r["direction_kind"] for r in mine}
         assert {"component-1", "component-2"} <= kinds
         assert all(r["file2"] for r in mine)
-        # the floor: the governing width is at least each recorded component's verified width
+        # the floor: the governing width is at least each recorded component's design width
         for r in mine:
-            assert _f(g["verified_width_m"]) >= _f(r["verified_width_m"])
-        assert _f(g["verified_width_m"]) == max(_f(r["verified_width_m"]) for r in mine)
-    # width_all_m is the largest verified width of the suite; all-but-one the second largest governing
-    widths = [_f(r["verified_width_m"]) for r in rows]
+            assert _f(g["design_width_m"]) >= _f(r["design_width_m"])
+        assert _f(g["design_width_m"]) == max(_f(r["design_width_m"]) for r in mine)
+    # width_all_m is the largest design width of the suite; all-but-one the second largest governing
+    widths = [_f(r["design_width_m"]) for r in rows]
     s = suite[0]
     assert _f(s["width_all_m"]) == max(widths)
-    assert _f(s["width_all_but_one_m"]) == sorted(_f(g["verified_width_m"]) for g in gov)[0]
+    assert _f(s["width_all_but_one_m"]) == sorted(_f(g["design_width_m"]) for g in gov)[0]
     assert int(s["n_records"]) == 2 and int(s["n_rows"]) == len(rows)
     # shares counted by hand from the rows
     survive = [all(r["overturns"] == "False" for r in rows if r["pair"] == g["pair"]) for g in gov]
@@ -140,7 +140,7 @@ def test_pair_rows_governing_and_suite(pairs, pair_run, tmp_path):
     by_kind = {r["direction_kind"]: r for r in pa}
     for kind, path in (("component-1", a1), ("component-2", a2)):
         r, ref = by_kind[kind], alone[str(path)]
-        for key in ("verified_width_m", "pga_g", "eq31_width_m", "envelope_width_m"):
+        for key in ("design_width_m", "pga_g", "eq31_width_m", "envelope_width_m"):
             # exactly the same samples (cos 0 = 1, sin 0 = 0; cos 90 deg = 6e-17 times the other
             # component: below the last of 6 printed digits)
             assert _f(r[key]) == pytest.approx(_f(ref[key]), rel=1e-5), key
@@ -159,8 +159,8 @@ def test_direction_equals_rotated_record_file(pairs, pair_run, tmp_path):
     assert _run(out, path, "--block", f"{H}x{B}") == 0
     (ref,) = _read(out / "summary.csv")
     # SAC stores float32: samples come back to a relative 6e-8, so the fit and the widths agree to
-    # far better than the 1e-4 asked here (the verified width's own bracket is 1e-3 relative)
-    for key in ("pga_g", "pgv_m_s", "verified_width_m", "eq31_width_m", "envelope_width_m",
+    # far better than the 1e-4 asked here (the search's own bracket is 1e-3 relative)
+    for key in ("pga_g", "pgv_m_s", "design_width_m", "eq31_width_m", "envelope_width_m",
                 "max_theta_ratio", "pulse_tp_s"):
         assert _f(row[key]) == pytest.approx(_f(ref[key]), rel=1e-4), key
     assert row["overturns"] == ref["overturns"]
@@ -200,16 +200,16 @@ def test_scale_and_scales(pairs, tmp_path):
     (r1,), (r2,) = _read(out1 / "summary.csv"), _read(out2 / "summary.csv")
     assert r1["scale"] == "1" and r2["scale"] == "2"
     assert _f(r2["pga_g"]) == pytest.approx(2 * _f(r1["pga_g"]), rel=1e-5)
-    # the verified width of the scaled record, from the library on the record scaled here
+    # the design width of the scaled record, from the library on the record scaled here
     rec = pulses.read_record(a1).scaled(2.0)
     ref = rocking.required_width(H, rec, rule="exact").width
-    assert _f(r2["verified_width_m"]) == pytest.approx(ref, rel=1e-5)
+    assert _f(r2["design_width_m"]) == pytest.approx(ref, rel=1e-5)
     table = tmp_path / "scales.csv"
     table.write_text(f"record,scale\n{pathlib.Path(a1).name},2\n")
     out3 = tmp_path / "k3"
     assert _run(out3, a1, "--height", H, "--scales", table) == 0
     (r3,) = _read(out3 / "summary.csv")
-    assert r3["scale"] == "2" and r3["verified_width_m"] == r2["verified_width_m"]
+    assert r3["scale"] == "2" and r3["design_width_m"] == r2["design_width_m"]
     # a record the table does not name is an argument error (exit 2), not a guess
     assert _run(tmp_path / "k4", a1, a2, "--height", H, "--scales", table) == 2
 
@@ -247,7 +247,7 @@ def test_frame_reports(pairs, tmp_path):
     assert r["cap_mass_ratio"] == "2"
     ref = rocking.required_width(H, pulses.read_record(a1), rule="exact", cap_mass_ratio=2.0).width
     lone = rocking.required_width(H, pulses.read_record(a1), rule="exact").width
-    assert _f(r["verified_width_m"]) == pytest.approx(ref, rel=1e-5)
+    assert _f(r["design_width_m"]) == pytest.approx(ref, rel=1e-5)
     assert abs(ref - lone) > 1e-3 * lone  # the frame is not the lone column here
     assert _run(tmp_path / "bad", a1, "--height", H, "--cap-mass-ratio", "-1") == 2
 
@@ -284,7 +284,7 @@ def test_fragility_outputs(pairs, tmp_path):
 
 @pytest.mark.slow
 def test_suite_and_fragility_plots():
-    """The suite plot draws the share of records verified at each width (step curve through the
+    """The suite plot draws the share of records whose design width is at most each width (step curve through the
     sorted governing widths) and marks the column; PNGs are at least 1000 px wide."""
     import io
 
@@ -292,7 +292,7 @@ def test_suite_and_fragility_plots():
 
     from pipeline.reports.plot_site import fragility_figure_png, suite_figure, suite_figure_png
 
-    rows = [{"column": "2x0.35", "pair": p, "verified_width_m": w, "eq31_width_m": e}
+    rows = [{"column": "2x0.35", "pair": p, "design_width_m": w, "eq31_width_m": e}
             for p, w, e in (("a", 0.30, 0.2), ("a", 0.41, 0.25), ("b", 0.22, 0.3), ("c", 0.50, 0.1))]
     suite = [{"column": "2x0.35", "width_m": 0.35, "width_all_m": 0.50, "n_records": 3, "n_rows": 4}]
     fig = suite_figure(rows, suite)

@@ -1,4 +1,4 @@
-"""The check above the verified width (docs/slivers.md): failing slivers above it, found and
+"""The check above the search width (docs/slivers.md): failing slivers above it, found and
 reported, against independent dense scans."""
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def _verdicts(height, record, widths):
 
 def _chaotic_record(seed=8, duration=20.0, dt=0.01):
     """A 0.3 g sine pulse in 0.15 g of band-limited noise: under it a 7.5 m column has failing
-    widths above its verified width (0.878 m): a 3000-width linear scan of (w, 2w] finds three,
+    widths above its search width (0.878 m): a 3000-width linear scan of (w, 2w] finds three,
     1.0, 1.5 and 2.7 % above it, and 4 % of 1500 log-spaced widths 0.01-1 % above it fail)."""
     from scipy import signal
 
@@ -61,7 +61,7 @@ def test_check_widths_layout():
     assert not np.array_equal(x, check_widths(w, top, s, seed=6))
     # span: at most check_span times the width
     assert check_widths(1.0, 100.0, s, seed=1)[-1] <= s.check_span
-    # nothing to check where the verified width is the no-uplift width; 0 runs switch it off
+    # nothing to check where the search width is the no-uplift width; 0 runs switch it off
     assert check_widths(1.0, 1.0, s).size == 0
     assert check_widths(1.0, 2.0, s.replace(check_runs=0)).size == 0
     # later stages: two widths in every bin, ratio 0.5 (no spread) except three bins: spread
@@ -98,7 +98,7 @@ def test_check_widths_layout():
 @pytest.mark.slow
 def test_check_against_dense_scans_synthetic():
     """A synthetic chaotic record: the check changes nothing else, is repeatable, reports only
-    widths that overturn, and its share just above the verified width agrees with a dense
+    widths that overturn, and its share just above the search width agrees with a dense
     independent scan of the same stretch."""
     height = 7.5
     rec = _chaotic_record()
@@ -148,7 +148,7 @@ def test_check_against_dense_scans_synthetic():
 @pytest.mark.slow
 def test_check_against_dense_scan_real_record():
     """Landers, Lucerne 345 (real, 7.5 m): an independent linear scan of 4000 widths of (w, 2w]
-    finds failing widths more than 1 % above the verified width; the check reports a widest
+    finds failing widths more than 1 % above the search width; the check reports a widest
     failing width at least that far up (not None), which overturns in the reference model."""
     height = 7.5
     rec = pulses.read_record(shared_record("RSN879_LANDERS_LCN345.AT2"))
@@ -181,21 +181,21 @@ def test_pipeline_reports_the_check(tmp_path):
     out = tmp_path / "out"
     # a column at the search's width (rounded up to 1 mm): above the search's first transition,
     # yet the check found wider failing widths (0.878 m, failing widths up to ~0.91 m), so it is
-    # below the design width: not verified-adequate
+    # below the design width: not design-adequate
     ver = rocking.required_width(7.5, pulses.read_record(path), rule="exact")
     width = math.ceil(ver.search_width * 1000) / 1000
     assert ver.search_width <= width < ver.widest_failing_width < ver.width
     assert main(["run", str(path), "--block", f"7.5x{width}", "--out", str(out), "-q"]) == 0
     row = next(csv.DictReader(open(out / "chaotic.csv")))
-    assert float(row["verified_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
+    assert float(row["design_width_m"]) == pytest.approx(ver.width, rel=1e-5)  # 6 digits
     assert float(row["search_width_m"]) == pytest.approx(ver.search_width, rel=1e-5)
     assert float(row["failing_share"]) == pytest.approx(ver.failing_share, rel=1e-5)
     assert float(row["widest_failing_width_m"]) == pytest.approx(ver.widest_failing_width, rel=1e-5)
     assert int(float(row["check_runs"])) == ver.check_runs
     assert ver.check_runs + ver.refine_runs <= DEFAULT_SETTINGS.check_runs < ver.check_runs + 50
-    assert row["verified_adequate"] == "False"
+    assert row["design_adequate"] == "False"
     suite = next(csv.DictReader(open(out / "suite.csv")))
-    assert suite["share_column_verified"] == "0" and suite["share_column_checked"] == "0"
+    assert suite["share_column_adequate"] == "0" and suite["share_column_checked"] == "0"
     assert (out / "plots" / "widths" / "chaotic.png").stat().st_size > 10_000
     text = (out / "columns.md").read_text()
     assert "`widest_failing_width_m`" in text and "docs/slivers.md" in text
@@ -203,7 +203,7 @@ def test_pipeline_reports_the_check(tmp_path):
 
 
 def test_check_uses_the_search_widths():
-    """The later stages measure the spread over the search's widths above the verified width too
+    """The later stages measure the spread over the search's widths above the search width too
     (at no cost): a model response with no spread anywhere but in the search's widths of one bin
     sends the later stages there; without them the stages spread evenly."""
     from rocking.widths import _add_check

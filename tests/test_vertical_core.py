@@ -246,7 +246,7 @@ def test_coarse_sampling_takes_sub_steps_and_agrees_with_the_reference():
     assert abs(res.max_rotation - ref.max_rotation) <= TOL_ALPHA * block.alpha
 
 
-# -- the verified width with the vertical ------------------------------------------------------------
+# -- the design width with the vertical --------------------------------------------------------------
 def _rsn15():
     if not DOWNLOAD.is_dir():
         pytest.skip(f"the shared PEER download is absent ({DOWNLOAD})")
@@ -257,7 +257,7 @@ def _rsn15():
 
 
 @pytest.mark.slow
-def test_verified_width_with_a_zero_vertical_is_the_horizontal_one():
+def test_design_width_with_a_zero_vertical_is_the_horizontal_one():
     rec = record()
     hor = rocking.required_width(3.0, rec, rule="exact")
     ver = rocking.required_width(3.0, rec, rule="exact", vertical=pulses.Record(np.zeros(rec.npts), rec.dt))
@@ -266,8 +266,8 @@ def test_verified_width_with_a_zero_vertical_is_the_horizontal_one():
 
 
 @pytest.mark.slow
-def test_verified_width_with_the_vertical_on_a_real_record():
-    """Taft (RSN 15, UP vertical), a 3 m column: at the verified width with the vertical the
+def test_design_width_with_the_vertical_on_a_real_record():
+    """Taft (RSN 15, UP vertical), a 3 m column: at the design width with the vertical the
     column survives in the compiled engine and in the independent reference integrator, and the
     widest width the search saw fail with the vertical overturns in the reference too."""
     rec, up = _rsn15()
@@ -289,7 +289,7 @@ def test_verified_width_with_the_vertical_on_a_real_record():
     assert res.width < 3.0 * ratio
 
 
-def test_a_vertical_reaching_minus_g_has_no_verified_width():
+def test_a_vertical_reaching_minus_g_has_no_design_width():
     rec = record()
     down = pulses.Record(np.where(np.arange(rec.npts) == 50, -1.2 * G, 0.0), rec.dt)
     with pytest.raises(rocking.errors.RockingInputError, match="leave the ground"):

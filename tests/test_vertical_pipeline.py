@@ -99,8 +99,8 @@ def test_a_level_with_the_vertical_is_at_least_the_overturning_design_in_every_d
     summary = rows(out)
     assert len(summary) >= 2 and all(r["design_governed_by"] for r in summary)
     for r in summary:
-        assert float(r["verified_width_m"]) >= float(r["overturning_width_m"]) > 0
-        assert float(r["verified_width_m"]) >= float(r["vertical_verified_width_m"])
+        assert float(r["design_width_m"]) >= float(r["overturning_width_m"]) > 0
+        assert float(r["design_width_m"]) >= float(r["vertical_design_width_m"])
     (design,) = rows(out, "design.csv")
     assert float(design["overturning_width_m"]) == max(float(r["overturning_width_m"]) for r in summary)
     plain = tmp_path / "plain"
@@ -108,6 +108,6 @@ def test_a_level_with_the_vertical_is_at_least_the_overturning_design_in_every_d
     assert all(r["overturning_width_m"] == "" for r in rows(plain))
     # the overturning design of the level's run is the plain run's, direction by direction (the
     # same searches; on this pair the passes check the same directions in both runs)
-    by_dir = {r["direction_deg"]: r["verified_width_m"] for r in rows(plain)}
+    by_dir = {r["direction_deg"]: r["design_width_m"] for r in rows(plain)}
     for r in summary:
         assert float(r["overturning_width_m"]) == float(by_dir[r["direction_deg"]])

@@ -16,7 +16,7 @@ import rocking
 pulse = pulses.OneSine(ap=0.5 * pulses.G, tp=1.0)
 heights = np.linspace(3, 15, 13)
 rules = {"eq31": ("Eq. 31", "#0072B2", "-"), "eq20": ("Eq. 20", "#E69F00", ":"),
-         "envelope": ("envelope rule", "#009E73", "--"), "exact": ("exact (verified)", "k", "-")}
+         "envelope": ("envelope rule", "#009E73", "--"), "exact": ("exact (time histories)", "k", "-")}
 
 fig, ax = plt.subplots(figsize=(8, 3.6), layout="constrained")
 for rule, (label, colour, style) in rules.items():

@@ -1,4 +1,4 @@
-"""Which directions of a pair get the check above the verified width and the figures.
+"""Which directions of a pair get the check above the search width and the figures.
 
 A pair designed in many directions is governed by its widest direction: the pair's design width is
 the widest of its directions' design widths, each above every failing width its check found
@@ -16,7 +16,7 @@ design width to, :func:`_bracket_step`):
 2. the other directions, each with its check where its ``check_top`` lies above the widest
    width the scouts found (a lower bound of the pair's design width), in the same task as its
    search;
-3. the governing direction (widest verified width, the first such in angle order, as in
+3. the governing direction (widest design width, the first such in angle order, as in
    ``pairs.csv``) with its check where not done, and its figures;
 4. then, while any is left, every unchecked direction whose ``check_top`` lies above the pair's
    design width found so far (the widest design width of the checked directions): the whole
@@ -80,7 +80,7 @@ class _Direction:
     index: int
     checked: bool
     plotted: bool
-    #: per column label: (verified width, check top, widest failing width or None)
+    #: per column label: (design width, check top, widest failing width or None)
     columns: dict
 
 
@@ -111,7 +111,7 @@ class Plan:
         for r in rows:
             # as the report holds them (6 digits): a resumed run decides as the first did
             w, H, pga, widest = (None if r.get(k) in (None, "") else float(fmt(float(r[k])))
-                                 for k in ("verified_width_m", "height_m", "pga_g", "widest_failing_width_m"))
+                                 for k in ("design_width_m", "height_m", "pga_g", "widest_failing_width_m"))
             # the widest design width its check could set (above the reach of its rounds)
             cols[r["column"]] = (w, self.step * min(self.span * w, H * pga), widest)
         group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols)
@@ -141,7 +141,7 @@ class Plan:
         for i in sorted(self.held):
             t = tasks[i]
             group = self.pairs.get(pair_of(t), {})
-            lower = {}  # the scouts' widest verified width (not their checks': the same on a resumed run)
+            lower = {}  # the scouts' widest design width (not their checks': the same on a resumed run)
             for d in group.values():
                 for label, (w, _, _) in d.columns.items():
                     lower[label] = max(lower.get(label, 0.0), w)

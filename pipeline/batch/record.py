@@ -60,7 +60,7 @@ def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
            "failure": None, "plot": None, "widths_plot": None}
     try:
-        rows, fit_parts, verified = _process(task)
+        rows, fit_parts, designs = _process(task)
         out["rows"] = rows
     except StageError as err:
         out["failure"] = failure(task, err.stage, err.exc)
@@ -75,18 +75,18 @@ def _process_record(task: Task) -> dict:
 
         try:
             out["plot"] = _stage("plot", run_figure_png, task.record_id, *fit_parts)
-            out["widths_plot"] = _stage("plot", _widths_png, task.record_id, verified)
+            out["widths_plot"] = _stage("plot", _widths_png, task.record_id, designs)
         except StageError as err:
             out["failure"] = failure(task, err.stage, err.exc)
     return out
 
 
-def _widths_png(record_id, verified):
-    """``plots/widths/<record>.png`` where the check above a verified width found failing widths
+def _widths_png(record_id, designs):
+    """``plots/widths/<record>.png`` where the check above a search width found failing widths
     (docs/slivers.md); None elsewhere."""
     from ..reports.plot_widths import record_widths_png
 
-    return record_widths_png(record_id, {f"{H:g} m": v for H, v in verified.items()})
+    return record_widths_png(record_id, {f"{H:g} m": v for H, v in designs.items()})
 
 
 FAILURE_COLUMNS = Columns(
@@ -366,8 +366,8 @@ def _eq31_design_fields(height, w31, res31) -> dict:
     })
 
 
-VERIFIED_COLUMNS = Columns(
-    ("verified_width_m", "m", "Design width: the smallest width for which a column of this height "
+DESIGN_WIDTH_COLUMNS = Columns(
+    ("design_width_m", "m", "Design width: the smallest width for which a column of this height "
                               "survives the full record (max|theta|/alpha <= `design_limit` with "
                               "`--limit`), at that width and at every larger one the search and the "
                               "check above it examined: at least every width they found to fail, "
@@ -375,10 +375,10 @@ VERIFIED_COLUMNS = Columns(
                               "`.width`); with a vertical component, the wider of the horizontal "
                               "motion's and the one with the vertical (`design_governed_by`). "
                               "Independent of the pulse fit."),
-    ("verified_tan_alpha", "-", "tan(alpha) of the design width, verified_width_m / height_m."),
-    ("verified_adequate", "-", "The column as it stands is at least as wide as the design width "
+    ("design_tan_alpha", "-", "tan(alpha) of the design width, design_width_m / height_m."),
+    ("design_adequate", "-", "The column as it stands is at least as wide as the design width "
                                "(blank for `--height`). A column that survives (`overturns` False) "
-                               "but is not verified-adequate stands on a safe island: some slightly "
+                               "but is not design-adequate stands on a safe island: some slightly "
                                "wider column of the same height overturns under the same record."),
     ("search_width_m", "m", "Diagnostic: the search's first transition (the smallest width above "
                             "which every width the search examined survives; `search_width`), "
@@ -391,16 +391,16 @@ VERIFIED_COLUMNS = Columns(
     ("overturning_width_m", "m", "With `--limit` R: the overturning design width of the same column "
                                  "and record (the same search and check for not overturning; with a "
                                  "vertical, the wider of the two motions'). The design width "
-                                 "`verified_width_m` is at least it: a width that overturns fails "
+                                 "`design_width_m` is at least it: a width that overturns fails "
                                  "every level (docs/design.md, \"Performance levels\"). Blank without "
                                  "`--limit`."),
 )
 
 
-def _verified_fields(col: Column, ver) -> dict:
-    return VERIFIED_COLUMNS.row({
-        "verified_width_m": float(ver.width), "verified_tan_alpha": float(ver.width) / col.height,
-        "verified_adequate": None if col.width is None else col.width >= float(ver.width),
+def _design_width_fields(col: Column, ver) -> dict:
+    return DESIGN_WIDTH_COLUMNS.row({
+        "design_width_m": float(ver.width), "design_tan_alpha": float(ver.width) / col.height,
+        "design_adequate": None if col.width is None else col.width >= float(ver.width),
         "search_width_m": None if ver.search_width is None else float(ver.search_width),
         "design_governed_by": ver.governed_by, "design_limit": ver.limit,
         "overturning_width_m": ver.overturning_width,
@@ -416,13 +416,13 @@ CHECK_COLUMNS = Columns(
                            f"width so far up to {check_reach_words()} or the no-uplift width (height x PGA / g), "
                            "whichever is smaller: this is the share of them that fail (0: none did; "
                            "blank: no check, as in a direction of a pair whose check could not reach "
-                           "the pair's design width, docs/site.md). The design width `verified_width_m` lies just above the "
+                           "the pair's design width, docs/site.md). The design width `design_width_m` lies just above the "
                            "widest failing width found."),
     ("widest_failing_width_m", "m", "The widest width the search or the check found to fail above "
                                     "the search width (a failing sliver; blank where none was found, "
                                     "which does not prove there is none); the design width lies just "
                                     "above it."),
-    ("check_runs", "-", "Number of widths (solver runs) of the check above the verified width (0: "
+    ("check_runs", "-", "Number of widths (solver runs) of the check above the search width (0: "
                         "not checked; fewer than its 1500 where its later rounds could not reach the "
                         "pair's design width, docs/site.md)."),
 )
@@ -439,7 +439,7 @@ def _check_fields(ver) -> dict:
 COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
            + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
            + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
-           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + VERIFIED_COLUMNS.columns
+           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + DESIGN_WIDTH_COLUMNS.columns
            + CHECK_COLUMNS.columns
            + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns + vertical.VERTICAL_COLUMNS.columns)
 FIELDS = [name for name, _, _ in COLUMNS]
@@ -480,7 +480,7 @@ def _process(task: Task):
 
     rows = []
     histories = []
-    verified_cache = {}
+    design_cache = {}
     eq31_cache = {}
     for col in task.columns:
         H = col.height
@@ -515,10 +515,10 @@ def _process(task: Task):
 
         # -- design width: smallest width surviving the full record (islands respected), above
         #    every width found to fail, with the vertical where there is one ----------------------
-        if H not in verified_cache:
-            verified_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col])
+        if H not in design_cache:
+            design_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col])
         if draw:  # the column at its design width, for the figure
-            wv = float(verified_cache[H].width)
+            wv = float(design_cache[H].width)
             block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
             curves.append((f"design width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
             histories.append((col.label, curves))
@@ -528,13 +528,13 @@ def _process(task: Task):
         row.update(designed)
         row.update(_as_stands_fields(block, designed, res))
         row.update(_eq31_design_fields(H, w31, res31))
-        row.update(_verified_fields(col, verified_cache[H]))
-        row.update(_check_fields(verified_cache[H]))
+        row.update(_design_width_fields(col, design_cache[H]))
+        row.update(_check_fields(design_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, verified_cache[H]))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, design_cache[H]))
         rows.append(row)
 
-    return rows, (record, fit, fitting, histories, velocity), verified_cache
+    return rows, (record, fit, fitting, histories, velocity), design_cache
 
 
 def design_width(record, up, height, cap_mass_ratio, limit, settings):

@@ -92,7 +92,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
     except OSError as exc:
         problems.append(exc)
     if plots:
-        # the record's figure, and the barcode of the check above the verified width where it
+        # the record's figure, and the barcode of the check above the search width where it
         # found failing widths; a figure not drawn this time is removed (an earlier run's)
         for name, data in ((report.record_plot_name(rid), res.get("plot")),
                            (report.record_widths_plot_name(rid), res.get("widths_plot"))):

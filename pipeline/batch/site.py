@@ -224,7 +224,7 @@ def governing_rows(rows, failed=None) -> list[dict]:
     ``failed``: ``{pair: directions that failed}``."""
     out = []
     for (_, pair), group in _groups(rows).items():
-        gov = max(group, key=lambda r: r["verified_width_m"])  # first of equal widths
+        gov = max(group, key=lambda r: r["design_width_m"])  # first of equal widths
         row = PAIR_COLUMNS.row({"n_directions": len(group), "n_directions_failed": (failed or {}).get(pair, 0),
                                 "governing_direction_deg": gov["direction_deg"]})
         row.update(gov)
@@ -245,18 +245,18 @@ SUITE_COLUMNS = Columns(
     ("width_all_but_one_m", "m", "Width that survives all records but one (each record counted by its "
                                  "governing direction): the second largest governing design width "
                                  "(blank with fewer than two records)."),
-    ("verified_width_median_m", "m", "Median of the records' governing design widths."),
-    ("verified_width_p84_m", "m", "84th percentile of the records' governing design widths (linear "
+    ("design_width_median_m", "m", "Median of the records' governing design widths."),
+    ("design_width_p84_m", "m", "84th percentile of the records' governing design widths (linear "
                                   "interpolation between order statistics, numpy's default)."),
     ("eq31_width_max_m", "m", "Largest Eq. 31 width over the records and directions."),
     ("share_column_survives", "-", "Share of the records under which the column as it stands does not "
                                    "overturn, in any direction (blank for `--height`)."),
-    ("share_column_verified", "-", "Share of the records whose governing design width the column as it "
+    ("share_column_adequate", "-", "Share of the records whose governing design width the column as it "
                                    "stands reaches (so it survives them with no safe island)."),
     ("share_column_checked", "-", "Share of the records whose governing design width the column as it "
                                   "stands reaches and that the check above the search width "
                                   "(`failing_share`, docs/slivers.md) found no failing width at or above "
-                                  "the column's width, in any direction: verified with the same check as "
+                                  "the column's width, in any direction: judged with the same check as "
                                   "each record's `widest_failing_width_m` (blank for `--height`)."),
     ("share_eq31_survives", "-", "Share of the records under which the column's Eq. 31 design (for each "
                                  "direction, its own Eq. 31 width) does not overturn, in any direction."),
@@ -268,7 +268,7 @@ def checked(row, width) -> bool:
     """A column ``width`` wide reaches the row's design width and is wider than every failing
     width the check above it found (docs/slivers.md)."""
     widest = row.get("widest_failing_width_m")
-    return (width is not None and float(width) >= float(row["verified_width_m"])
+    return (width is not None and float(width) >= float(row["design_width_m"])
             and (widest is None or float(width) > float(widest)))
 
 
@@ -282,7 +282,7 @@ def suite_rows(rows) -> list[dict]:
     out = []
     for label, crows in by_column.items():
         groups = _groups(crows)
-        gov = np.array([max(r["verified_width_m"] for r in g) for g in groups.values()])
+        gov = np.array([max(r["design_width_m"] for r in g) for g in groups.values()])
         first = crows[0]
         is_block = first["column_kind"] == "block"
 
@@ -296,11 +296,11 @@ def suite_rows(rows) -> list[dict]:
             "n_records": len(groups), "n_rows": len(crows),
             "width_all_m": float(ranked[0]),
             "width_all_but_one_m": float(ranked[1]) if ranked.size > 1 else None,
-            "verified_width_median_m": float(np.median(gov)),
-            "verified_width_p84_m": float(np.percentile(gov, 84)),
+            "design_width_median_m": float(np.median(gov)),
+            "design_width_p84_m": float(np.percentile(gov, 84)),
             "eq31_width_max_m": max(float(r["eq31_width_m"]) for r in crows),
             "share_column_survives": share(lambda r: not r["overturns"]) if is_block else None,
-            "share_column_verified": share(lambda r: bool(r["verified_adequate"])) if is_block else None,
+            "share_column_adequate": share(lambda r: bool(r["design_adequate"])) if is_block else None,
             "share_column_checked": share(lambda r: checked(r, first["width_m"])) if is_block else None,
             "share_eq31_survives": share(lambda r: not r["eq31_width_overturns"]),
             "share_envelope_survives": share(lambda r: not r["envelope_width_overturns"]),

@@ -53,7 +53,7 @@ class Options:
     limit: float | None = None
     #: ``"auto"``: use a record's known vertical (pipeline.batch.vertical); ``"none"``: horizontal only
     vertical: str = "auto"
-    #: ``--thorough``: every direction of a pair gets the check above its verified width and
+    #: ``--thorough``: every direction of a pair gets the check above its search width and
     #: (with plots) its figures, as a lone record does (pipeline.batch.passes)
     thorough: bool = False
 
@@ -76,7 +76,7 @@ class Task:
     peer: object = None
     #: the vertical component's file of a pair (pipeline.batch.vertical: --triplet, --pairs auto)
     vertical: str | None = None
-    #: run the check above the verified width (docs/slivers.md); pipeline.batch.passes decides per
+    #: run the check above the search width (docs/slivers.md); pipeline.batch.passes decides per
     #: direction of a pair
     check: bool = True
     #: with ``check``: run it for a column only where its top lies above this width (m, one per

@@ -35,11 +35,12 @@ VERTICAL_COLUMNS = Columns(
                                 "which the rocking model does not describe; the response with the "
                                 "vertical stops there and its verdict is not a verdict."),
     ("vertical_t_lift_off_s", "s", "First time of g + av < 0 (blank when it never happens)."),
-    ("vertical_verified_width_m", "m", "Verified width with the vertical (`rocking.required_width`, "
+    ("vertical_design_width_m", "m", "Design width with the vertical (`rocking.required_width`, "
                                        "rule exact, `vertical=`): the smallest width surviving the "
                                        "horizontal motion of this row together with the vertical, at "
-                                       "that width and every larger one scanned; compare "
-                                       "`verified_width_m` (horizontal alone). Blank where the vertical "
+                                       "that width and every larger one the search and the check "
+                                       "examined; compare "
+                                       "`design_width_m` (the wider of this and the horizontal motion's alone, `design_governed_by`). Blank where the vertical "
                                        "reaches -g (the block would leave the ground)."),
     ("vertical_model", "-", "Model that answered with the vertical: `fast-vertical` (the compiled "
                             "engine, `rocking.simulate(..., vertical=)`; `rest` if the column never "
@@ -174,9 +175,9 @@ def fields(block, record, up, shown_file, designed=None) -> dict:
               "vertical_pga_g": float(np.max(np.abs(up.acc))) / G,
               "vertical_min_effective_gravity": float(np.min(1.0 + up.acc / G)),
               "vertical_overturns": None, "vertical_max_theta_ratio": None, "vertical_lifts_off": None,
-              "vertical_t_lift_off_s": None, "vertical_model": None, "vertical_verified_width_m": None}
+              "vertical_t_lift_off_s": None, "vertical_model": None, "vertical_design_width_m": None}
     if designed is not None and designed.vertical_width is not None:
-        values["vertical_verified_width_m"] = float(designed.vertical_width)
+        values["vertical_design_width_m"] = float(designed.vertical_width)
     if block is not None:
         res = rocking.simulate(block, record, vertical=up, history=False)
         values.update(vertical_overturns=bool(res.overturned), vertical_max_theta_ratio=float(res.max_rotation_ratio),

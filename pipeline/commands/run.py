@@ -73,7 +73,7 @@ def add_parser(subparsers) -> None:
                    help="append one JSON line per record to FILE (record, status, seconds, model, "
                         "worker), to watch a long batch")
     p.add_argument("--thorough", action="store_true",
-                   help="for pairs: the check above the verified width (and with --plots, the "
+                   help="for pairs: the check above the search width (and with --plots, the "
                         "figures) in every direction; by default only where it can change the "
                         "pair's design width (the same answer, docs/slivers.md)")
     add_record_options(p)

@@ -32,14 +32,14 @@ DESIGN_COLUMNS = Columns(
     ("governing_tp_s", "s", "Its period Tp."),
     ("eq31_width_m", "m", "Width the column's height needs by Eq. 31 for the governing pulse."),
     ("eq31_width_overturns", "-", "That Eq. 31 design overturns under the full record."),
-    ("verified_width_m", "m", "Design width: the smallest width surviving the full record at it and at "
+    ("design_width_m", "m", "Design width: the smallest width surviving the full record at it and at "
                               "every larger width examined, above every width the search and the check "
                               "found to fail, with the vertical where there is one (for a pair: the "
                               "widest over its directions; `--limit` R: max|theta|/alpha <= R)."),
     ("width_m", "m", "Width of the column as it stands (blank for `--height`)."),
     ("survives", "-", "The column as it stands does not overturn under the record (in any direction "
                       "of a pair); blank for `--height`."),
-    ("verified_adequate", "-", "The column as it stands is at least the design width (it survives "
+    ("design_adequate", "-", "The column as it stands is at least the design width (it survives "
                                "with no safe island); blank for `--height`."),
     ("max_theta_ratio", "-", "Largest max|theta|/alpha of the column as it stands over the directions."),
     ("widest_failing_width_m", "m", "Widest width found to overturn above the search width by the check "
@@ -123,14 +123,14 @@ def design_rows(rows, failed=None) -> list[dict]:
     ``failed`` (``{pair: directions that failed}``)."""
     out = []
     for (pair, column), group in _groups(rows).items():
-        gov = max(group, key=lambda r: number(r.get("verified_width_m")) or -math.inf)  # first of equals
+        gov = max(group, key=lambda r: number(r.get("design_width_m")) or -math.inf)  # first of equals
         block = gov.get("column_kind") == "block"
         limit = number(gov.get("design_limit"))
         ratios = [number(r.get("max_theta_ratio")) for r in group]
         ratios = [v for v in ratios if v is not None]
         survives = _bool_all([_meets(r, limit) for r in group]) if block else None
-        adequate = _bool_all([r.get("verified_adequate") for r in group]) if block else None
-        w31, wd = number(gov.get("eq31_width_m")), number(gov.get("verified_width_m"))
+        adequate = _bool_all([r.get("design_adequate") for r in group]) if block else None
+        w31, wd = number(gov.get("eq31_width_m")), number(gov.get("design_width_m"))
         row = DESIGN_COLUMNS.row({
             "record": pair, "column": column,
             "direction_deg": gov.get("direction_deg"),
@@ -140,9 +140,9 @@ def design_rows(rows, failed=None) -> list[dict]:
             "governing_shape": gov.get("governing_shape"), "governing_ap_g": gov.get("governing_ap_g"),
             "governing_tp_s": gov.get("governing_tp_s"),
             "eq31_width_m": gov.get("eq31_width_m"), "eq31_width_overturns": gov.get("eq31_width_overturns"),
-            "verified_width_m": gov.get("verified_width_m"),
+            "design_width_m": gov.get("design_width_m"),
             "width_m": gov.get("width_m") if block else None,
-            "survives": survives, "verified_adequate": adequate,
+            "survives": survives, "design_adequate": adequate,
             "max_theta_ratio": max(ratios) if (block and ratios) else None,
             "widest_failing_width_m": _widest([r.get("widest_failing_width_m") for r in group],
                                               above=number(gov.get("search_width_m"))),
@@ -155,7 +155,7 @@ def design_rows(rows, failed=None) -> list[dict]:
             "eq31_below_design": None if (w31 is None or wd is None) else w31 < wd,
             "check_runs": gov.get("check_runs"),
             "verdict": None if survives is None else verdict_text({"survives": survives,
-                                                                   "verified_adequate": adequate}),
+                                                                   "design_adequate": adequate}),
             "vertical_lift_off_s": (None if not block else min(
                 [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
                  if t is not None], default=None)),
@@ -181,15 +181,16 @@ def _m(value):
     return "-" if v is None else f"{v:.3f}"
 
 
-def excess_text(value, verified) -> str | None:
-    """``+2.5 %``: how far the width ``value`` lies above the ``verified`` width, relative to it.
+def excess_text(value, reference) -> str | None:
+    """``+2.5 %``: how far the width ``value`` lies above the ``reference`` width (the search
+    width, in the reports), relative to it.
 
     Whole percent from 10 % (``+25 %``), tenths from 1 % (``+2.5 %``), hundredths below
     (``+0.25 %``, ``+0.02 %``) and ``<+0.01 %`` below 0.01 %, so that a failing width a hair above
-    the verified one never reads as ``+0.0 %``.  None when either is blank or ``value`` is not
-    above ``verified``.
+    the reference never reads as ``+0.0 %``.  None when either is blank or ``value`` is not
+    above ``reference``.
     """
-    v, ref = number(value), number(verified)
+    v, ref = number(value), number(reference)
     if v is None or ref is None or ref <= 0 or v <= ref:
         return None
     pct = 100.0 * (v - ref) / ref
@@ -198,14 +199,14 @@ def excess_text(value, verified) -> str | None:
     return f"+{pct:.{0 if pct >= 10 else 1 if pct >= 1 else 2}f} %"
 
 
-def failing_text(value, verified, unit=" m") -> str | None:
-    """``0.608 m (+2.5 %)``: a failing width with how far it lies above ``verified``
+def failing_text(value, reference, unit=" m") -> str | None:
+    """``0.608 m (+2.5 %)``: a failing width with how far it lies above ``reference``
     (:func:`excess_text`; metres only where that is blank); None where ``value`` is blank.
     ``unit=""`` gives ``0.608 (+2.5 %)`` for a column headed in metres."""
     v = number(value)
     if v is None:
         return None
-    excess = excess_text(v, verified)
+    excess = excess_text(v, reference)
     return f"{v:.3f}{unit}" + (f" ({excess})" if excess else "")
 
 
@@ -225,7 +226,7 @@ def verdict_text(row) -> str:
         return "-"
     if not s:
         return "NO"
-    return "survives" if row.get("verified_adequate") else "NO: safe island"
+    return "survives" if row.get("design_adequate") else "NO: safe island"
 
 
 def survives_text(row) -> str:
@@ -260,7 +261,7 @@ def table_cells(row) -> tuple[str, ...]:
         name += f" @{d:.0f}deg"
     return (name, display(row.get("column") or "-"), _yes(row.get("pulse_like")), pulse_text(row),
             eq31_text(row),
-            _m(row.get("verified_width_m")) + (" m" if number(row.get("verified_width_m")) is not None else "")
+            _m(row.get("design_width_m")) + (" m" if number(row.get("design_width_m")) is not None else "")
             + (" (vertical)" if row.get("design_governed_by") == "with vertical" else ""),
             search_text(row), survives_text(row))
 
@@ -271,7 +272,7 @@ def search_text(row) -> str:
     w = number(row.get("search_width_m"))
     if w is None:
         return "-"
-    excess = excess_text(row.get("verified_width_m"), w)
+    excess = excess_text(row.get("design_width_m"), w)
     return f"{w:.3f} m" + (f" ({excess})" if excess else "")
 
 
@@ -333,11 +334,11 @@ def table_text(rows, failures=(), summary=()) -> str:
         widths = {}
         for r in summary:
             key = (r.get("pair") or r.get("record"), r.get("column"))
-            w = number(r.get("vertical_verified_width_m"))
+            w = number(r.get("vertical_design_width_m"))
             if w is not None:
                 widths[key] = max(w, widths.get(key, w))
         headers = HEADERS + (VERTICAL_HEADER,)
-        body = [c + (vertical_text(r) + (f", verified {widths[(r['record'], r.get('column'))]:.3f} m"
+        body = [c + (vertical_text(r) + (f", design {widths[(r['record'], r.get('column'))]:.3f} m"
                                           if (r["record"], r.get("column")) in widths else ""),)
                 for c, r in zip(body, rows)]
     body = _align_failing(body, FAILS_COLUMN)
@@ -376,7 +377,7 @@ def verdict_lines(rows) -> list[str]:
         by_column.setdefault(r.get("column"), []).append(r)
     out = []
     for column, group in by_column.items():
-        widths = [(number(r.get("verified_width_m")), r) for r in group]
+        widths = [(number(r.get("design_width_m")), r) for r in group]
         widths = [(w, r) for w, r in widths if w is not None]
         if not widths:
             continue

@@ -145,7 +145,7 @@ def _batch_table(design, anchors) -> list[str]:
             + _cell(r["governing_ap_g"], _fixed(r["governing_ap_g"], 3), numeric=True)
             + _cell(r["governing_tp_s"], _fixed(r["governing_tp_s"], 3), numeric=True)
             + _cell(r["eq31_width_m"], eq31_text(r).replace(" m", ""), numeric=True)
-            + _cell(r["verified_width_m"], _fixed(r["verified_width_m"])
+            + _cell(r["design_width_m"], _fixed(r["design_width_m"])
                     + (" (vertical)" if r.get("design_governed_by") == "with vertical" else ""), numeric=True)
             + _cell(r.get("search_width_m"), search_text(r).replace(" m", ""), numeric=True)
             + _cell(r.get("widest_failing_width_m"),
@@ -196,9 +196,9 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                             "the one asking for the widest column by Eq. 31)")
             parts = [governs,
                      f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
-                     + (" (below the design width)" if (_num(r.get("eq31_width_m")) or 0) < (_num(r.get("verified_width_m")) or 0) else "")
+                     + (" (below the design width)" if (_num(r.get("eq31_width_m")) or 0) < (_num(r.get("design_width_m")) or 0) else "")
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
-                     f"design width {_fixed(r.get('verified_width_m')) or '-'} m"
+                     f"design width {_fixed(r.get('design_width_m')) or '-'} m"
                      + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
                      + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else "")
                      + (f", at least the overturning design width {_fixed(r['overturning_width_m'])} m"
@@ -214,7 +214,7 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                                 if share else "none fails"))
             if r.get("column_kind") == "block":
                 surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
-                                      "verified_adequate": r.get("verified_adequate")})
+                                      "design_adequate": r.get("design_adequate")})
                 verdict = {"yes": "survives", "NO": "overturns",
                            "NO: safe island": "NO: survives only on a safe island (narrower than the design width)"}
                 parts.append(f"as it stands: {verdict.get(surv, surv)}"
@@ -288,7 +288,7 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
                        + "</tr>")
         out.append("</tbody></table>")
     site = [(k, label) for k, label in (("summary", "Required against actual slenderness"),
-                                        ("suite", "Suite: share of records verified against width"),
+                                        ("suite", "Suite: share of records whose design width a column of width B reaches"),
                                         ("fragility", "Collapse fragility")) if figures.get(k)]
     if site:
         out.append("<h2>Batch figures</h2>")

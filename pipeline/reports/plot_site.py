@@ -1,4 +1,4 @@
-"""Plots of a suite (``pipeline run``): share of the suite verified against width, and the collapse
+"""Plots of a suite (``pipeline run``): share of the suite covered against width, and the collapse
 fragility curves.  matplotlib's public object API only (a new :class:`matplotlib.figure.Figure` per
 plot, saved without the software-version text, so a re-run gives the same bytes)."""
 from __future__ import annotations
@@ -32,8 +32,8 @@ def _governing_checked(rows, label):
     failing widths the check above them found (docs/slivers.md), sorted."""
     out = {}
     for r in rows:
-        if r["column"] == label and r["verified_width_m"] is not None:
-            need = max(float(r["verified_width_m"]), float(r.get("widest_failing_width_m") or 0.0))
+        if r["column"] == label and r["design_width_m"] is not None:
+            need = max(float(r["design_width_m"]), float(r.get("widest_failing_width_m") or 0.0))
             out[r["pair"]] = max(out.get(r["pair"], -np.inf), need)
     return np.array(sorted(out.values()))
 
@@ -48,7 +48,7 @@ def suite_figure(rows, suite):
     axes = fig.subplots(n, 1, squeeze=False)[:, 0]
     for ax, s in zip(axes, suite):
         label = s["column"]
-        widths = _governing(rows, label, "verified_width_m")
+        widths = _governing(rows, label, "design_width_m")
         eq31 = _governing(rows, label, "eq31_width_m")
         share = np.arange(1, widths.size + 1) / widths.size
         x = np.concatenate([[0.0], widths])

@@ -1,5 +1,5 @@
 """The verdict against the width for one record and one column height: a *barcode* of the widths
-that survive and those that overturn, with the verified width and the failing slivers above it
+that survive and those that overturn, with the search width and the failing slivers above it
 marked (docs/slivers.md).  matplotlib's public object API only (a new
 :class:`matplotlib.figure.Figure` per plot, saved without the software-version text, so a re-run
 gives the same bytes)."""
@@ -40,14 +40,14 @@ def widths_figure(title, width, widths, failed, widest_failing=None, near=0.05):
     ----------
     title : str
     width : float
-        The verified width, m (a black line).
+        The search width, m (a black line; :attr:`rocking.RequiredWidth.search_width`).
     widths, failed : array_like
         Widths examined (m) and whether each overturned: a fine grid, or the check's widths.
     widest_failing : float, optional
         The widest failing width to mark (m; default: the widest failing one of ``widths``).
     near : float
         The lower panel shows ``B / width - 1`` from 1e-4 to this (log scale): the slivers just
-        above the verified width.
+        above the search width.
     """
     from matplotlib.figure import Figure
 
@@ -62,21 +62,21 @@ def widths_figure(title, width, widths, failed, widest_failing=None, near=0.05):
     ax1, ax2 = fig.subplots(2, 1)
     _bars(ax1, x, f)
     ax1.set_xlim(x[0], x[-1])
-    ax1.axvline(width, color="k", lw=2, label=f"verified width {width:.4g} m")
+    ax1.axvline(width, color="k", lw=2, label=f"search width {width:.4g} m")
     if widest_failing is not None:
         ax1.axvline(widest_failing, color=FAIL, lw=2, ls="--",
                     label=f"widest failing width {widest_failing:.4g} m "
                           f"({excess_text(widest_failing, width)})")
     ax1.set_xlabel("column width B (m): vermillion overturns, pale blue survives")
     ax1.set_title(f"{title}: {x.size} widths, {int(f.sum())} overturn, "
-                  f"{int(above.sum())} of them above the verified width", fontsize=9)
+                  f"{int(above.sum())} of them above the search width", fontsize=9)
     ax1.legend(loc="upper right", fontsize=7, framealpha=0.9)
     d = x / width - 1.0
     sel = (d > 0) & (d <= near)
     _bars(ax2, x[sel], f[sel], scale=100.0 / width, offset=width)
     ax2.set_xscale("log")
     ax2.set_xlim(1e-2, 100.0 * near)
-    ax2.set_xlabel("just above the verified width: B / verified width - 1 (%)")
+    ax2.set_xlabel("just above the search width: B / search width - 1 (%)")
     return fig
 
 
@@ -85,11 +85,11 @@ def widths_figure_png(title, width, widths, failed, widest_failing=None) -> byte
     return _png(widths_figure(title, width, widths, failed, widest_failing))
 
 
-def record_widths_png(record_id, verified) -> bytes | None:
-    """``plots/widths/<record>.png``: the barcode of the check above each column height's verified
-    width (``verified``: ``{label: RequiredWidth}``) where it found failing widths; None where it
+def record_widths_png(record_id, designs) -> bytes | None:
+    """``plots/widths/<record>.png``: the barcode of the check above each column height's search
+    width (``designs``: ``{label: RequiredWidth}``) where it found failing widths; None where it
     found none."""
-    found = [(label, v) for label, v in verified.items()
+    found = [(label, v) for label, v in designs.items()
              if v.check_widths is not None and v.widest_failing_width is not None]
     if not found:
         return None

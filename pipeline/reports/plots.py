@@ -208,7 +208,7 @@ def summary_figure(rows) -> Figure:
     if blocks:
         x = np.array([_num(r, "tan_alpha") for r in blocks])
         y31 = np.array([_num(r, "governing_eq31_tan_alpha") for r in blocks])
-        yv = np.array([_num(r, "verified_tan_alpha") for r in blocks])
+        yv = np.array([_num(r, "design_tan_alpha") for r in blocks])
         over = np.array([bool(r.get("overturns")) for r in blocks])
         ax1.scatter(x, y31, marker="o", facecolors="none", edgecolors=PALETTE[0], label="Eq. 31 (governing pulse)")
         ax1.scatter(x[~over], yv[~over], marker="x", color=PALETTE[2], label="design width, column survives")
@@ -227,7 +227,7 @@ def summary_figure(rows) -> Figure:
         ax1.text(0.5, 0.5, "no column as it stands (--block) in this run", ha="center", va="center",
                  transform=ax1.transAxes, fontsize=LABEL_SIZE, color="0.4")
     x = np.array([_num(r, "eq31_width_tan_alpha") for r in rows])
-    y = np.array([_num(r, "verified_tan_alpha") for r in rows])
+    y = np.array([_num(r, "design_tan_alpha") for r in rows])
     bad = np.array([bool(r.get("eq31_width_overturns")) for r in rows], dtype=bool)
     hi2 = np.nanmax(np.concatenate([x, y, [0.0]])) if rows else 0.0
     hi2 = 1.1 * hi2 if hi2 > 0 else 1.0

@@ -33,7 +33,7 @@ GOVERNING_RULE = (
     "the one whose Eq. 31 fixed-point width at the column's height is largest (the most demanding "
     "design; ties go to the better fit). `eq31_width_m` and `governing_eq31_tan_alpha` use it. "
     "Eq. 31 designs depend on the shape, so this rule is conservative among plausible shapes; the "
-    "verification under the full record (`overturns`, `eq31_width_overturns`, `verified_width_m`) "
+    "verification under the full record (`overturns`, `eq31_width_overturns`, `design_width_m`) "
     "does not depend on any shape and is the arbiter."
 )
 

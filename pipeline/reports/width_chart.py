@@ -12,7 +12,7 @@ RULES = {
     "eq31": ("Eq. 31 (the paper's design rule)", "#0072B2", "-"),
     "eq20": ("Eq. 20", "#E69F00", ":"),
     "envelope": ("envelope rule (conservative closed form)", "#009E73", "--"),
-    "exact": ("exact: verified under the pulse", "#000000", "-"),
+    "exact": ("exact: time histories under the pulse", "#000000", "-"),
 }
 
 

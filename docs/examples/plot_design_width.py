@@ -2,7 +2,7 @@
 A design width and its barcode
 ==============================
 
-The design (verified) width is the narrowest column of a given height that survives the whole
+The design width is the narrowest column of a given height that survives the whole
 record at that width and at every larger one found.  Here the 7.5 m high column under a bundled record: the
 verdict at each width of a fine grid (the barcode), the design width, and Eq. 31's width for
 the record's fitted pulse beside it.
