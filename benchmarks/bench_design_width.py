@@ -3,6 +3,8 @@
     python benchmarks/bench_design_width.py                 # 1-4 min a seed on 2 cores; needs ../shared
     python benchmarks/bench_design_width.py --heights 7.5   # one column height
     python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
+    python benchmarks/bench_design_width.py --identical     # a level reusing the overturning runs
+        # against the same computed without them: the same answers?
     python benchmarks/bench_design_width.py --seeds record,1,2 --no-level --cache /tmp/dense --misses
         # the check's seed set to each ("record": the package's own); overturning only (~40 s a
         # seed once the dense grids are kept); where the misses lie
@@ -15,8 +17,10 @@ transition ``w`` (``search_width``, called the verified width before 0.5) and th
 (``width``).  An independent dense grid of ``DENSE`` linear widths in ``(w, min(SPAN w, top)]``
 (``top``: the no-uplift width) counts the records with a failing width more than 1 % above ``w``
 (today's answer) and more than 1 % above ``W``.  With ``limit=0.5``: the design width ``W_R`` is
-run again (``rocking.simulate``): max|theta|/alpha <= 0.5, and ``W_R >= W``.  Runs per design
-width (search + check + refinement) are printed for both.
+run again (``rocking.simulate``): max|theta|/alpha <= 0.5, and ``W_R >= W``, ``W_R`` as
+``pipeline run --limit`` computes it (``pipeline.batch.record.design_width``: the overturning
+design, then the level given it, reusing its runs).  Runs per design width (search + check +
+refinement) are printed for both, and the solver runs of the level with its overturning design.
 
 ``--sensitivity``: the design width with the check's seed changed (``SearchSettings.check_seed``,
 ``SEEDS``) and with the restitution ``ETA_FACTORS`` times Eq. 5 at each width (capped at 1), for
@@ -110,6 +114,7 @@ def sliver_width(height, record, b, step):
 def measure(paths, heights, settings=None, cache=None, level=True, misses=False):
     import pulses
     import rocking
+    from pipeline.batch.record import design_width
     from pulses import G
     from rocking.search import DEFAULT_SETTINGS
 
@@ -125,11 +130,12 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
             over = rocking.required_width(H, record, rule="exact", settings=settings)
             t_over = time.perf_counter() - t
             t = time.perf_counter()
-            # the level alone (pipeline run --limit), and given the overturning design
+            # the level alone (0.6.0's pipeline run --limit), and pipeline run --limit's path: the
+            # overturning design, then the level given it (its runs reused)
             alone = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings)
                      if level else over)
-            half = (rocking.required_width(H, record, rule="exact", limit=LEVEL, settings=settings,
-                                           overturning=over) if level else over)
+            t = time.perf_counter()
+            half = design_width(record, None, H, 0.0, LEVEL, settings) if level else over
             t_half = time.perf_counter() - t
             # the reference: the search of 0.5.0 alone (its first transition, today's search
             # width), whatever the settings measured
@@ -158,6 +164,8 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
                        runs=over.total_runs, runs_today=base.runs + 1500,
                        w_search=over.search_width,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
+                       W_over_half=half.overturning_width if level else W,
+                       solver_half=half.solver_runs, shared_half=half.shared_runs,
                        W_alone=alone.width, runs_alone=alone.total_runs,
                        t_over=t_over, t_half=t_half)
             rows.append(row)
@@ -183,12 +191,14 @@ def table(rows):
     (old_u, n_u), (new_u, _) = _unique(rows, "far_old"), _unique(rows, "far_new")
     raised = sum(r["W"] > r["w"] for r in rows)
     bad_half = [r for r in rows if r["ratio_half"] > LEVEL]
-    below = [r for r in rows if r["W_half"] < r["W"]]
+    below = [r for r in rows if r["W_half"] < r["W"] or r["W_half"] < r["W_over_half"]]
     below_alone = [r for r in rows if r["W_alone"] < r["W"]]
     runs_a = np.array([r["runs_alone"] for r in rows])
     runs = np.array([r["runs"] for r in rows])
     today = np.array([r["runs_today"] for r in rows])
     runs_h = np.array([r["runs_half"] for r in rows])
+    solver_h = np.array([r["solver_half"] for r in rows])
+    shared_h = np.array([r["shared_half"] for r in rows])
     up = np.array([r["W"] / r["w"] - 1 for r in rows]) * 100
     return [
         f"{n} cases (records x heights); dense grid {DENSE} linear widths in (w, min({SPAN:g} w, top)].",
@@ -206,11 +216,14 @@ def table(rows):
         f"{len(bad_half)} cases ({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W: "
         f"alone on {len(below_alone)}"
         + "".join(f" ({r['record']} {r['height']:g} m: {r['W_alone']:.5f} < {r['W']:.5f})" for r in below_alone)
-        + f", given the overturning design on {len(below)}",
+        + f", through pipeline run --limit's path (the overturning design, then the level given it) on {len(below)}",
         f"- runs per level width alone: median {np.median(runs_a):.0f} (max {runs_a.max()})",
         f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
         f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
-        f"limit {LEVEL} given W median {np.median(runs_h):.0f} (max {runs_h.max()})",
+        f"limit {LEVEL} given W median {np.median(runs_h):.0f} (max {runs_h.max()}) widths, of which "
+        f"run: median {np.median(solver_h):.0f} (shared with the overturning design: median "
+        f"{np.median(shared_h):.0f}); the level with its overturning design (pipeline run --limit): "
+        f"median {np.median(runs + solver_h):.0f} solver runs (max {(runs + solver_h).max()})",
     ]
 
 
@@ -260,6 +273,38 @@ def sensitivity(paths, heights):
     return lines
 
 
+def identical(paths, heights):
+    """``--identical``: the level given its overturning design with its runs reused (``pipeline run
+    --limit``) against the same without them (every width run again): the same design width,
+    search width, widest failing width and widths checked on every case?"""
+    import dataclasses
+
+    import pulses
+    import rocking
+
+    same, n, shared, total, lines = 0, 0, [], [], []
+    for path in paths:
+        record = pulses.read_record(str(path))
+        for H in heights:
+            over = rocking.required_width(H, record, rule="exact")
+            kw = dict(rule="exact", limit=LEVEL)
+            a = rocking.required_width(H, record, overturning=over, **kw)
+            b = rocking.required_width(H, record, overturning=dataclasses.replace(over, outcomes=None), **kw)
+            ok = (a.width == b.width and a.search_width == b.search_width
+                  and a.widest_failing_width == b.widest_failing_width and a.total_runs == b.total_runs
+                  and np.array_equal(a.check_widths, b.check_widths)
+                  and np.array_equal(a.check_failed, b.check_failed))
+            n, same = n + 1, same + ok
+            shared.append(a.shared_runs)
+            total.append(a.total_runs)
+            print(f"{path.stem:28s} H {H:4.1f}: {'same' if ok else 'DIFFERENT'} {a.width:.6f} "
+                  f"{b.width:.6f}; shared {a.shared_runs} of {a.total_runs}", flush=True)
+    lines.append(f"level {LEVEL} with the overturning design's runs reused against without: the same "
+                 f"answer on {same} of {n} cases; widths shared median {np.median(shared):.0f} of "
+                 f"{np.median(total):.0f}")
+    return lines
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     heights = HEIGHTS
@@ -274,6 +319,9 @@ def main(argv=None):
         paths = [p for p in paths if p.stem in only]
     if "--sensitivity" in argv:
         print("\n".join(sensitivity(paths, heights)))
+        return 0
+    if "--identical" in argv:
+        print("\n".join(identical(paths, heights)))
         return 0
     from rocking.search import DEFAULT_SETTINGS
 

@@ -61,7 +61,14 @@ autosummary_imported_members = False
 doctest_test_doctest_blocks = "default"
 doctest_global_setup = "import numpy as np"
 
-# the gallery: every script of docs/examples runs at build, its figures embedded
+# the gallery: every script of docs/examples runs at build, its figures embedded.  sphinx-gallery
+# keeps the pages it wrote for an example since renamed or removed, which would then be pages in no
+# toctree: those (docs/gallery is written by this build alone) are removed first
+_GALLERY = os.path.join(os.path.dirname(os.path.abspath(__file__)), "gallery")
+for _name in os.listdir(_GALLERY) if os.path.isdir(_GALLERY) else ():
+    _example = os.path.join(os.path.dirname(_GALLERY), "examples", _name.split(".")[0] + ".py")
+    if _name.startswith("plot_") and not os.path.exists(_example):
+        os.remove(os.path.join(_GALLERY, _name))
 sphinx_gallery_conf = {
     "examples_dirs": "examples",
     "gallery_dirs": "gallery",

@@ -91,11 +91,29 @@ class RequiredWidth:
     vertical_width: float | None = None
     #: with a vertical record: the answer of the other motion, whole (a RequiredWidth)
     other: "RequiredWidth | None" = field(default=None, repr=False, compare=False)
+    #: a level designed given its overturning design (``overturning=``): that design's width (m;
+    #: with a vertical, the wider of the two motions'); :attr:`width` is at least it
+    overturning_width: float | None = None
+    #: widths of :attr:`total_runs` that the overturning design had run in the same batch (same
+    #: column, record and solver: the same computation), answered from it, not run again
+    shared_runs: int = 0
+    #: a record's overturning design: every batch it ran, in order, as ``(widths, overturned,
+    #: max|theta|/alpha)`` arrays (a level given this design reuses the same batches)
+    outcomes: tuple | None = field(default=None, repr=False, compare=False)
+    #: what the runs depend on (record and vertical hashed, height, restitution, frame, model):
+    #: a level may reuse only the runs of the same inputs
+    inputs: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def total_runs(self) -> int:
-        """Solver runs of the search, the check and the refinement together."""
+        """Widths run by the search, the check and the refinement together (of which
+        :attr:`shared_runs` were answered by the overturning design's runs: :attr:`solver_runs`)."""
         return int(self.runs) + int(self.check_runs) + int(self.refine_runs)
+
+    @property
+    def solver_runs(self) -> int:
+        """Solver runs this design made itself: :attr:`total_runs` less :attr:`shared_runs`."""
+        return self.total_runs - int(self.shared_runs)
 
     @property
     def tan_alpha(self) -> float:
@@ -173,8 +191,9 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         ``max|theta|/alpha <= R`` (a width fails where it exceeds R or the column overturns);
         None (default): overturning, the paper's question (docs/design.md, "Performance levels").
     overturning : RequiredWidth, optional
-        With ``limit`` under a record (no vertical): its overturning design, already computed;
-        the level's width is then at least its width (docs/design.md, "Performance levels").
+        With ``limit`` under a record: its overturning design (same column, record and ``vertical``;
+        with one, :func:`governing`'s answer); the level with each motion is at least that
+        motion's overturning width, reusing its runs (docs/design.md, "Performance levels").
     shape, lam : str (optional), float
         ``rule="envelope"``: the shape whose factor to use (default every shape); Eq. 20's lambda.
     n_scan, n_zone, rtol : int, int, float, optional
@@ -212,8 +231,9 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
                   n_zone=n_zone, settings=settings, gamma=gamma, limit=limit)
         if vertical is None:
             return _exact_width(height, excitation, overturning=overturning, **kw)
-        return governing(horizontal or _exact_width(height, excitation, **kw),
-                         _exact_width(height, excitation, vertical=vertical, **kw))
+        over_h, over_v = _motions(overturning, horizontal)
+        return governing(horizontal or _exact_width(height, excitation, overturning=over_h, **kw),
+                         _exact_width(height, excitation, vertical=vertical, overturning=over_v, **kw))
     if vertical is not None:
         raise ValueError("a vertical record goes with rule='exact' under a record")
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
@@ -255,13 +275,29 @@ def _check_arguments(height, rule, overturning, limit, vertical, excitation) -> 
         raise ValueError(f"height must be positive, got {height!r} m")
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
-    if overturning is not None and (rule != "exact" or limit is None or vertical is not None
+    if overturning is not None and (rule != "exact" or limit is None
                                     or overturning.limit is not None
+                                    or (vertical is None) != (overturning.governed_by is None)
                                     or getattr(excitation, "shape", "record") in SHAPES):
-        raise ValueError("overturning= goes with rule='exact' under a record, a limit and no "
-                         "vertical record: the overturning design (limit=None) of the same column "
-                         "and record")
+        raise ValueError("overturning= goes with rule='exact' under a record and a limit: the "
+                         "overturning design (limit=None) of the same column and record, with the "
+                         "vertical where vertical= is given (and only there)")
     return height
+
+
+def _motions(overturning, horizontal):
+    """The overturning designs ``(horizontal motion alone, with the vertical)`` of a
+    :func:`governing` answer (``(None, None)`` without one); ValueError where ``horizontal`` (the
+    level's horizontal answer) was not designed given the same horizontal overturning design."""
+    if overturning is None:
+        return None, None
+    pair = (overturning, overturning.other)
+    over_h, over_v = pair if overturning.governed_by == "horizontal" else pair[::-1]
+    if horizontal is not None and horizontal.overturning_width != over_h.width:
+        raise ValueError("horizontal= with overturning=: the level's horizontal answer designed "
+                         "given the horizontal overturning design (required_width(..., "
+                         "overturning=)) of the same record")
+    return over_h, over_v
 
 
 def governing(horizontal, with_vertical):
@@ -270,10 +306,11 @@ def governing(horizontal, with_vertical):
     (:attr:`RequiredWidth.other`) set.  Ties go to the horizontal motion."""
     vertical_governs = with_vertical.width > horizontal.width
     res, other = (with_vertical, horizontal) if vertical_governs else (horizontal, with_vertical)
+    overs = [w.overturning_width for w in (horizontal, with_vertical)]
     return dataclasses.replace(
         res, governed_by="with vertical" if vertical_governs else "horizontal",
         horizontal_width=float(horizontal.width), vertical_width=float(with_vertical.width),
-        other=other,
+        other=other, overturning_width=None if None in overs else max(overs),
         method=res.method + (f"; governed by the {'horizontal motion with the vertical' if vertical_governs else 'horizontal motion alone'}"
                              f" ({horizontal.width:.6g} m alone, {with_vertical.width:.6g} m "
                              f"with the vertical)"))
@@ -316,39 +353,106 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
 
     is_pulse = getattr(excitation, "shape", "record") in SHAPES
     if not is_pulse:
-        def evaluate_record(widths):
-            # max|theta|/alpha over the level (1 for overturning): the search's and the check's
-            # "near failure" thresholds then hold for any level
-            res = run_widths(widths)
-            return (_failed(res, criterion, limit),
-                    np.asarray(res.max_rotation_ratio, dtype=float) / (limit or 1.0))
-
+        inputs = (searches.digest(excitation.acc), float(excitation.dt),
+                  None if vertical is None else (searches.digest(vertical.acc), float(vertical.dt)),
+                  float(height), eta, float(gamma), model)
+        runs = _Runs(run_widths, overturning, inputs)
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
-        res, seen = searches.remembered(  # a batch's later pass: the same search (rocking.searches)
-            searches.key(excitation, vertical, settings, height, criterion, eta, gamma, limit, model),
-            lambda: _record_search(height, top, evaluate_record, criterion=criterion, eta=eta, settings=settings))
-        res.cap_mass_ratio, res.limit, res.search_width = gamma, limit, res.width
-        if vertical is not None:
-            res.method += "; with the vertical record (compiled engine, fast-vertical)"
-        if limit is not None:
-            res.method += f"; a width fails where max|theta|/alpha > {limit:g}"
-        reach = min(settings.check_span ** settings.check_rounds * res.width, top)
-        binned = settings.check_layout == "bins"
-        if not res.below_scan and settings.check_runs > 0 and (binned or reach > settings.check_above):
-            seed = settings.check_seed
-            if seed is None:
-                seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
-            check = _check_bins if binned else _check_rounds
-            seen = check(res, top, evaluate_record, settings, seed, seen)
-        if overturning is not None and overturning.width > res.width:
-            # a width that overturns fails every level: one run at the overturning design width,
-            # and a bisection above it where that width exceeds the level
-            _at_least(res, overturning, evaluate_record, seen, settings)
+        res = _record_design(height, excitation, top, runs, criterion=criterion, eta=eta,
+                             gamma=gamma, limit=limit, model=model, vertical=vertical,
+                             settings=settings, overturning=overturning)
+        res.inputs = inputs
         return res
     res = _pulse_width(height, top, lambda idx, widths: _failed(run_widths(widths), criterion, limit),
                        settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol))
     res.criterion, res.eta, res.cap_mass_ratio, res.limit = criterion, eta, gamma, limit
     res.search_width = res.width
+    return res
+
+
+class _Runs:
+    """The solver runs of one record's exact design: ``outcomes(widths)`` gives whether each width
+    of a batch overturned and its max|theta|/alpha.  A batch the overturning design
+    (``overturning``, same ``inputs``) ran, the same widths in the same order, is answered from
+    its :attr:`RequiredWidth.outcomes`, the others are run; it counts the widths so answered and
+    keeps every batch.
+
+    Only whole batches are shared: a run's last bits depend on its batch (its lanes share their
+    Taylor order, its forcing grid follows its stiffest block), so the same width run in another
+    batch agrees only to rounding, and the check's later stages, which rank widths by
+    max|theta|/alpha, could then pick other widths (measured: 1 of 62 cases).  The same batch is
+    the same computation, so the answer is the same as without the sharing, bit for bit.  The
+    batch both designs run is the search's geometric scan (131 widths), and the single widths
+    at either end of their bisections where they meet."""
+
+    def __init__(self, run_widths, overturning, inputs):
+        self.run_widths, self.shared = run_widths, 0
+        self.known = {}
+        if overturning is not None and overturning.outcomes is not None:
+            if overturning.inputs != inputs:
+                raise ValueError("overturning= is the design of another record, vertical, column "
+                                 "or model: the overturning design of the same ones")
+            self.known = {x.tobytes(): (o, r) for x, o, r in overturning.outcomes}
+        self.log = []
+
+    def outcomes(self, widths):
+        widths = np.ascontiguousarray(widths, dtype=float)
+        hit = self.known.get(widths.tobytes())
+        if hit is not None:
+            self.shared += widths.size
+            over, ratio = hit
+        else:
+            res = self.run_widths(widths)
+            over = np.asarray(res.overturned, dtype=bool).copy()
+            ratio = np.asarray(res.max_rotation_ratio, dtype=float).copy()
+        self.log.append((widths.copy(), over, ratio))
+        return over.copy(), ratio.copy()
+
+
+def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limit, model, vertical,
+                   settings, overturning):
+    """The design width under a record: the search (kept between calls, :mod:`rocking.searches`),
+    the check above it, and with ``overturning`` at least that design's width."""
+    def evaluate_record(widths):
+        # max|theta|/alpha over the level (1 for overturning): the search's and the check's
+        # "near failure" thresholds then hold for any level
+        if criterion == "exceed" and limit is None:   # needs exceeded_alpha: no sharing
+            res = runs.run_widths(widths)
+            return _failed(res, criterion), np.asarray(res.max_rotation_ratio, dtype=float)
+        over, ratio = runs.outcomes(widths)
+        failed = over if limit is None else over | (ratio > limit)
+        return failed, ratio / (limit or 1.0)
+
+    def search():
+        out = _record_search(height, top, evaluate_record, criterion=criterion, eta=eta, settings=settings)
+        out[0].shared_runs, out[0].outcomes = runs.shared, tuple(runs.log)   # kept with it
+        return out
+
+    res, seen = searches.remembered(  # a batch's later pass: the same search (rocking.searches)
+        searches.key(excitation, vertical, settings, height, criterion, eta, gamma, limit, model), search)
+    shared, runs.shared, runs.log = res.shared_runs, 0, list(res.outcomes or ())
+    res.cap_mass_ratio, res.limit, res.search_width = gamma, limit, res.width
+    if vertical is not None:
+        res.method += "; with the vertical record (compiled engine, fast-vertical)"
+    if limit is not None:
+        res.method += f"; a width fails where max|theta|/alpha > {limit:g}"
+    reach = min(settings.check_span ** settings.check_rounds * res.width, top)
+    binned = settings.check_layout == "bins"   # separable: it runs only above check_above itself
+    if not res.below_scan and settings.check_runs > 0 and (binned or reach > settings.check_above):
+        seed = settings.check_seed
+        if seed is None:
+            seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
+        check = _check_bins if binned else _check_rounds
+        seen = check(res, top, evaluate_record, settings, seed, seen)
+    if overturning is not None:
+        res.overturning_width = float(overturning.width)
+        if overturning.width > res.width:
+            # a width that overturns fails every level: one run at the overturning design width,
+            # and a bisection above it where that width exceeds the level
+            _at_least(res, overturning, evaluate_record, seen, settings)
+    res.shared_runs = shared + runs.shared
+    # the batches run, for a level given this design (none kept otherwise: they serve no other)
+    res.outcomes = tuple(runs.log) if limit is None and criterion == "overturn" else None
     return res
 
 

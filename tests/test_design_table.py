@@ -113,3 +113,19 @@ def test_the_motion_that_governs_is_marked_where_it_is_the_vertical():
     assert table_cells(d["h"])[5] == "1.431 m"
     text = table_text([d["v"], d["h"]])
     assert "1.553 m (vertical)" in text and "1.431 m (vertical)" not in text
+
+
+def test_a_levels_overturning_width_is_the_widest_over_directions_and_in_the_fine_print():
+    """Under --limit: design.csv's overturning_width_m is the widest over a pair's directions (the
+    governing direction's need not be it), the printed table's widths stay the level's, and the
+    fine print says the design width is at least the overturning one; blank without a level."""
+    rows = [dict(_row(0, 1.0, None, search=0.95), design_limit=0.5, overturning_width_m=0.7),
+            dict(_row(90, 0.9, None, search=0.85), design_limit=0.5, overturning_width_m=0.8)]
+    d, = design_rows(rows)
+    assert d["overturning_width_m"] == 0.8 and d["design_width_m"] == 1.0
+    text = table_text([d])
+    assert "1.000 m for max theta/alpha <= 0.5" in text
+    assert "at least the overturning design width (overturning_width_m, 0.800 m here)" in text
+    plain, = design_rows([_row(0, 1.0, None, search=0.95)])
+    assert plain["overturning_width_m"] is None
+    assert "overturning design width" not in table_text([plain])

@@ -150,9 +150,12 @@ def test_pipeline_run_limit(tmp_path):
         row = next(csv.DictReader(open(out / "design.csv")))
         widths[name] = float(row["design_width_m"])
         assert row["design_limit"] == ("0.5" if extra else "")
+        widths[name + " overturning"] = row["overturning_width_m"]
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
     assert widths["half"] >= widths["over"]
+    # the level's run computed the overturning run's design width (the same text, 6 digits)
+    assert widths["half overturning"] == f"{widths['over']:g}" and widths["over overturning"] == ""
 
 
 def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
@@ -209,3 +212,99 @@ def test_overturning_design_goes_with_a_level_only(kw):
         kw["vertical"] = pulses.Record(np.zeros(2000), 0.01)
     with pytest.raises(ValueError, match="overturning="):
         rocking.required_width(7.5, rec, rule=rule, overturning=over, **kw)
+
+
+@pytest.mark.slow
+def test_level_reuses_the_overturning_runs_and_answers_the_same():
+    """Kern County, Taft 021 (real, 6 m): a level given its overturning design answers from that
+    design's outcomes every batch it ran (the record search's geometric scan is the same batch of
+    widths for both criteria, and every run gives overturned and max|theta|/alpha).  The answer
+    is the same, bit for bit, as the level computed given the same design without its runs, and
+    the runs it made itself are fewer by the widths shared, at least the scan's."""
+    import dataclasses
+
+    rec = pulses.read_record(shared_record("RSN15_KERN_TAF021.AT2"))
+    over = rocking.required_width(6.0, rec, rule="exact")
+    shared = rocking.required_width(6.0, rec, rule="exact", limit=0.5, overturning=over)
+    apart = rocking.required_width(6.0, rec, rule="exact", limit=0.5,
+                                   overturning=dataclasses.replace(over, outcomes=None))
+    assert apart.shared_runs == 0
+    for name in ("width", "search_width", "widest_failing_width", "transitions", "runs",
+                 "check_runs", "refine_runs", "failing_share", "overturning_width"):
+        assert getattr(shared, name) == getattr(apart, name), name
+    assert np.array_equal(shared.check_widths, apart.check_widths)
+    assert np.array_equal(shared.check_failed, apart.check_failed)
+    scan = DEFAULT_SETTINGS.record_scan - 1 + DEFAULT_SETTINGS.record_tail   # top is never run
+    assert scan <= shared.shared_runs < shared.total_runs
+    assert shared.solver_runs == shared.total_runs - shared.shared_runs
+    # the overturning design's outcomes are its batches: the first is the search's scan, which
+    # the same batch run again gives bit for bit (what the sharing relies on), and which
+    # independent single runs give to rounding (1e-9 in max|theta|/alpha, as tests/test_lanes.py
+    # holds the batch engine to single runs)
+    x, toppled, ratio = over.outcomes[0]
+    assert x.size == scan and sum(b[0].size for b in over.outcomes) == over.total_runs
+    res = rocking.simulate_many([Block.from_dimensions(6.0, b) for b in x], rec)
+    assert np.array_equal(res.overturned, toppled) and np.array_equal(res.max_rotation_ratio, ratio)
+    for k in (0, x.size // 2, x.size - 1):
+        one = rocking.simulate(Block.from_dimensions(6.0, x[k]), rec, history=False)
+        assert bool(one.overturned) == toppled[k]
+        assert one.max_rotation_ratio == pytest.approx(ratio[k], rel=0, abs=1e-9)
+
+
+@pytest.mark.slow
+def test_level_with_the_vertical_at_least_each_overturning_design():
+    """With a vertical (the PEER download's Pacoima Dam 254 and its vertical, 7.5 m), as
+    `pipeline run --limit 0.5` computes it (pipeline.batch.record.design_width): the level with
+    the vertical is at least the overturning design with it, the horizontal level at least the
+    horizontal one; the reported overturning width is the governing overturning design's; the
+    design width keeps max|theta|/alpha <= 0.5 with and without the vertical (independent runs)."""
+    from pipeline.batch.record import design_width
+
+    if not DOWNLOAD.is_dir():
+        pytest.skip(f"the PEER download is absent: {DOWNLOAD}")
+    h1, h2, up = pulses.check_triplet(*(pulses.read_record(str(DOWNLOAD / f"RSN77_SFERN_PUL{c}.AT2"))
+                                        for c in ("164", "254", "DWN")), "RSN77_SFERN_PULDWN.AT2")
+    level = design_width(h2, up, 7.5, 0.0, 0.5, DEFAULT_SETTINGS)
+    over_h = rocking.required_width(7.5, h2, rule="exact")
+    over = rocking.required_width(7.5, h2, rule="exact", vertical=up, horizontal=over_h)
+    assert level.overturning_width == over.width
+    assert level.horizontal_width >= over.horizontal_width
+    assert level.vertical_width >= over.vertical_width
+    assert level.width == max(level.horizontal_width, level.vertical_width) >= over.width
+    for vertical in (None, up):
+        toppled, ratio = _ratio(7.5, level.width, h2, vertical=vertical)
+        assert not toppled and ratio <= 0.5
+    # inconsistent arguments: one line each
+    with pytest.raises(ValueError, match="overturning="):   # a horizontal-only design with vertical=
+        rocking.required_width(7.5, h2, rule="exact", limit=0.5, vertical=up, overturning=over_h)
+    with pytest.raises(ValueError, match="overturning="):   # a design with the vertical without it
+        rocking.required_width(7.5, h2, rule="exact", limit=0.5, overturning=over)
+    with pytest.raises(ValueError, match="another record"):
+        rocking.required_width(7.5, h1, rule="exact", limit=0.5, overturning=over_h)
+    with pytest.raises(ValueError, match="horizontal="):    # a level not given the same design
+        rocking.required_width(7.5, h2, rule="exact", limit=0.5, vertical=up, overturning=over,
+                               horizontal=rocking.required_width(7.5, h2, rule="exact", limit=0.5))
+
+
+@pytest.mark.slow
+def test_pipeline_design_limit_is_at_least_the_overturning_design():
+    """`pipeline.design(..., limit=0.5)` on Kern County, Taft 021 (real, 6 m; the case whose level
+    alone fell below its overturning design): design.csv and summary.csv carry the overturning
+    design width, equal to `rocking.required_width` without a limit (to the reports' 6
+    significant digits); the design width is at least it and keeps max|theta|/alpha <= 0.5 under
+    the record (an independent run at the reported width)."""
+    import pipeline
+
+    path = shared_record("RSN15_KERN_TAF021.AT2")
+    run = pipeline.design([str(path)], heights=6.0, limit=0.5, shapes="sine")
+    rec = pulses.read_record(path)
+    over = rocking.required_width(6.0, rec, rule="exact")
+    for table in (run.design, run.summary):
+        row = table.iloc[0]
+        assert float(row["overturning_width_m"]) == pytest.approx(over.width, rel=1e-6)
+        assert float(row["design_width_m"]) >= float(row["overturning_width_m"])
+    toppled, ratio = _ratio(6.0, float(run.design.iloc[0]["design_width_m"]), rec)
+    assert not toppled and ratio <= 0.5
+    # without a level the column is blank
+    plain = pipeline.design([str(path)], heights=6.0, shapes="sine")
+    assert plain.design["overturning_width_m"].isna().all()

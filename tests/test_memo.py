@@ -134,3 +134,27 @@ def test_a_run_in_this_process_keeps_nothing_after_it(tmp_path):
     assert code == 0
     # a later rocking.required_width in this process computes (a test may have changed the solver)
     assert searches._size == 0 and not searches._kept and not memo._kept
+
+
+@pytest.mark.slow
+def test_a_level_and_its_overturning_design_are_both_kept_between_passes(kept, monkeypatch):
+    """`pipeline run --limit`'s design of a column (pipeline.batch.record.design_width): a later
+    pass (the check on) finds both searches, the overturning design's and the level's, kept from
+    the first pass (no search runs again), and answers as a fresh computation."""
+    from pipeline.batch.record import design_width
+    from rocking import widths
+
+    record = _synthetic(0.4, 3)
+    first_pass, later = DEFAULT_SETTINGS.replace(check_runs=0), DEFAULT_SETTINGS
+    searches.keep(0)
+    fresh = design_width(record, None, H, 0.0, 0.5, later)
+    searches.keep(8)
+    calls = []
+    real = widths._record_search
+    monkeypatch.setattr(widths, "_record_search", lambda *a, **k: calls.append(k.get("criterion")) or real(*a, **k))
+    design_width(record, None, H, 0.0, 0.5, first_pass)
+    assert len(calls) == 2                       # the overturning design's search and the level's
+    again = design_width(record, None, H, 0.0, 0.5, later)
+    assert len(calls) == 2                       # both kept
+    _same(again, fresh)
+    assert again.overturning_width == fresh.overturning_width and again.check_runs > 0

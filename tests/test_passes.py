@@ -22,6 +22,8 @@ ROUNDS = DEFAULT_SETTINGS.replace(check_layout="rounds")
 #: what the check decides besides its own columns: the direction's design width (the search's
 #: width where it found no failing width above it)
 DESIGN = CHECK + ["design_width_m", "design_tan_alpha", "design_adequate"]
+#: and with ``--limit``, the overturning design's width (its check runs where the level's does)
+LEVEL_DESIGN = DESIGN + ["overturning_width_m"]
 
 
 def _rows(out):
@@ -48,8 +50,10 @@ def _run(out, pair, *extra):
 def _same_answer(default, thorough):
     """The default's rows against ``--thorough``'s: the same design width; every checked direction
     identical; every unchecked one identical but for the check's columns, and its check could
-    not have reached the design width."""
+    not have reached the design width (with ``--limit``: its width is the level's search width
+    raised to at least the overturning design's search width)."""
     design = _design(thorough)
+    DESIGN = LEVEL_DESIGN
     assert _design(default) == design
     by_dir = {r["direction_deg"]: r for r in thorough}
     n_checked = 0
@@ -65,7 +69,13 @@ def _same_answer(default, thorough):
         else:
             assert {k: v for k, v in r.items() if k not in DESIGN} == {k: v for k, v in ref.items() if k not in DESIGN}
             assert r["failing_share"] == "" and r["widest_failing_width_m"] == ""
-            assert r["design_width_m"] == r["search_width_m"] == ref["search_width_m"]
+            assert r["search_width_m"] == ref["search_width_m"]
+            if r["overturning_width_m"]:       # --limit: at least the overturning design's
+                assert float(r["design_width_m"]) >= max(float(r["search_width_m"]),
+                                                         float(r["overturning_width_m"]))
+                assert float(r["overturning_width_m"]) <= float(ref["overturning_width_m"])
+            else:
+                assert r["design_width_m"] == r["search_width_m"]
             assert _top(r) <= design * (1.0 + passes.MARGIN)
     return n_checked
 
@@ -150,6 +160,25 @@ def test_default_gives_the_thorough_design_width_figures_where_they_inform(pair,
     assert _run(tmp_path / "default", pair, *args) == 0
     after = {p: p.read_bytes() for p in (tmp_path / "default").rglob("*") if p.is_file()}
     assert before == after
+
+
+@pytest.mark.slow
+def test_a_level_gives_the_thorough_design_width_and_its_overturning_design(pair, tmp_path):
+    """`--limit 0.5` on a pair in 6 directions: the pair's design width is --thorough's; every
+    direction's design width is at least its overturning design width (overturning_width_m), and
+    design.csv's is the widest over the directions, below the pair's design width."""
+    args = ("--block", f"{H}x{B}", "--directions", "6", "--limit", "0.5", "--no-plots")
+    assert _run(tmp_path / "thorough", pair, *args, "--thorough") == 0
+    assert _run(tmp_path / "default", pair, *args) == 0
+    default, thorough = _rows(tmp_path / "default"), _rows(tmp_path / "thorough")
+    assert 1 <= _same_answer(default, thorough) <= len(default)
+    for r in default + thorough:
+        assert float(r["design_width_m"]) >= float(r["overturning_width_m"]) > 0
+    for out, rows in (("default", default), ("thorough", thorough)):
+        with open(tmp_path / out / "design.csv", newline="") as fh:
+            (row,) = list(csv.DictReader(fh))
+        assert float(row["overturning_width_m"]) == max(float(r["overturning_width_m"]) for r in rows)
+        assert float(row["overturning_width_m"]) <= float(row["design_width_m"])
 
 
 def test_plots_all_draws_every_direction_and_no_plots_none(pair, tmp_path):

@@ -84,3 +84,30 @@ def test_a_vertical_without_polarity_is_not_used_and_said(files, tmp_path):
     for r in rows(out):
         assert r["vertical_file"] == ""
         assert "vertical not used" in r["warnings"] and "polarity" in r["warnings"]
+
+
+@pytest.mark.slow
+def test_a_level_with_the_vertical_is_at_least_the_overturning_design_in_every_direction(files, tmp_path):
+    """`--triplet ... --limit 0.5`: in every direction of the pair the design width (the wider of
+    the level's with and without the vertical) is at least the overturning design width (the
+    wider of the overturning designs with and without it), and the one with the vertical is at
+    least that direction's overturning design with it; design.csv's is the widest over the
+    directions; without --limit the column is blank."""
+    out = tmp_path / "level"
+    assert main(["run", "--triplet", *files, *RUN_ARGS, "--scale", "5", "--limit", "0.5",
+                 "--out", str(out)]) == 0
+    summary = rows(out)
+    assert len(summary) >= 2 and all(r["design_governed_by"] for r in summary)
+    for r in summary:
+        assert float(r["design_width_m"]) >= float(r["overturning_width_m"]) > 0
+        assert float(r["design_width_m"]) >= float(r["vertical_design_width_m"])
+    (design,) = rows(out, "design.csv")
+    assert float(design["overturning_width_m"]) == max(float(r["overturning_width_m"]) for r in summary)
+    plain = tmp_path / "plain"
+    assert main(["run", "--triplet", *files, *RUN_ARGS, "--scale", "5", "--out", str(plain)]) == 0
+    assert all(r["overturning_width_m"] == "" for r in rows(plain))
+    # the overturning design of the level's run is the plain run's, direction by direction (the
+    # same searches; on this pair the passes check the same directions in both runs)
+    by_dir = {r["direction_deg"]: r["design_width_m"] for r in rows(plain)}
+    for r in summary:
+        assert float(r["overturning_width_m"]) == float(by_dir[r["direction_deg"]])

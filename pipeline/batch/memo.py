@@ -11,8 +11,9 @@ from __future__ import annotations
 from rocking.searches import Kept, digest
 
 #: results kept per kind in a worker: a pool's tasks come back for their next pass after the
-#: pass's other tasks, so this covers a few pairs of 38 directions and two heights
-KEPT = 256
+#: pass's other tasks, so this covers a few pairs of 38 directions and two heights (under
+#: ``--limit`` two searches a column, the overturning design's and the level's; about 20 kB each)
+KEPT = 512
 
 _kept: dict[str, Kept] = {}
 

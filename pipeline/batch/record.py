@@ -388,6 +388,12 @@ DESIGN_WIDTH_COLUMNS = Columns(
                                 "record's vertical); blank without a vertical."),
     ("design_limit", "-", "The performance level of the design (`--limit` R: max|theta|/alpha <= R); "
                           "blank: overturning, the paper's question."),
+    ("overturning_width_m", "m", "With `--limit` R: the overturning design width of the same column "
+                                 "and record (the same search and check for not overturning; with a "
+                                 "vertical, the wider of the two motions'). The design width "
+                                 "`design_width_m` is at least it: a width that overturns fails "
+                                 "every level (docs/design.md, \"Performance levels\"). Blank without "
+                                 "`--limit`."),
 )
 
 
@@ -397,6 +403,7 @@ def _design_width_fields(col: Column, ver) -> dict:
         "design_adequate": None if col.width is None else col.width >= float(ver.width),
         "search_width_m": None if ver.search_width is None else float(ver.search_width),
         "design_governed_by": ver.governed_by, "design_limit": ver.limit,
+        "overturning_width_m": ver.overturning_width,
     })
 
 
@@ -511,10 +518,7 @@ def _process(task: Task):
         # -- design width: smallest width surviving the full record (islands respected), above
         #    every width found to fail, with the vertical where there is one ----------------------
         if H not in design_cache:
-            alone = _stage("verify", rocking.required_width, H, record, rule="exact",
-                           cap_mass_ratio=gamma, limit=opts.limit,
-                           settings=settings[col])
-            design_cache[H] = _stage("verify", vertical.design, record, up, H, alone, gamma, opts.limit)
+            design_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col])
         if draw:  # the column at its design width, for the figure
             wv = float(design_cache[H].width)
             block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
@@ -533,6 +537,23 @@ def _process(task: Task):
         rows.append(row)
 
     return rows, (record, fit, fitting, histories, velocity), design_cache
+
+
+def design_width(record, up, height, cap_mass_ratio, limit, settings):
+    """The design width of a column ``height`` (m) tall under ``record`` (with its vertical ``up``
+    where there is one, :func:`pipeline.batch.vertical.design`).  With a level ``limit``: the
+    overturning design first (a width that overturns fails every level), then the level's given
+    it (``rocking.required_width(..., overturning=)``: at least its width with each motion, and
+    the widths it ran not run again); ``.overturning_width`` is its width."""
+    import rocking
+
+    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings)
+    over = over_h = None
+    if limit is not None:
+        over_h = _stage("verify", rocking.required_width, height, record, **kw)
+        over = _stage("verify", vertical.design, record, up, height, over_h, cap_mass_ratio)
+    alone = _stage("verify", rocking.required_width, height, record, limit=limit, overturning=over_h, **kw)
+    return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over)
 
 
 def _check_settings(task: Task) -> dict:

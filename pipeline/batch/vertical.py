@@ -143,10 +143,12 @@ def scaled(task, up):
     return up.scaled(task.scale) if (up is not None and task.scale != 1.0) else up
 
 
-def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None):
+def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overturning=None):
     """The design width of a column ``height`` (m) tall: ``horizontal`` (the horizontal motion's
     answer) where there is no vertical or it reaches -g, else the wider of it and the answer with
-    the vertical (``rocking.required_width(..., vertical=)``, ``governed_by`` set)."""
+    the vertical (``rocking.required_width(..., vertical=)``, ``governed_by`` set); with a level,
+    ``overturning``: the overturning design this function gave (the level with each motion is at
+    least the overturning design with it)."""
     import numpy as np
 
     import rocking
@@ -155,7 +157,7 @@ def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None):
     if up is None or float(np.min(1.0 + up.acc / G)) <= 0.0:
         return horizontal
     return rocking.required_width(height, record, rule="exact", vertical=up, horizontal=horizontal,
-                                  cap_mass_ratio=cap_mass_ratio, limit=limit)
+                                  cap_mass_ratio=cap_mass_ratio, limit=limit, overturning=overturning)
 
 
 def fields(block, record, up, shown_file, designed=None) -> dict:

@@ -54,6 +54,9 @@ DESIGN_COLUMNS = Columns(
     ("design_governed_by", "-", "`horizontal` or `with vertical`: which motion sets the design width "
                                 "(blank without a vertical)."),
     ("design_limit", "-", "`--limit` R (max|theta|/alpha <= R); blank: overturning."),
+    ("overturning_width_m", "m", "With `--limit`: the overturning design width (for a pair: the widest "
+                                 "over its directions); the design width is at least it (a width that "
+                                 "overturns fails every level). Blank without `--limit`."),
     ("eq31_below_design", "-", "The Eq. 31 width is below the design width (Eq. 31 is not conservative "
                                "for this record)."),
     ("verdict", "-", "The column as it stands: `survives`, `NO` (overturns; with `--limit`, exceeds "
@@ -148,6 +151,7 @@ def design_rows(rows, failed=None) -> list[dict]:
                  for r in group])),
             "search_width_m": gov.get("search_width_m"), "design_governed_by": gov.get("design_governed_by"),
             "design_limit": limit,
+            "overturning_width_m": _widest([r.get("overturning_width_m") for r in group]),
             "eq31_below_design": None if (w31 is None or wd is None) else w31 < wd,
             "check_runs": gov.get("check_runs"),
             "verdict": None if survives is None else verdict_text({"survives": survives,
@@ -426,7 +430,18 @@ def fine_print(rows) -> str | None:
             + f" widths per record from the search width up to {check_reach_words()} (or the "
             "no-uplift width), more where the response varied from one width to the next; thinner "
             "failing slivers may remain (docs/slivers.md). Search width: the "
-            "search's first transition, with how far the design width lies above it.")
+            "search's first transition, with how far the design width lies above it."
+            + _level_print(rows))
+
+
+def _level_print(rows) -> str:
+    """Under ``--limit``: the design width is at least the overturning design's (its widths)."""
+    over = [v for v in (number(r.get("overturning_width_m")) for r in rows) if v is not None]
+    if not over:
+        return ""
+    return (" With the level, the design width is also at least the overturning design width "
+            f"(overturning_width_m, {min(over):.3f}" + (f"-{max(over):.3f}" if max(over) > min(over) else "")
+            + " m here): a width that overturns fails every level.")
 
 
 def columns_markdown() -> str:

@@ -200,7 +200,9 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
                      f"design width {_fixed(r.get('design_width_m')) or '-'} m"
                      + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
-                     + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else ""),
+                     + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else "")
+                     + (f", at least the overturning design width {_fixed(r['overturning_width_m'])} m"
+                        if _num(r.get("overturning_width_m")) else ""),
                      f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
