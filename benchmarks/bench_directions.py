@@ -110,7 +110,7 @@ def same_rows(a, b) -> bool:
     return ra.keys() == rb.keys() and all(ra[k][c] == rb[k][c] for k in ra for c in COMPARED)
 
 
-def measure(baseline, n_pairs, jobs, share_jobs, dask) -> list[dict]:
+def measure(baseline, n_pairs, jobs, share_jobs, dask, only=None) -> list[dict]:
     base_python = str(pathlib.Path(baseline) / ".venv" / "bin" / "python")
     runs_of = [("baseline", base_python, (), jobs, False), ("default", sys.executable, (), jobs, True),
                ("baseline-thorough", base_python, ("--thorough",), jobs, False),
@@ -121,7 +121,8 @@ def measure(baseline, n_pairs, jobs, share_jobs, dask) -> list[dict]:
         runs_of.append(("default-dask", sys.executable, ("--dask", "local"), share_jobs or 2, True))
     out = []
     with tempfile.TemporaryDirectory() as tmp:
-        for k, spec in enumerate(PAIRS[:n_pairs]):
+        chosen = [p for p in PAIRS if only is None or any(o in p[0] for o in only)][:n_pairs]
+        for k, spec in enumerate(chosen):
             pair = pair_paths(spec)
             runs = {name: run_one(py, pair, pathlib.Path(tmp) / f"{k}-{name}", j, extra, log)
                     for name, py, extra, j, log in runs_of}
@@ -179,8 +180,11 @@ def main(argv=None) -> None:
     ap.add_argument("--share-jobs", type=int, default=2, help="--jobs of a further default run measuring "
                     "the main process's share (0: none; default 2)")
     ap.add_argument("--dask", action="store_true", help="also a default run with --dask local")
+    ap.add_argument("--only", help="comma-separated names: the pairs whose first file's name holds one "
+                    "(e.g. RSN159,RSN1084), at most --pairs of them")
     args = ap.parse_args(argv)
-    entries = measure(args.baseline, args.pairs, args.jobs, args.share_jobs, args.dask)
+    only = args.only.split(",") if args.only else None
+    entries = measure(args.baseline, args.pairs, args.jobs, args.share_jobs, args.dask, only)
     res = summary(entries)
     if args.share_jobs:
         res["batch"] = batch(args.baseline, args.pairs, args.share_jobs)

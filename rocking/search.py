@@ -52,7 +52,8 @@ class SearchSettings:
     record_near``: isolated failing bands of real records sit where the block nearly overturns);
     at most ``record_rounds`` rounds (a failure found above the candidate moves it up).
 
-    The check above a record's search width ``w`` (docs/slivers.md;
+    The check in rounds above a record's search width ``w`` (``check_layout="rounds"``, the former
+    default; docs/slivers.md;
     :func:`rocking.widths.check_widths`, :func:`rocking.widths.follow_widths`): ``check_runs``
     widths from ``w`` to ``check_span`` times ``w`` or the no-uplift width, whichever is smaller,
     jittered (one random width in each of equal strata; seeded from the record, so a re-run gives
@@ -80,10 +81,27 @@ class SearchSettings:
     sizes were chosen from
     ``benchmarks/bench_slivers.py`` (its tables are in docs/slivers.md).
 
+    ``check_layout="bins"`` (the default; :mod:`rocking.binned`, docs/slivers.md, "A check
+    separable in a threshold"): one span ``(w, min(check_span w, top)]`` cut into bins
+    ``check_bin_width w`` wide.  The first stage as above; then ``check_stages`` stages giving
+    each bin ``floor(check_bin_runs q**check_power + u)`` widths, ``q`` its spread over the fixed
+    ``check_scale`` (at most 1; 1 where a width in it failed), ``u`` a seeded uniform draw; then a
+    zoom around at most ``check_zoom_peaks`` surviving widths of each bin with
+    ``max|theta|/alpha >= check_zoom_ratio``.  Where the search's own runs (``check_budget`` > 0)
+    promise the later stages more than ``check_budget`` widths (``check_stages check_bin_runs
+    sum(q**check_power)`` over the bins, from the search's runs alone), ``check_bin_runs`` is scaled
+    down to it: a record irregular everywhere gets the budget.  A bin's widths depend only on its
+    own runs and the search's, so
+    ``check_above`` runs only the bins above it (and below it down to the first with a width run
+    at or below it), and gives exactly the full check's widths, verdicts and design width above it
+    (pipeline/batch/passes.py).  The number of runs varies from record to record (only the first
+    stage's, ``check_runs (1 - check_follow)``, is fixed); ``check_zoom`` and ``check_rounds``
+    belong to the rounds layout (``check_layout="rounds"``, the former default, described above).
+
     The design width: where the check finds a failing width above the search's answer, the
     bracket above the widest failing width (up to the next width run, which survived) is bisected
     to ``design_rtol`` relative, and its surviving end is the design width
-    (:attr:`rocking.widths.RequiredWidth.width`).  The check runs in ``check_rounds`` rounds sharing
+    (:attr:`rocking.widths.RequiredWidth.width`).  The rounds layout runs ``check_rounds`` rounds sharing
     ``check_runs``, each above the design width the rounds before it left (its span starts
     there).  ``check_seed``: the check's seed (None: made
     from the record's samples and the column, so a re-run gives the same widths).
@@ -124,6 +142,13 @@ class SearchSettings:
     check_zoom: float = 0.3
     check_zoom_points: int = 4
     check_zoom_width: float = 2e-4
+    check_layout: str = "bins"
+    check_bin_width: float = 0.005
+    check_scale: float = 0.07
+    check_bin_runs: float = 20.0
+    check_zoom_ratio: float = 0.9
+    check_zoom_peaks: int = 2
+    check_budget: float = 0.0
 
     def __post_init__(self):
         for name in ("n_scan", "ksection", "record_scan", "record_chunk"):
@@ -148,6 +173,13 @@ class SearchSettings:
                              "check_zoom_points 0 or more, check_zoom_width in (0, 1), got "
                              f"{self.check_zoom!r}, {self.check_zoom_points!r}, "
                              f"{self.check_zoom_width!r}")
+        if self.check_layout not in ("rounds", "bins") or not 0.0 < self.check_bin_width \
+                or not self.check_scale > 0.0 or self.check_bin_runs < 0 or self.check_zoom_peaks < 0 \
+                or self.check_budget < 0:
+            raise ValueError("SearchSettings.check_layout must be 'rounds' or 'bins', check_bin_width "
+                             "and check_scale positive, check_bin_runs and check_zoom_peaks 0 or more, "
+                             f"got {self.check_layout!r}, {self.check_bin_width!r}, "
+                             f"{self.check_scale!r}, {self.check_bin_runs!r}, {self.check_zoom_peaks!r}")
         if self.check_rounds < 1:
             raise ValueError(f"SearchSettings.check_rounds must be at least 1, got {self.check_rounds!r}")
         if not 0.0 < self.design_rtol < 1.0:

@@ -437,11 +437,13 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
     if limit is not None:
         res.method += f"; a width fails where max|theta|/alpha > {limit:g}"
     reach = min(settings.check_span ** settings.check_rounds * res.width, top)
-    if not res.below_scan and settings.check_runs > 0 and reach > settings.check_above:
+    binned = settings.check_layout == "bins"   # separable: it runs only above check_above itself
+    if not res.below_scan and settings.check_runs > 0 and (binned or reach > settings.check_above):
         seed = settings.check_seed
         if seed is None:
             seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
-        seen = _check_rounds(res, top, evaluate_record, settings, seed, seen)
+        check = _check_bins if binned else _check_rounds
+        seen = check(res, top, evaluate_record, settings, seed, seen)
     if overturning is not None:
         res.overturning_width = float(overturning.width)
         if overturning.width > res.width:
@@ -608,20 +610,50 @@ def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
         res.check_widths, res.check_failed = cx, cf
         _raise_to_failures(res, evaluate, (xs, fs), settings)
         left = max(left - (res.refine_runs - before), 0)     # a round's refinement: from the rest
+    _store_check(res, (cx, cf), (xs, fs), min(settings.check_span * res.width, top),
+                 base_method + f"; check above it in {rounds} round(s): " + "; ".join(notes))
+    return xs, fs, rs
+
+
+def _check_bins(res, top, evaluate, settings, seed, seen):
+    """The check above the search's answer laid out bin by bin (:mod:`rocking.binned`; separable
+    in a threshold: only the bins above ``settings.check_above`` run), then the design width raised
+    above the widest failing width found (:func:`_raise_to_failures`).  Stores the outcome in
+    ``res``; returns every width run ``(widths, failed, ratio)``."""
+    from . import binned
+
+    xs, fs, rs = (np.asarray(v) for v in seen)
+    above = float(settings.check_above)
+    if res.limit:   # the ratios are over the level: their spread is measured in max|theta|/alpha
+        settings = settings.replace(check_scale=settings.check_scale / res.limit)
+    (cx, cf, cr), hi = binned.check(res.width, top, evaluate, (xs, fs, rs), settings, seed, above)
+    if not cx.size:   # no bin above check_above: as unchecked (the search's runs are above w)
+        return xs, fs, rs
+    xs, fs, rs = np.concatenate([xs, cx]), np.concatenate([fs, cf]), np.concatenate([rs, cr])
+    _raise_to_failures(res, evaluate, (xs, fs), settings)
+    where = f"above {above:.6g} m " if above > res.search_width else ""
+    _store_check(res, (cx, cf), (xs, fs), hi,
+                 res.method + f"; check above it in bins of {settings.check_bin_width:.2%} of it up "
+                 f"to {hi:.6g} m: {cx.size} widths {where}run, {int(cf.sum())} failed")
+    return xs, fs, rs
+
+
+def _store_check(res, checked, seen, hi, method) -> None:
+    """The check's outcome in ``res``: ``checked`` ``(widths, failed)`` the check ran, ``seen``
+    every width run with its verdict, ``hi`` the span's top (m)."""
+    cx, cf = (np.asarray(v) for v in checked)
+    xs, fs = (np.asarray(v) for v in seen)
     order = np.argsort(cx, kind="stable")
-    res.check_widths, res.check_failed = cx[order], cf[order]
-    seen = (xs, fs, rs)
+    res.check_widths, res.check_failed = cx[order], cf[order].astype(bool)
     res.check_runs = int(cx.size)
-    res.check_top = float(min(settings.check_span * res.width, top))
+    res.check_top = float(hi)
     res.failing_share = float(cf.mean()) if cx.size else 0.0
     known = np.concatenate([xs[fs.astype(bool)], [res.widest_failing_width or 0.0]])
     above = known[known > res.search_width]
     res.widest_failing_width = float(above.max()) if above.size else None
-    res.method = base_method + (f"; check above it in {rounds} round(s): " + "; ".join(notes)
-                                + (f"; design width {res.width:.6g} m, just above the widest "
-                                   f"failing width {res.widest_failing_width:.6g} m"
-                                   if res.widest_failing_width else ""))
-    return seen
+    res.method = method + (f"; design width {res.width:.6g} m, just above the widest "
+                           f"failing width {res.widest_failing_width:.6g} m"
+                           if res.widest_failing_width else "")
 
 
 def _at_least(res, overturning, evaluate, seen, settings) -> None:

@@ -45,7 +45,16 @@ def test_design_width_is_above_every_failing_width():
     # every width the check ran above the design width survived
     assert not res.check_failed[res.check_widths > res.width].any()
     assert 0 < res.refine_runs <= 25 and res.total_runs == res.runs + res.check_runs + res.refine_runs
-    assert res.total_runs <= res.runs + DEFAULT_SETTINGS.check_runs
+    assert res.check_runs <= _most(res, rec)
+
+
+def _most(res, rec) -> int:
+    """The most widths the default (binned) check can run above ``res``'s search width: its number
+    varies with the record (docs/slivers.md); the median over 62 cases is within the former 1500."""
+    from rocking import binned
+
+    hi = binned.span_top(res.search_width, res.height * rec.pga / pulses.G, DEFAULT_SETTINGS)
+    return binned.most_runs(res.search_width, hi, DEFAULT_SETTINGS)
 
 
 def test_level_half():
@@ -60,11 +69,9 @@ def test_level_half():
     assert not toppled and ratio <= 0.5
     assert half.width >= over.width
     assert _ratio(7.5, half.search_width * (1 - 1e-6), rec)[1] > 0.5 or half.widest_failing_width
-    # the same budget of runs as overturning (search + check + refinement)
-    # runs: search + check + refinement within today's search + 1500 (the refinement comes out of
-    # the check's budget)
+    # the check's runs within what its layout allows (their number varies with the record)
     for res in (half, over):
-        assert res.total_runs <= res.runs + DEFAULT_SETTINGS.check_runs
+        assert 0 < res.check_runs <= _most(res, rec)
 
 
 def test_vertical_governs_the_design():

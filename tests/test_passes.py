@@ -17,6 +17,8 @@ from rocking.search import DEFAULT_SETTINGS
 from .test_site import H, B, _pair
 
 CHECK = list(CHECK_COLUMNS.names)
+#: the check in rounds (the layout before the binned one; check_above switches it off or on)
+ROUNDS = DEFAULT_SETTINGS.replace(check_layout="rounds")
 #: what the check decides besides its own columns: the direction's design width (the search's
 #: width where it found no failing width above it)
 DESIGN = CHECK + ["design_width_m", "design_tan_alpha", "design_adequate"]
@@ -37,7 +39,7 @@ def _design(rows) -> float:
 def _top(row) -> float:
     """The widest width the check of this row's direction would look at (rocking.widths)."""
     w = float(row["design_width_m"])
-    return passes._bracket_step() * min(DEFAULT_SETTINGS.check_span ** DEFAULT_SETTINGS.check_rounds * w,
+    return passes._bracket_step() * min(passes.reach(DEFAULT_SETTINGS) * w,
                                         float(row["height_m"]) * float(row["pga_g"]))
 
 
@@ -91,12 +93,23 @@ def test_the_check_goes_to_the_governing_direction_then_where_it_could_reach_the
     # it found a failing width at 1.5 m: the design width; a check reaching up to 1.0 m cannot
     # change it, one reaching 2.0 m or 2.4 m can
     group[1] = _d(1, True, True, 1.2, 2.4, 1.5)
-    assert passes._wanted(group, plots=True) == ({0: False, 3: False}, {"7.5x1.8": 1.5})
+    assert passes._wanted(group, plots=True) == ({0: False, 3: False}, {"7.5x1.8": 1.5}, set())
     group[0], group[3] = _d(0, True, False, 1.0, 2.0), _d(3, True, False, 1.2, 2.4, 2.1)
     assert passes._wanted(group, plots=True)[0] == {}
     # a direction whose check could reach 2.1 m only if the design width were lower
     group[4] = _d(4, False, False, 1.05, 2.1 * (1.0 - 1e-3))
     assert passes._wanted(group, plots=True)[0] == {}
+
+
+def test_a_governing_direction_checked_only_above_a_bound_is_checked_whole():
+    # direction 1 was checked above the scouts' bound only (the separable layout) and governs:
+    # it is computed again with its whole check, drawn or not
+    group = {0: _d(0, False, False, 1.0, 2.0), 1: passes._Direction(1, True, False, {"7.5x1.8": (1.2, 2.4, None)},
+                                                                  full=False)}
+    for plots in (True, False):
+        assert passes._wanted(group, plots=plots) == ({1: plots}, {}, {1})
+    group[1].full = True
+    assert passes._wanted(group, plots=False) == ({0: False}, {"7.5x1.8": 1.2}, set())
 
 
 def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
@@ -117,9 +130,10 @@ def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
                               "pga_g": 0.5, "widest_failing_width_m": None}])
     second = plan.next_pass(first)
     assert [t.index for t in second] == [1, 2, 5, 7]
-    # each checked where its check could reach above 1.3 m, the scouts' widest design width
-    step = passes._bracket_step()
-    assert all(t.check and t.check_above == pytest.approx((1.3 / step,), rel=1e-5) for t in second)
+    # each checked above 1.3 m, the scouts' widest design width (the binned check); the rounds
+    # check is run where it could reach that far, its top allowed a bracket step above it
+    below = 1.0 if DEFAULT_SETTINGS.check_layout == "bins" else passes._bracket_step()
+    assert all(t.check and t.check_above == pytest.approx((1.3 / below,), rel=1e-5) for t in second)
     assert plan.held == set()
 
 
@@ -191,15 +205,15 @@ def test_real_pairs_default_design_width_is_the_thorough_one(shared_records, nam
     assert _same_answer(_rows(tmp_path / "default"), _rows(tmp_path / "thorough")) >= 1
 
 
-def test_check_above_switches_the_check_off_only_where_its_top_is_not_above_it():
+def test_check_above_switches_the_rounds_check_off_only_where_its_top_is_not_above_it():
     import importlib.resources
 
     import pulses
     import rocking
 
     record = pulses.read_record(str(importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
-    full = rocking.required_width(7.5, record, rule="exact")
-    s = DEFAULT_SETTINGS
+    s = ROUNDS
+    full = rocking.required_width(7.5, record, rule="exact", settings=s)
     # the widest width the check's rounds could reach: each round's span is at most check_span
     # times the width the one before left, and nothing rocks above the no-uplift width
     reach = min(s.check_span ** s.check_rounds * full.search_width, 7.5 * record.pga / pulses.G)
@@ -213,15 +227,15 @@ def test_check_above_switches_the_check_off_only_where_its_top_is_not_above_it()
         (full.width, full.check_runs, full.failing_share, full.widest_failing_width)
 
 
-def test_the_check_stops_after_a_round_when_the_rounds_left_could_not_reach_check_above():
+def test_the_rounds_check_stops_after_a_round_when_the_rounds_left_could_not_reach_check_above():
     import importlib.resources
 
     import pulses
     import rocking
 
     record = pulses.read_record(str(importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac"))
-    s = DEFAULT_SETTINGS
-    full = rocking.required_width(7.5, record, rule="exact")
+    s = ROUNDS
+    full = rocking.required_width(7.5, record, rule="exact", settings=s)
     top = 7.5 * record.pga / pulses.G
     # above what a second round from the search's width could reach, below what two could: the
     # first round runs (its share of the runs) and, where it raised nothing that far, no second

@@ -10,7 +10,7 @@ import pytest
 import pulses
 import rocking
 from pulses import G, make_pulse
-from rocking import Block
+from rocking import Block, binned
 from rocking.search import DEFAULT_SETTINGS, SearchSettings
 from rocking.widths import _record_seed, check_widths, follow_widths
 
@@ -115,25 +115,23 @@ def test_check_against_dense_scans_synthetic():
     assert np.array_equal(again.check_widths, res.check_widths) and again.width == res.width
     assert again.failing_share == res.failing_share
     top = height * rec.pga / G
-    # the check's 1500 runs include the refinement's: what it spent refining comes off the widths
+    # the binned check's runs: its first stage, and at most what its bins allow
     assert res.check_runs == res.check_widths.size
-    assert res.check_runs + res.refine_runs <= DEFAULT_SETTINGS.check_runs < res.check_runs + 50
-    assert res.check_top == pytest.approx(min(DEFAULT_SETTINGS.check_span * res.width, top), rel=1e-15)
+    hi = binned.span_top(w, top, DEFAULT_SETTINGS)
+    first = binned.first_widths(w, hi, DEFAULT_SETTINGS, _record_seed(rec, height, "overturn", None, 0.0))
+    assert first.size < res.check_runs <= binned.most_runs(w, hi, DEFAULT_SETTINGS)
+    assert res.check_top == pytest.approx(hi, rel=1e-15)
     assert res.failing_share == pytest.approx(res.check_failed.mean(), abs=0)
     # the widest failing width overturns in the reference model too (an independent integrator)
     ref = rocking.simulate(Block.from_dimensions(height, res.widest_failing_width), rec,
                            model="reference", history=False)
     assert ref.overturned
-    # the first round's first stage of log-spaced widths in d = B/w - 1 in [1e-4, 1e-2] (the
+    # the first stage's log-spaced widths in d = B/w - 1 in [1e-4, 1e-2] (the
     # later stages place theirs by what it found, so only the first stage is an unbiased sample)
     # against 1500 log-spaced widths of the same stretch (an independent deterministic grid): the
     # check's count of failures there is binomial with the grid's share p; 4 standard deviations
     # plus 2 for the grid's own sampling error (a 1500-point estimate of p) bound it (a chance of
     # ~1e-4 to fail by luck)
-    reserve = math.ceil(math.log2(0.016 / DEFAULT_SETTINGS.design_rtol))   # the last refinement's
-    first_round = DEFAULT_SETTINGS.replace(
-        check_runs=(DEFAULT_SETTINGS.check_runs - reserve) // DEFAULT_SETTINGS.check_rounds)
-    first = check_widths(w, top, first_round, _record_seed(rec, height, "overturn", None, 0.0))
     assert np.isin(first, res.check_widths).all()
     d = res.check_widths / w - 1.0
     sel = (d >= 1e-4) & (d <= 1e-2) & np.isin(res.check_widths, first)
@@ -192,7 +190,6 @@ def test_pipeline_reports_the_check(tmp_path):
     assert float(row["failing_share"]) == pytest.approx(ver.failing_share, rel=1e-5)
     assert float(row["widest_failing_width_m"]) == pytest.approx(ver.widest_failing_width, rel=1e-5)
     assert int(float(row["check_runs"])) == ver.check_runs
-    assert ver.check_runs + ver.refine_runs <= DEFAULT_SETTINGS.check_runs < ver.check_runs + 50
     assert row["design_adequate"] == "False"
     suite = next(csv.DictReader(open(out / "suite.csv")))
     assert suite["share_column_adequate"] == "0" and suite["share_column_checked"] == "0"

@@ -1,33 +1,43 @@
 """Which directions of a pair get the check above the search width and the figures.
 
-A pair designed in many directions is governed by its widest direction: the pair's design width is
-the widest of its directions' design widths, each above every failing width its check found
-(docs/slivers.md).  The check of a direction (1500 runs) changes that answer only where it can
-find a failing width above the pair's design width, and it looks only up to ``check_top =
-min(check_span ** check_rounds w, H PGA / g)`` (``rocking.search.SearchSettings``: each round's
-span is at most ``check_span`` times the width the round before left; ``w`` the search's width,
-``H PGA / g`` the no-uplift width under the direction's component).  So ``pipeline run`` computes a
-pair in passes (a check's top below also allows for the bracket above a failing width it may raise the
-design width to, :func:`_bracket_step`):
+A pair designed in many directions is governed by its widest direction: the pair's design width
+``D`` is the widest of its directions' design widths ``W_d``, each above every failing width its
+check found (docs/slivers.md).  The check (:mod:`rocking.binned`, the default layout) is
+*separable in a threshold*: run only above ``T`` (``SearchSettings.check_above``), a direction's
+check runs exactly the widths its whole check runs above ``T``, with the same verdicts (and the
+bins below ``T`` down to the first holding a width run at or below ``T``), so its design width
+``W_d(T)`` is ``W_d`` wherever ``W_d > T``, and at most ``W_d`` otherwise.  A direction left
+unchecked has the design width ``W_d(T)`` for any ``T`` at or above its *reach* ``step min(check_span
+w, H PGA / g)`` (``w`` its search width, ``H PGA / g`` the no-uplift width under its component,
+``step`` the search's scan step, :func:`_bracket_step`: a failing width the check could find is
+at most its top, and the bracket above it ends at the next width run).
+
+The argument: let every direction ``d`` be checked above some ``T_d < D'``, ``D'`` the widest of
+the ``W_d(T_d)`` (the pair's design width the run reports).  Then ``D' <= D``, since every
+``W_d(T_d) <= W_d``; and for a direction ``g`` with ``W_g = D``, ``T_g < D' <= D = W_g``, so
+``W_g(T_g) = W_g = D`` and ``D' >= D``.  So ``D'`` is the design width ``--thorough`` (every
+direction checked whole, as a lone record) finds, whatever the bounds, as long as each lies below
+the final ``D'``.  Any width a direction reports (its search width at least) is such a bound.
+``pipeline run`` computes a pair in passes:
 
 1. a few *scout* directions (the recorded components, the pulse's and its normal, every
    :data:`SCOUT_EVERY` th direction in angle order): the search only (no check), no figure
    (unless ``--plots all``);
-2. the other directions, each with its check where its ``check_top`` lies above the widest
-   width the scouts found (a lower bound of the pair's design width), in the same task as its
-   search;
-3. the governing direction (widest design width, the first such in angle order, as in
-   ``pairs.csv``) with its check where not done, and its figures;
-4. then, while any is left, every unchecked direction whose ``check_top`` lies above the pair's
-   design width found so far (the widest design width of the checked directions): the whole
-   direction again (the check's later stages use the search's widths, and the check may raise
-   the direction's design width, which other columns use).
+2. the other directions, each checked above the widest width the scouts found (a lower bound of
+   the pair's design width), in the same task as its search;
+3. the governing direction (the widest design width so far, the first such in angle order, as in
+   ``pairs.csv``) with its whole check, and its figures, where not done;
+4. then, while any is left, every unchecked direction whose reach lies above the pair's design
+   width found so far, checked above that width: the whole direction again (the check uses the
+   search's widths, and may raise the direction's design width, which other columns use).
 
-A direction left unchecked cannot find a failing width above the pair's final design width, so
-the pair's design width is the one ``--thorough`` (every direction checked, as a lone record)
-finds; the unchecked directions' rows say so (``check_runs`` 0, ``failing_share`` blank).  Each
-pass is the same :func:`pipeline.batch.record.process_record` on tasks whose ``check`` and ``plot``
-switches are set here; a lone record is one pass, checked and drawn.
+The directions checked above a bound say how many widths they ran (``check_runs``); those left
+unchecked say so (``check_runs`` 0, ``failing_share`` blank).  Each pass is the same
+:func:`pipeline.batch.record.process_record` on tasks whose ``check``, ``check_above`` and
+``plot`` switches are set here; a lone record is one pass, checked whole and drawn.  With the
+former layout (``check_layout="rounds"``, not separable) ``check_above`` switches a direction's
+check off where its rounds could not reach above it, and runs it whole otherwise; the bounds are
+then divided by ``step``, for the bracket above the rounds' top.
 """
 from __future__ import annotations
 
@@ -47,6 +57,15 @@ def _bracket_step() -> float:
     from rocking.search import DEFAULT_SETTINGS as s
 
     return (1.0 / s.record_low) ** (1.0 / (s.record_scan - 1))
+
+
+def reach(settings) -> float:
+    """How far above its search width ``w`` a direction's check looks, over ``w``: one span
+    (``check_span``) for the binned layout, ``check_span ** check_rounds`` for the rounds (each
+    round's span is at most ``check_span`` times the width the round before left)."""
+    if settings.check_layout == "bins":
+        return float(settings.check_span)
+    return float(settings.check_span) ** int(settings.check_rounds)
 
 
 def staged(task, options) -> bool:
@@ -82,6 +101,12 @@ class _Direction:
     plotted: bool
     #: per column label: (design width, check top, widest failing width or None)
     columns: dict
+    #: checked in full, not only above a bound (None: as ``checked``)
+    full: bool | None = None
+
+    def __post_init__(self):
+        if self.full is None:
+            self.full = self.checked
 
 
 class Plan:
@@ -91,8 +116,13 @@ class Plan:
         from rocking.search import DEFAULT_SETTINGS
 
         self.options = options
-        self.span = float(DEFAULT_SETTINGS.check_span) ** int(DEFAULT_SETTINGS.check_rounds)
+        #: the check's layout is separable in a threshold: a check above a bound runs only there
+        self.separable = DEFAULT_SETTINGS.check_layout == "bins"
+        self.span = reach(DEFAULT_SETTINGS)
         self.step = _bracket_step()
+        #: what a lower bound of the pair's design width is divided by to give check_above: the
+        #: binned check refines its own bracket across the bound; the rounds' is allowed for here
+        self.below = 1.0 if self.separable else self.step
         self.pairs: dict[str, dict[int, _Direction]] = {}
         #: the directions held back from the first pass (indices)
         self.held = set(held)
@@ -114,7 +144,8 @@ class Plan:
                                  for k in ("design_width_m", "height_m", "pga_g", "widest_failing_width_m"))
             # the widest design width its check could set (above the reach of its rounds)
             cols[r["column"]] = (w, self.step * min(self.span * w, H * pga), widest)
-        group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols)
+        full = bool(task.check) and not (self.separable and any(task.check_above))
+        group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols, full)
 
     def next_pass(self, tasks) -> list:
         """The tasks to compute next (their switches set), from ``tasks`` (the run's tasks, by
@@ -123,11 +154,11 @@ class Plan:
             return self._second_pass(tasks)
         out = []
         for group in self.pairs.values():
-            want, design = _wanted(group, bool(self.options.plots))
+            want, design, whole = _wanted(group, bool(self.options.plots))
             for i, plot in sorted(want.items()):
                 # the governing direction's check whole; the others' rounds where they could reach
                 # above the pair's design width so far
-                above = () if plot else tuple(design.get(c.label, 0.0) * (1.0 - MARGIN) / self.step
+                above = () if plot or i in whole else tuple(design.get(c.label, 0.0) * (1.0 - MARGIN) / self.below
                                               for c in tasks[i].columns)
                 out.append(dataclasses.replace(tasks[i], check=True, check_above=above, plot=plot or tasks[i].plot))
         return out
@@ -145,25 +176,27 @@ class Plan:
             for d in group.values():
                 for label, (w, _, _) in d.columns.items():
                     lower[label] = max(lower.get(label, 0.0), w)
-            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) / self.step for c in t.columns)
+            above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) / self.below for c in t.columns)
             out.append(dataclasses.replace(t, check=True, check_above=above))
         self.held = set()
         return out
 
 
-def _wanted(group, plots: bool) -> tuple[dict, dict]:
-    """``{index: draw}`` of the directions of one pair to compute (checked) next, and the pair's
-    design width so far by column label (where its governing direction is checked)."""
-    want, designs = {}, {}
+def _wanted(group, plots: bool) -> tuple[dict, dict, set]:
+    """``{index: draw}`` of the directions of one pair to compute (checked) next, the pair's
+    design width so far by column label (where its governing direction is checked whole), and the
+    indices of the governing directions to check whole."""
+    want, designs, whole = {}, {}, set()
     labels = {c for d in group.values() for c in d.columns}
     for label in labels:
         dirs = [d for d in sorted(group.values(), key=lambda d: d.index) if label in d.columns]
         gov = max(dirs, key=lambda d: d.columns[label][0])  # the first of equal widths
-        if not gov.checked or (plots and not gov.plotted):
+        if not gov.full or (plots and not gov.plotted):
             want[gov.index] = plots
+            whole.add(gov.index)
             continue
         design = designs[label] = max(max(w, f or 0.0) for d in dirs if d.checked for w, _, f in [d.columns[label]])
         for d in dirs:
             if not d.checked and d.columns[label][1] > design * (1.0 - MARGIN):
                 want.setdefault(d.index, False)
-    return want, designs
+    return want, designs, whole

@@ -16,7 +16,7 @@ import time
 from pulses.shapes import AntisymmetricRicker
 
 from . import memo, peer_inputs, site, vertical
-from ..reports.design_table import check_reach_words
+from ..reports.design_table import check_bin_words, check_reach_words
 from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
@@ -412,19 +412,21 @@ CHECK_COLUMNS = Columns(
                            "search's first transition (`search_width_m`) the response is chaotic and "
                            "failing slivers thinner than the search's 0.05 % grid may lie above it. "
                            "After the search, a check runs `check_runs` jittered widths (seeded from "
-                           "the record, off the search's grid) in two rounds, each from the design "
-                           f"width so far up to {check_reach_words()} or the no-uplift width (height x PGA / g), "
-                           "whichever is smaller: this is the share of them that fail (0: none did; "
+                           "the record, off the search's grid) from the search width up to "
+                           f"{check_reach_words()} or the no-uplift width (height x PGA / g), whichever "
+                           f"is smaller, in bins of {check_bin_words()} of it, more where the response varies from one "
+                           "width to the next (in a direction of a pair, only above a lower bound of the "
+                           "pair's design width, docs/site.md): this is the share of them that fail (0: none did; "
                            "blank: no check, as in a direction of a pair whose check could not reach "
-                           "the pair's design width, docs/site.md). The design width `design_width_m` lies just above the "
+                           "the pair's design width). The design width `design_width_m` lies just above the "
                            "widest failing width found."),
     ("widest_failing_width_m", "m", "The widest width the search or the check found to fail above "
                                     "the search width (a failing sliver; blank where none was found, "
                                     "which does not prove there is none); the design width lies just "
                                     "above it."),
-    ("check_runs", "-", "Number of widths (solver runs) of the check above the search width (0: "
-                        "not checked; fewer than its 1500 where its later rounds could not reach the "
-                        "pair's design width, docs/site.md)."),
+    ("check_runs", "-", "Number of widths (solver runs) of the check above the search width: 300 "
+                        "and more where the response varies (0: not checked; in a direction of a pair, "
+                        "those above a lower bound of the pair's design width, docs/site.md)."),
 )
 
 

@@ -403,12 +403,20 @@ def verdict_lines(rows) -> list[str]:
 
 
 def check_reach_words() -> str:
-    """How far above the width it starts from each round of the check looks, in words ("1.5
-    times it"; ``rocking.search.SearchSettings.check_span``)."""
+    """How far above the search width the check looks, in words ("1.5 times it";
+    ``rocking.search.SearchSettings.check_span``)."""
     from rocking.search import DEFAULT_SETTINGS
 
     span = float(DEFAULT_SETTINGS.check_span)
     return "twice it" if span == 2.0 else f"{span:g} times it"
+
+
+def check_bin_words() -> str:
+    """The width of the check's bins, relative to the search width, in words ("0.5 %";
+    ``rocking.search.SearchSettings.check_bin_width``)."""
+    from rocking.search import DEFAULT_SETTINGS
+
+    return f"{100.0 * float(DEFAULT_SETTINGS.check_bin_width):g} %"
 
 
 def fine_print(rows) -> str | None:
@@ -420,7 +428,8 @@ def fine_print(rows) -> str | None:
             f"fail, refined just above the widest; the check ran {min(runs):.0f}"
             + (f"-{max(runs):.0f}" if max(runs) > min(runs) else "")
             + f" widths per record from the search width up to {check_reach_words()} (or the "
-            "no-uplift width) in each round; thinner failing slivers may remain (docs/slivers.md). Search width: the "
+            "no-uplift width), more where the response varied from one width to the next; thinner "
+            "failing slivers may remain (docs/slivers.md). Search width: the "
             "search's first transition, with how far the design width lies above it."
             + _level_print(rows))
 
