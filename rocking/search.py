@@ -101,7 +101,11 @@ class SearchSettings:
     The design width: where the check finds a failing width above the search's answer, the
     bracket above the widest failing width (up to the next width run, which survived) is bisected
     to ``design_rtol`` relative, and its surviving end is the design width
-    (:attr:`rocking.widths.RequiredWidth.width`).  The rounds layout runs ``check_rounds`` rounds sharing
+    (:attr:`rocking.widths.RequiredWidth.width`).  Under a record it is then raised to the
+    narrowest number of ``design_digits`` significant digits at or above it that survives (run
+    there; a failure there is bracketed and bisected in turn), so that the width as the reports
+    print it (6 digits) is a width that was run and survived: a width 1e-6 above a failing one
+    can print below it.  The rounds layout runs ``check_rounds`` rounds sharing
     ``check_runs``, each above the design width the rounds before it left (its span starts
     there).  ``check_seed``: the check's seed (None: made
     from the record's samples and the column, so a re-run gives the same widths).
@@ -136,6 +140,7 @@ class SearchSettings:
     check_bins: int = 100
     check_power: float = 3.0
     design_rtol: float = 1e-6
+    design_digits: int = 6
     check_seed: int | None = None
     check_rounds: int = 2
     check_above: float = 0.0
@@ -182,6 +187,9 @@ class SearchSettings:
                              f"{self.check_scale!r}, {self.check_bin_runs!r}, {self.check_zoom_peaks!r}")
         if self.check_rounds < 1:
             raise ValueError(f"SearchSettings.check_rounds must be at least 1, got {self.check_rounds!r}")
+        if not (isinstance(self.design_digits, int) and 1 <= self.design_digits <= 15):
+            raise ValueError(f"SearchSettings.design_digits must be a whole number in [1, 15], got "
+                             f"{self.design_digits!r}")
         if not 0.0 < self.design_rtol < 1.0:
             raise ValueError(f"SearchSettings.design_rtol must be in (0, 1), got {self.design_rtol!r}")
         if not self.rtol > 0:

@@ -450,6 +450,7 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
             # a width that overturns fails every level: one run at the overturning design width,
             # and a bisection above it where that width exceeds the level
             _at_least(res, overturning, evaluate_record, seen, settings)
+    seen = _on_digits(res, top, evaluate_record, seen, settings)
     res.shared_runs = shared + runs.shared
     # the batches run, for a level given this design (none kept otherwise: they serve no other)
     res.outcomes = tuple(runs.log) if limit is None and criterion == "overturn" else None
@@ -756,6 +757,42 @@ def _raise_to_failures(res, evaluate, seen, settings) -> None:
         res.refine_runs += 1
         lo, hi = (mid, hi) if failed else (lo, mid)
     res.width, res.widest_failing_width = hi, lo
+
+
+def digits_up(width: float, digits: int) -> float:
+    """The narrowest number of ``digits`` significant digits at or above ``width`` (> 0)."""
+    w = float(f"{width:.{digits}g}")
+    if w < width:
+        w = float(f"{w + 10.0 ** (math.floor(math.log10(w)) - digits + 1):.{digits}g}")
+    return w
+
+
+def _on_digits(res, top, evaluate, seen, settings):
+    """``res.width`` raised to the narrowest width of ``settings.design_digits`` significant digits
+    at or above it that survives (SearchSettings: the reports print that many, so the width they
+    print is one that was run); returns ``seen`` with the runs added.  A width above the no-uplift
+    width ``top`` survives without a run (nothing uplifts there)."""
+    if res.below_scan or not res.width > 0:
+        return seen
+    x, f, r = (list(np.asarray(v)) for v in seen)
+    while True:
+        w = digits_up(res.width, int(settings.design_digits))
+        if w == res.width:
+            break
+        if w > top:
+            res.width = w
+            break
+        failed, ratio = (np.asarray(v) for v in evaluate(np.array([w])))
+        res.refine_runs += 1
+        x.append(w), f.append(bool(failed[0])), r.append(float(ratio[0]))
+        if not failed[0]:
+            res.width = w
+            break
+        x_, f_ = np.asarray(x, dtype=float), np.asarray(f, dtype=bool)
+        if not (x_ > w).any():          # nothing run above it: the no-uplift width survives
+            x_, f_ = np.append(x_, top), np.append(f_, False)
+        _raise_to_failures(res, evaluate, (x_, f_), settings)
+    return tuple(np.asarray(v) for v in (x, f, r))
 
 
 #: how far below the scan's narrowest width (in halvings) the search looks for a failure

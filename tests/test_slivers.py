@@ -250,3 +250,37 @@ def test_zoom_widths_go_around_the_widths_nearest_to_failing():
     assert np.array_equal(y, zoom_widths(w, top, widths, ratio, failed, 8, s, seed=2))
     assert not np.array_equal(y, zoom_widths(w, top, widths, ratio, failed, 8, s, seed=3))
     assert zoom_widths(w, top, widths, ratio, failed, 0, s).size == 0
+
+
+def _printed_width_is_safe(height, record, limit=None, overturning=None):
+    """The design width has the reports' 6 significant digits, survives as printed, and lies above
+    every failing width found (the widest one included, to the printed digits)."""
+    w = rocking.required_width(height, record, rule="exact", limit=limit, overturning=overturning)
+    printed = float(f"{w.width:.6g}")
+    assert printed == w.width
+    if w.widest_failing_width is not None:
+        assert float(f"{w.widest_failing_width:.6g}") <= printed and w.widest_failing_width < printed
+    res = rocking.simulate(Block.from_dimensions(height, printed), record)
+    assert not res.overturned
+    if limit is not None:
+        assert res.max_rotation_ratio <= limit
+    return w
+
+
+def test_the_printed_design_width_is_a_width_that_survived():
+    """Raised to 6 significant digits (SearchSettings.design_digits) and run there: a width just
+    1e-6 above a failing one, printed with 6 digits, could otherwise print below it."""
+    w = _printed_width_is_safe(7.5, _chaotic_record())
+    assert w.width >= w.search_width
+
+
+@pytest.mark.slow
+def test_the_printed_level_width_keeps_the_level_on_a_real_record():
+    """Kern Taft 021 at 6 m, level 0.5 given the overturning design (pipeline run --limit's
+    path): bisected to 1e-6 alone, the design width lay 0.36 um above a failing width
+    (0.5557753720 against 0.5557750122 m), and its 6-digit print, 0.555775 m, reached max
+    theta/alpha 0.715; now 0.555776 m (0.30)."""
+    record = pulses.read_record(shared_record("RSN15_KERN_TAF021.AT2"))
+    over = _printed_width_is_safe(6.0, record)
+    w = _printed_width_is_safe(6.0, record, limit=0.5, overturning=over)
+    assert w.width >= over.width
