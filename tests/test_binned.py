@@ -11,6 +11,7 @@ import pulses
 import rocking
 from rocking import binned
 from rocking.search import DEFAULT_SETTINGS
+from rocking.widths import digits_up
 
 from .conftest import shared_record
 
@@ -70,7 +71,8 @@ def test_the_check_above_a_threshold_is_the_full_check_above_it():
     # above the span's top and the search's next width: nothing to run
     none = rocking.required_width(7.5, record, rule="exact",
                                   settings=BINS.replace(check_above=full.check_top * 1.2))
-    assert (none.check_runs, none.width) == (0, full.search_width)
+    assert (none.check_runs, none.search_width) == (0, full.search_width)
+    assert none.width == digits_up(full.search_width, BINS.design_digits)   # run there: survived
 
 
 def test_a_bins_widths_depend_on_its_own_runs_only():

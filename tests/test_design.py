@@ -276,7 +276,8 @@ def test_required_width_exact_for_a_record():
     w = rocking.required_width(5.0, rec, rule="exact")
     assert 0 < w.width < 5.0 * 0.6
     assert not rocking.simulate(Block.from_dimensions(5.0, w.width * (1 + 1e-6)), rec).overturned
-    assert rocking.simulate(Block.from_dimensions(5.0, w.width * (1 - 1e-6)), rec).overturned
+    # the transition is the search's (the design width is it raised to 6 significant digits)
+    assert rocking.simulate(Block.from_dimensions(5.0, w.search_width * (1 - 1e-6)), rec).overturned
     with pytest.raises(ValueError):
         rocking.required_width(5.0, rec, rule="eq31")
 
@@ -390,8 +391,9 @@ def test_record_width_search_matches_brute_force_synthetic(height):
                                    settings=rocking.design.SearchSettings(record_chunk=10**9))
     assert whole.width == fast.width and whole.runs >= fast.runs
     # and it is a transition: fails just below, survives just above (fast solver and reference)
-    for f, expect in [(1 + 1e-6, False), (1 - 1e-6, True)]:
-        blk = Block.from_dimensions(height, fast.width * f)
+    # (the transition is the search's; the design width is it raised to 6 significant digits)
+    for b, expect in [(fast.width * (1 + 1e-6), False), (fast.search_width * (1 - 1e-6), True)]:
+        blk = Block.from_dimensions(height, b)
         assert rocking.simulate(blk, rec, history=False).overturned is expect
         assert rocking.simulate(blk, rec, model="reference", history=False).overturned is expect
 
@@ -457,6 +459,6 @@ def test_design_width_never_zero_for_a_very_tall_column(shared_records):
     rec = pulses.read_record(shared_records / "Rinaldi228.AT2")
     res = rocking.required_width(1000.0, rec, rule="exact")
     assert res.width > 0.0 and not res.below_scan
-    for f, expect in [(1 + 1e-6, False), (1 - 1e-6, True)]:
-        blk = Block.from_dimensions(1000.0, res.width * f)
+    for b, expect in [(res.width * (1 + 1e-6), False), (res.search_width * (1 - 1e-6), True)]:
+        blk = Block.from_dimensions(1000.0, b)
         assert rocking.simulate(blk, rec, model="fast", history=False).overturned is expect

@@ -104,7 +104,11 @@ def test_printed_table_and_design_csv(demo):
     below = sum(r["eq31_below_design"] == "True" for r in rows)
     over = sum(r["eq31_width_overturns"] == "True" for r in rows)
     assert f"Eq. 31 is below the design width on {below} of 5 record(s); its design overturns under {over}." in proc.stdout
-    assert re.search(r"the check ran 14[5-9]\d(-1[45]\d\d)? widths per record", proc.stdout)
+    # the fine print gives the check's runs as design.csv has them (300 at least: its first stage)
+    runs = [int(r["check_runs"]) for r in rows if r["check_runs"] not in ("", "0")]
+    assert min(runs) >= 300
+    assert (f"the check ran {min(runs)}" + (f"-{max(runs)}" if max(runs) > min(runs) else "")
+            + " widths per record") in proc.stdout
     # the files are the run's own: listed in the manifest (so a re-run may replace them)
     manifest = (out / "pipeline-manifest.txt").read_text()
     assert "  design.csv\n" in manifest and "  report.html\n" in manifest

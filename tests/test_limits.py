@@ -3,6 +3,8 @@
 checked against independent runs of ``rocking.simulate``."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -39,7 +41,9 @@ def test_design_width_is_above_every_failing_width():
     assert res.widest_failing_width > 1.05 * res.search_width       # far above the search's answer
     assert res.widest_failing_width < res.width
     # refined just above it: within design_rtol (plus one bisection step)
-    assert res.width - res.widest_failing_width <= 2 * DEFAULT_SETTINGS.design_rtol * res.width
+    # the bracket bisected to design_rtol, its end raised to 6 significant digits (one unit more)
+    unit = 10.0 ** (math.floor(math.log10(res.width)) - DEFAULT_SETTINGS.design_digits + 1)
+    assert res.width - res.widest_failing_width <= unit + 2 * DEFAULT_SETTINGS.design_rtol * res.width
     assert not _ratio(7.5, res.width, rec)[0]
     assert _ratio(7.5, res.widest_failing_width, rec)[0]
     # every width the check ran above the design width survived

@@ -74,8 +74,8 @@ def _same_answer(default, thorough):
                 assert float(r["design_width_m"]) >= max(float(r["search_width_m"]),
                                                          float(r["overturning_width_m"]))
                 assert float(r["overturning_width_m"]) <= float(ref["overturning_width_m"])
-            else:
-                assert r["design_width_m"] == r["search_width_m"]
+            else:   # the search width raised to 6 significant digits (run there)
+                assert float(r["design_width_m"]) >= float(r["search_width_m"])
             assert _top(r) <= design * (1.0 + passes.MARGIN)
     return n_checked
 
@@ -219,7 +219,7 @@ def test_check_above_switches_the_rounds_check_off_only_where_its_top_is_not_abo
     reach = min(s.check_span ** s.check_rounds * full.search_width, 7.5 * record.pga / pulses.G)
     assert full.check_runs > 0 and reach > full.search_width
     off = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=reach))
-    assert (off.width, off.check_runs, off.failing_share) == (full.search_width, 0, None)
+    assert (off.search_width, off.check_runs, off.failing_share) == (full.search_width, 0, None)
     # below what the last round from the search's width reaches: every round runs
     last = min(s.check_span * full.search_width, 7.5 * record.pga / pulses.G)
     on = rocking.required_width(7.5, record, rule="exact", settings=s.replace(check_above=last * (1.0 - 1e-9)))

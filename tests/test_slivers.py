@@ -107,7 +107,7 @@ def test_check_against_dense_scans_synthetic():
     # the search is that of the search without the check; the design width lies above it and
     # above every failing width found (here the check finds slivers up to ~3 % above the search's)
     w = res.search_width
-    assert w == off.width and res.runs == off.runs and res.transitions == off.transitions
+    assert w == off.search_width and res.runs == off.runs and res.transitions == off.transitions
     assert off.failing_share is None and off.widest_failing_width is None and off.check_runs == 0
     assert res.width > res.widest_failing_width > w
     assert not res.check_failed[res.check_widths > res.width].any()
