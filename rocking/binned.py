@@ -56,7 +56,8 @@ def edges(width, hi, settings) -> np.ndarray:
 
 def first_widths(width, hi, settings, seed) -> np.ndarray:
     """The first stage's widths (m, ascending) over ``(width, hi]``: ``check_runs (1 -
-    check_follow)`` of them, as :func:`rocking.widths.check_widths` lays them."""
+    check_follow)`` of them, laid out as :func:`rocking.widths.check_widths` says (which calls
+    this with ``hi`` the span's top)."""
     n = int(settings.check_runs) - int(round(settings.check_follow * int(settings.check_runs)))
     if n <= 0 or not hi > width * (1.0 + settings.check_first):
         return np.zeros(0)

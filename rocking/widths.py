@@ -518,20 +518,9 @@ def check_widths(width, top, settings=DEFAULT_SETTINGS, seed=0):
     from ``numpy.random.default_rng(seed)``, so that the widths are spread evenly, never lie on
     the search's fixed grid, and are the same for the same seed.  Empty where ``hi <= width``.
     """
-    n = _first_runs(settings)
-    hi = min(settings.check_span * width, top)
-    if n <= 0 or not hi > width * (1.0 + settings.check_first):
-        return np.zeros(0)
-    rng = np.random.default_rng(seed)
-    n_near = int(round(settings.check_near * n))
+    from . import binned   # the binned layout's first stage is this one
 
-    def jittered(k):
-        return (np.arange(k) + rng.random(k)) / k
-
-    d_hi = hi / width - 1.0
-    near = width * (1.0 + settings.check_first * (d_hi / settings.check_first) ** jittered(n_near))
-    spread = width + (hi - width) * jittered(n - n_near)
-    return np.sort(np.concatenate([near, spread]))
+    return binned.first_widths(width, min(settings.check_span * width, top), settings, seed)
 
 
 def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTINGS, seed=0,
