@@ -1,5 +1,5 @@
 """The check above a record's search width laid out bin by bin, so that it is *separable in a
-threshold* (docs/slivers.md, "A check separable in a threshold").
+threshold* (docs/slivers.md, "The check above the search width").
 
 The span ``(w, hi]`` above the search width ``w`` (``hi = min(check_span w, top)``, ``top`` the
 no-uplift width; one span, no rounds) is cut into bins ``check_bin_width w`` wide.  Every width the check runs belongs to one bin,

@@ -371,8 +371,9 @@ DESIGN_WIDTH_COLUMNS = Columns(
                               "survives the full record (max|theta|/alpha <= `design_limit` with "
                               "`--limit`), at that width and at every larger one the search and the "
                               "check above it examined: at least every width they found to fail, "
-                              "refined just above the widest (`rocking.required_width`, rule exact, "
-                              "`.width`); with a vertical component, the wider of the horizontal "
+                              "refined just above the widest to a number of 6 significant digits "
+                              "that was run and survived, so the value printed is the width tested "
+                              "(`rocking.required_width`, rule exact, `.width`); with a vertical component, the wider of the horizontal "
                               "motion's and the one with the vertical (`design_governed_by`). "
                               "Independent of the pulse fit."),
     ("design_tan_alpha", "-", "tan(alpha) of the design width, design_width_m / height_m."),
