@@ -198,6 +198,16 @@ class SearchSettings:
             raise ValueError("SearchSettings.record_spacing must be 'geometric' or 'uniform', "
                              f"got {self.record_spacing!r}")
 
+    @property
+    def check_reach(self) -> float:
+        """How far above the search width ``w`` the check looks, over ``w`` (before the no-uplift
+        width cuts it): one span, ``check_span``, for the binned layout; ``check_span **
+        check_rounds`` for the rounds (each round's span is at most ``check_span`` times the width
+        the round before left)."""
+        if self.check_layout == "bins":
+            return float(self.check_span)
+        return float(self.check_span) ** int(self.check_rounds)
+
     def replace(self, **changes) -> "SearchSettings":
         """A copy with ``changes``; ``None`` values are ignored (keyword arguments left unset)."""
         changes = {k: v for k, v in changes.items() if v is not None}

@@ -436,7 +436,7 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
         res.method += "; with the vertical record (compiled engine, fast-vertical)"
     if limit is not None:
         res.method += f"; a width fails where max|theta|/alpha > {limit:g}"
-    reach = min(settings.check_span ** settings.check_rounds * res.width, top)
+    reach = min(settings.check_reach * res.width, top)
     binned = settings.check_layout == "bins"   # separable: it runs only above check_above itself
     if not res.below_scan and settings.check_runs > 0 and (binned or reach > settings.check_above):
         seed = settings.check_seed

@@ -39,7 +39,7 @@ def _design(rows) -> float:
 def _top(row) -> float:
     """The widest width the check of this row's direction would look at (rocking.widths)."""
     w = float(row["design_width_m"])
-    return passes._bracket_step() * min(passes.reach(DEFAULT_SETTINGS) * w,
+    return passes._bracket_step() * min(DEFAULT_SETTINGS.check_reach * w,
                                         float(row["height_m"]) * float(row["pga_g"]))
 
 

@@ -59,15 +59,6 @@ def _bracket_step() -> float:
     return (1.0 / s.record_low) ** (1.0 / (s.record_scan - 1))
 
 
-def reach(settings) -> float:
-    """How far above its search width ``w`` a direction's check looks, over ``w``: one span
-    (``check_span``) for the binned layout, ``check_span ** check_rounds`` for the rounds (each
-    round's span is at most ``check_span`` times the width the round before left)."""
-    if settings.check_layout == "bins":
-        return float(settings.check_span)
-    return float(settings.check_span) ** int(settings.check_rounds)
-
-
 def staged(task, options) -> bool:
     """Whether ``task`` is computed in passes: a direction of a pair, without ``--thorough``."""
     return task.direction is not None and not options.thorough
@@ -118,7 +109,7 @@ class Plan:
         self.options = options
         #: the check's layout is separable in a threshold: a check above a bound runs only there
         self.separable = DEFAULT_SETTINGS.check_layout == "bins"
-        self.span = reach(DEFAULT_SETTINGS)
+        self.span = DEFAULT_SETTINGS.check_reach
         self.step = _bracket_step()
         #: what a lower bound of the pair's design width is divided by to give check_above: the
         #: binned check refines its own bracket across the bound; the rounds' is allowed for here
