@@ -763,7 +763,7 @@ def _on_digits(res, top, evaluate, seen, settings):
     width ``top`` survives without a run (nothing uplifts there)."""
     if res.below_scan or not res.width > 0:
         return seen
-    x, f, r = (list(np.asarray(v)) for v in seen)
+    x, f, r = np.asarray(seen[0], dtype=float), np.asarray(seen[1], dtype=bool), np.asarray(seen[2], dtype=float)
     while True:
         w = digits_up(res.width, int(settings.design_digits))
         if w == res.width:
@@ -773,15 +773,13 @@ def _on_digits(res, top, evaluate, seen, settings):
             break
         failed, ratio = (np.asarray(v) for v in evaluate(np.array([w])))
         res.refine_runs += 1
-        x.append(w), f.append(bool(failed[0])), r.append(float(ratio[0]))
+        x, f, r = np.append(x, w), np.append(f, bool(failed[0])), np.append(r, float(ratio[0]))
         if not failed[0]:
             res.width = w
             break
-        x_, f_ = np.asarray(x, dtype=float), np.asarray(f, dtype=bool)
-        if not (x_ > w).any():          # nothing run above it: the no-uplift width survives
-            x_, f_ = np.append(x_, top), np.append(f_, False)
-        _raise_to_failures(res, evaluate, (x_, f_), settings)
-    return tuple(np.asarray(v) for v in (x, f, r))
+        # the no-uplift width survives: the bracket's end where nothing wider was run
+        _raise_to_failures(res, evaluate, (np.append(x, top), np.append(f, False)), settings)
+    return x, f, r
 
 
 #: how far below the scan's narrowest width (in halvings) the search looks for a failure
