@@ -9,7 +9,8 @@ RSN77, RSN181, RSN879, RSN1084, RSN159, RSN150, RSN250 are pulse-like, RSN6 and 
 examples' RSN179 pair too by S&B14; the first ``--pairs`` of them), one after the other in this one
 run, ``pipeline run --pair A B --directions 36 --block 7.5x1.8 --jobs J`` (38 directions) by:
 
-- the baseline, default options and ``--thorough``;
+- the baseline, default options and ``--thorough`` (where it has it: 0.4.0's default checked
+  and drew every direction, as ``--thorough`` does now, and is compared with it);
 - this version, default options (the check and the figures where they decide, pipeline/batch/passes.py);
 - this version with ``--thorough`` (every direction checked and drawn).
 
@@ -98,23 +99,42 @@ def run_one(python, pair, out, jobs, extra=(), log=False) -> dict:
     return got
 
 
+#: a column's former names, in versions compared with (0.4.0 wrote ``verified_width_m``)
+FORMER = {"design_width_m": "verified_width_m"}
+
+
+def _col(row, name):
+    return row[name] if name in row else row.get(FORMER.get(name, name), "")
+
+
 def design_width(rows) -> float:
     """The pair's design width: the widest design or failing width over its directions (m)."""
-    return max(max(float(r["design_width_m"]), float(r["widest_failing_width_m"] or 0.0)) for r in rows)
+    return max(max(float(_col(r, "design_width_m")), float(_col(r, "widest_failing_width_m") or 0.0))
+               for r in rows)
 
 
 def same_rows(a, b) -> bool:
     """Every direction's :data:`COMPARED` columns equal (as written)."""
     key = lambda r: (r.get("pair"), r["direction_deg"], r["column"])
     ra, rb = {key(r): r for r in a}, {key(r): r for r in b}
-    return ra.keys() == rb.keys() and all(ra[k][c] == rb[k][c] for k in ra for c in COMPARED)
+    return ra.keys() == rb.keys() and all(_col(ra[k], c) == _col(rb[k], c) for k in ra for c in COMPARED)
+
+
+def has_thorough(python) -> bool:
+    """Whether that version's ``pipeline run`` has ``--thorough`` (0.4.0 had not: its default
+    checked and drew every direction, which ``--thorough`` does now)."""
+    res = subprocess.run([python, "-m", "pipeline", "run", "--help"], capture_output=True, text=True,
+                         check=False, cwd=tempfile.gettempdir())
+    return "--thorough" in res.stdout
 
 
 def measure(baseline, n_pairs, jobs, share_jobs, dask, only=None) -> list[dict]:
     base_python = str(pathlib.Path(baseline) / ".venv" / "bin" / "python")
+    base_thorough = has_thorough(base_python)
     runs_of = [("baseline", base_python, (), jobs, False), ("default", sys.executable, (), jobs, True),
-               ("baseline-thorough", base_python, ("--thorough",), jobs, False),
                ("thorough", sys.executable, ("--thorough",), jobs, True)]
+    if base_thorough:
+        runs_of.append(("baseline-thorough", base_python, ("--thorough",), jobs, False))
     if share_jobs:
         runs_of.append((f"default-jobs{share_jobs}", sys.executable, (), share_jobs, True))
     if dask:
@@ -136,8 +156,8 @@ def measure(baseline, n_pairs, jobs, share_jobs, dask, only=None) -> list[dict]:
                                "exit": r["code"], "tasks": r.get("tasks"),
                                "stages_per_direction": {k: round(v / n, 4) for k, v in sorted(r["stages"].items())},
                                "checked": sum(row["check_runs"] not in ("", "0") for row in r["rows"])}
-            entry["thorough_rows_equal_baseline"] = same_rows(runs["thorough"]["rows"],
-                                                              runs["baseline-thorough"]["rows"])
+            entry["thorough_rows_equal_baseline"] = same_rows(
+                runs["thorough"]["rows"], runs["baseline-thorough" if base_thorough else "baseline"]["rows"])
             entry["default_rows_equal_baseline"] = same_rows(runs["default"]["rows"], runs["baseline"]["rows"])
             entry["default_design_equals_thorough"] = (entry["default"]["design_width"]
                                                        == entry["thorough"]["design_width"])
