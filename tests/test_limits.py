@@ -158,8 +158,11 @@ def test_pipeline_run_limit(tmp_path):
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
     assert widths["half"] >= widths["over"]
-    # the level's run computed the overturning run's design width (the same text, 6 digits)
-    assert widths["half overturning"] == f"{widths['over']:g}" and widths["over overturning"] == ""
+    # the level's run computed the overturning design where it could change the level's: here the
+    # level governs (2.158 m against 1.683 m when measured), so what it established is at most the
+    # overturning run's design width (6 digits) and the level's; blank without a level
+    assert float(widths["half overturning"]) <= min(float(f"{widths['over']:g}"), widths["half"])
+    assert widths["over overturning"] == ""
 
 
 def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
