@@ -297,15 +297,17 @@ def sensitivity(paths, heights):
 
 
 def identical(paths, heights):
-    """``--identical``: the level given its overturning design with its runs reused (``pipeline run
-    --limit``) against the same without them (every width run again): the same design width,
-    search width, widest failing width and widths checked on every case?"""
+    """``--identical``: the level given its overturning design with its runs reused against the
+    same without them (every width run again): the same design width, search width, widest
+    failing width and widths checked on every case?  And the level first, its overturning design
+    computed where it can change it (``overturning=True``, ``pipeline run --limit``): the same
+    design width as given the whole overturning design, and that design where it is wider?"""
     import dataclasses
 
     import pulses
     import rocking
 
-    same, n, shared, total, lines = 0, 0, [], [], []
+    same, same_first, n, shared, total, lines = 0, 0, 0, [], [], []
     for path in paths:
         record = pulses.read_record(str(path))
         for H in heights:
@@ -317,14 +319,21 @@ def identical(paths, heights):
                   and a.widest_failing_width == b.widest_failing_width and a.total_runs == b.total_runs
                   and np.array_equal(a.check_widths, b.check_widths)
                   and np.array_equal(a.check_failed, b.check_failed))
-            n, same = n + 1, same + ok
+            c = rocking.required_width(H, record, overturning=True, **kw)
+            first = c.width == a.width and (c.overturning_width == over.width
+                                            or c.overturning_width <= c.overturning_above)
+            n, same, same_first = n + 1, same + ok, same_first + first
             shared.append(a.shared_runs)
             total.append(a.total_runs)
             print(f"{path.stem:28s} H {H:4.1f}: {'same' if ok else 'DIFFERENT'} {a.width:.6f} "
-                  f"{b.width:.6f}; shared {a.shared_runs} of {a.total_runs}", flush=True)
+                  f"{b.width:.6f}; shared {a.shared_runs} of {a.total_runs}; the level first: "
+                  f"{'same' if first else 'DIFFERENT'} {c.width:.6f}", flush=True)
     lines.append(f"level {LEVEL} with the overturning design's runs reused against without: the same "
                  f"answer on {same} of {n} cases; widths shared median {np.median(shared):.0f} of "
                  f"{np.median(total):.0f}")
+    lines.append(f"the level first (overturning=True) against given the whole overturning design: "
+                 f"the same design width, and the same overturning design where it is wider than "
+                 f"the level's own, on {same_first} of {n} cases")
     return lines
 
 

@@ -389,12 +389,16 @@ DESIGN_WIDTH_COLUMNS = Columns(
                                 "record's vertical); blank without a vertical."),
     ("design_limit", "-", "The performance level of the design (`--limit` R: max|theta|/alpha <= R); "
                           "blank: overturning, the paper's question."),
-    ("overturning_width_m", "m", "With `--limit` R: the overturning design width of the same column "
-                                 "and record (the same search and check for not overturning; with a "
-                                 "vertical, the wider of the two motions'). The design width "
-                                 "`design_width_m` is at least it: a width that overturns fails "
-                                 "every level (docs/design.md, \"Performance levels\"). Blank without "
-                                 "`--limit`."),
+    ("overturning_width_m", "m", "With `--limit` R: the overturning design of the same column and "
+                                 "record, computed where it can change the level's (the same search, "
+                                 "its check only above the level's own design width; with a vertical, "
+                                 "the wider of the two motions'). Where it is wider than the level's "
+                                 "own width it is the overturning design width in full and "
+                                 "`design_width_m` is raised to at least it (a width that overturns "
+                                 "fails every level); where not, the level governs and this is what "
+                                 "was established: the overturning design width lies between it and "
+                                 "`design_width_m` (docs/design.md, \"Performance levels\"). Blank "
+                                 "without `--limit`."),
 )
 
 
