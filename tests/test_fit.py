@@ -30,7 +30,7 @@ from pulses.cwt import (
 )
 from pulses.synthetic import least_squares_limit, sampled_pulse, synthetic_record
 
-from .conftest import shared_record
+from .conftest import SHARED_RECORDS, shared_record
 
 SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
 TPS = (0.2, 0.5, 1.0, 2.0, 5.0)
@@ -365,6 +365,47 @@ def test_background_spectrum_leaves_out_the_pulse():
     alone = high(Background(noise, DT))
     assert high(Background(noise + misfit, DT)) > 1.3 * alone
     assert high(Background(noise + misfit, DT, skip=(7.75, 8.75))) == pytest.approx(alone, rel=0.1)
+
+
+@pytest.mark.parametrize("nseg", [16, 17, 250, 251, 500])
+def test_segment_periodograms_are_scipys_spectrogram(nseg):
+    """The background's periodograms are scipy.signal.spectrogram's (Hann, half overlap, constant
+    detrend, density), computed without importing scipy.signal.  The two differ only in the
+    rounding of the window, the mean and the scale: measured 2e-15 of each periodogram's peak
+    and 6e-13 relative on every bin above 1e-6 of it (the zero bin of a segment less its mean is
+    round-off itself); asserted at 1e-13 and 1e-11."""
+    from scipy import signal
+
+    from pulses.fit import segment_periodograms
+
+    rng = np.random.default_rng(7)
+    records = [rng.standard_normal(n) for n in (nseg, nseg + 1, 1001, 4000)]
+    records.append(synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, 0.005, noise=0.15, seed=1).acc)
+    rinaldi = SHARED_RECORDS / "Rinaldi228.AT2"
+    if rinaldi.is_file():
+        records.append(pulses.read_record(rinaldi).acc)
+    for x in records:
+        f_ref, _, p_ref = signal.spectrogram(x, fs=1.0 / 0.005, window="hann", nperseg=nseg, noverlap=nseg // 2,
+                                             detrend="constant")
+        f, p = segment_periodograms(x, 0.005, nseg)
+        assert p.shape == p_ref.shape
+        assert f == pytest.approx(f_ref, rel=1e-15, abs=0.0)
+        peak = p_ref.max(axis=0)
+        assert np.all(np.abs(p - p_ref) <= 1e-13 * peak)
+        above = p_ref[1:] > 1e-6 * peak
+        assert p[1:][above] == pytest.approx(p_ref[1:][above], rel=1e-11, abs=0.0)
+
+
+def test_a_fit_does_not_import_scipy_signal():
+    """scipy.signal (and the scipy.stats it imports) takes over a second to import cold."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np, pulses; t = np.arange(0.0, 10.0, 0.01); "
+            "rec = pulses.Record(pulses.make_pulse('sine', 5.0, 1.0, 2.0)(t) + 0.3 * np.sin(7.0 * t), 0.01); "
+            "assert pulses.fit_pulse(rec).weighting == 'background'; print('scipy.signal' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
 
 
 @pytest.mark.slow
