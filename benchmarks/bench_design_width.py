@@ -182,7 +182,10 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False,
                        w_search=over.search_width,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
                        W_over_half=half.overturning_width if level else W,
-                       solver_half=half.solver_runs, shared_half=half.shared_runs,
+                       solver_half=half.solver_runs,
+                       # widths answered from the other design's batches (either way round)
+                       shared_half=half.shared_runs + getattr(getattr(half, "overturning_design", None),
+                                                              "shared_runs", 0),
                        route=route_runs(half, over) if level else over.total_runs,
                        W_alone=alone.width, runs_alone=alone.total_runs,
                        t_over=t_over, t_half=t_half)
@@ -241,7 +244,7 @@ def table(rows, dense=True):
         f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
         f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
         f"limit {LEVEL} given W median {np.median(runs_h):.0f} (max {runs_h.max()}) widths, of which "
-        f"run: median {np.median(solver_h):.0f} (shared with the overturning design: median "
+        f"run: median {np.median(solver_h):.0f} (shared between the level and its overturning design: median "
         f"{np.median(shared_h):.0f}); the level with its overturning design (pipeline run --limit, "
         f"route_runs): "
         f"median {np.median(route):.0f} solver runs (max {route.max()}; at most the overturning "
