@@ -443,7 +443,10 @@ def _level_print(rows) -> str:
         return ""
     return (" With the level, the design width is also at least the overturning design width "
             f"(overturning_width_m, {min(over):.3f}" + (f"-{max(over):.3f}" if max(over) > min(over) else "")
-            + " m here): a width that overturns fails every level.")
+            + " m here): a width that overturns fails every level.  It is computed where it can "
+            "change the level's: where the level's own width is wider, overturning_width_m is what "
+            "its check above that width established, and the overturning design width lies between "
+            "it and the design width.")
 
 
 def columns_markdown() -> str:
