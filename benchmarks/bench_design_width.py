@@ -5,6 +5,8 @@
     python benchmarks/bench_design_width.py --sensitivity   # item 5: the check's seed, restitution
     python benchmarks/bench_design_width.py --identical     # a level reusing the overturning runs
         # against the same computed without them: the same answers?
+    python benchmarks/bench_design_width.py --level 0.2 --runs-only   # another level R; only the
+        # designs and their runs (no dense grid, no 0.5.0 search): the cost floors, ~2 min
     python benchmarks/bench_design_width.py --seeds record,1,2 --no-level --cache /tmp/dense --misses
         # the check's seed set to each ("record": the package's own); overturning only (~40 s a
         # seed once the dense grids are kept); where the misses lie
@@ -18,9 +20,10 @@ transition ``w`` (``search_width``, called the verified width before 0.5) and th
 (``top``: the no-uplift width) counts the records with a failing width more than 1 % above ``w``
 (today's answer) and more than 1 % above ``W``.  With ``limit=0.5``: the design width ``W_R`` is
 run again (``rocking.simulate``): max|theta|/alpha <= 0.5, and ``W_R >= W``, ``W_R`` as
-``pipeline run --limit`` computes it (``pipeline.batch.record.design_width``: the overturning
-design, then the level given it, reusing its runs).  Runs per design width (search + check +
-refinement) are printed for both, and the solver runs of the level with its overturning design.
+``pipeline run --limit`` computes it (``pipeline.batch.record.design_width``: the level, then its
+overturning design where it can change it: the search, the check above the level's width).  Runs
+per design width (search + check + refinement) are printed for both, and the solver runs of the
+level with its overturning design (:func:`route_runs`).  ``--level R``: another level than 0.5.
 
 ``--sensitivity``: the design width with the check's seed changed (``SearchSettings.check_seed``,
 ``SEEDS``) and with the restitution ``ETA_FACTORS`` times Eq. 5 at each width (capped at 1), for
@@ -111,7 +114,20 @@ def sliver_width(height, record, b, step):
     return (x[run].max() - x[run].min() + step / 10.0) / b if run.size else 0.0
 
 
-def measure(paths, heights, settings=None, cache=None, level=True, misses=False):
+def route_runs(level, over):
+    """Solver runs of a level's design width as ``pipeline run --limit`` computes it
+    (:func:`pipeline.batch.record.design_width`): the level's own and those of the overturning
+    design it computed (the part it computed: its search and its check above the level's width);
+    before 0.7.1 (no ``overturning_design``), the whole overturning design ``over`` first."""
+    inner = getattr(level, "overturning_design", None)
+    if inner is None:
+        return over.total_runs + level.solver_runs
+    return level.solver_runs + inner.solver_runs
+
+
+def measure(paths, heights, settings=None, cache=None, level=True, misses=False, dense=True):
+    import dataclasses
+
     import pulses
     import rocking
     from pipeline.batch.record import design_width
@@ -139,11 +155,12 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
             t_half = time.perf_counter() - t
             # the reference: the search of 0.5.0 alone (its first transition, today's search
             # width), whatever the settings measured
-            base = rocking.required_width(H, record, rule="exact", settings=BASELINE)
+            base = (rocking.required_width(H, record, rule="exact", settings=BASELINE) if dense
+                    else dataclasses.replace(over, runs=over.runs))
             w = base.search_width
             W = over.width
             top = H * record.pga / G
-            fx = dense_failures(H, record, w, top, cache)
+            fx = dense_failures(H, record, w, top, cache) if dense else np.zeros(0)
             widest = float(fx.max()) if fx.size else None
             ratio = max((rocking.simulate(rocking.Block.from_dimensions(H, h.width), record,
                                           history=False).max_rotation_ratio if level else 0.0)
@@ -165,13 +182,17 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False)
                        w_search=over.search_width,
                        W_half=half.width, ratio_half=float(ratio), runs_half=half.total_runs,
                        W_over_half=half.overturning_width if level else W,
-                       solver_half=half.solver_runs, shared_half=half.shared_runs,
+                       solver_half=half.solver_runs,
+                       # widths answered from the other design's batches (either way round)
+                       shared_half=half.shared_runs + getattr(getattr(half, "overturning_design", None),
+                                                              "shared_runs", 0),
+                       route=route_runs(half, over) if level else over.total_runs,
                        W_alone=alone.width, runs_alone=alone.total_runs,
                        t_over=t_over, t_half=t_half)
             rows.append(row)
             print(f"{path.stem:28s} H {H:4.1f}: w {w:.4f} W {W:.4f} (+{(W / w - 1) * 100:5.2f} %) "
-                  f"dense widest {'-' if widest is None else f'{widest:.4f}'} | R=0.5 {half.width:.4f} "
-                  f"ratio {ratio:.3f} | runs {over.total_runs}/{half.total_runs} "
+                  f"dense widest {'-' if widest is None else f'{widest:.4f}'} | R={LEVEL:g} {half.width:.4f} "
+                  f"ratio {ratio:.3f} | runs {over.total_runs}/{half.total_runs}/{row['route']} "
                   f"{t_over:.1f}/{t_half:.1f} s", flush=True)
     return rows
 
@@ -184,7 +205,7 @@ def _unique(rows, name):
     return sum(seen.values()), len(seen)
 
 
-def table(rows):
+def table(rows, dense=True):
     n = len(rows)
     old = sum(r["far_old"] for r in rows)
     new = sum(r["far_new"] for r in rows)
@@ -198,9 +219,10 @@ def table(rows):
     today = np.array([r["runs_today"] for r in rows])
     runs_h = np.array([r["runs_half"] for r in rows])
     solver_h = np.array([r["solver_half"] for r in rows])
+    route = np.array([r["route"] for r in rows])
     shared_h = np.array([r["shared_half"] for r in rows])
     up = np.array([r["W"] / r["w"] - 1 for r in rows]) * 100
-    return [
+    lines = [
         f"{n} cases (records x heights); dense grid {DENSE} linear widths in (w, min({SPAN:g} w, top)].",
         f"- failing widths more than 1 % above the search's answer w (today's width): {old} cases; "
         f"more than 1 % above the design width W: {new} cases",
@@ -216,15 +238,19 @@ def table(rows):
         f"{len(bad_half)} cases ({', '.join(r['record'] for r in bad_half) or 'none'}); W_R below W: "
         f"alone on {len(below_alone)}"
         + "".join(f" ({r['record']} {r['height']:g} m: {r['W_alone']:.5f} < {r['W']:.5f})" for r in below_alone)
-        + f", through pipeline run --limit's path (the overturning design, then the level given it) on {len(below)}",
+        + f", through pipeline run --limit's path (the level, then its overturning design where it can "
+        f"change it) on {len(below)}",
         f"- runs per level width alone: median {np.median(runs_a):.0f} (max {runs_a.max()})",
         f"- runs per design width: overturning median {np.median(runs):.0f} (max {runs.max()}), "
         f"today's search + check median {np.median(today):.0f} (max {today.max()}); "
         f"limit {LEVEL} given W median {np.median(runs_h):.0f} (max {runs_h.max()}) widths, of which "
-        f"run: median {np.median(solver_h):.0f} (shared with the overturning design: median "
-        f"{np.median(shared_h):.0f}); the level with its overturning design (pipeline run --limit): "
-        f"median {np.median(runs + solver_h):.0f} solver runs (max {(runs + solver_h).max()})",
+        f"run: median {np.median(solver_h):.0f} (shared between the level and its overturning design: median "
+        f"{np.median(shared_h):.0f}); the level with its overturning design (pipeline run --limit, "
+        f"route_runs): "
+        f"median {np.median(route):.0f} solver runs (max {route.max()}; at most the overturning "
+        f"design's on {int(np.sum(route <= runs))} of {n})",
     ]
+    return lines if dense else [f"{n} cases (records x heights), no dense grid (--runs-only)."] + lines[-3:]
 
 
 class _ScaledEta:
@@ -274,15 +300,17 @@ def sensitivity(paths, heights):
 
 
 def identical(paths, heights):
-    """``--identical``: the level given its overturning design with its runs reused (``pipeline run
-    --limit``) against the same without them (every width run again): the same design width,
-    search width, widest failing width and widths checked on every case?"""
+    """``--identical``: the level given its overturning design with its runs reused against the
+    same without them (every width run again): the same design width, search width, widest
+    failing width and widths checked on every case?  And the level first, its overturning design
+    computed where it can change it (``overturning=True``, ``pipeline run --limit``): the same
+    design width as given the whole overturning design, and that design where it is wider?"""
     import dataclasses
 
     import pulses
     import rocking
 
-    same, n, shared, total, lines = 0, 0, [], [], []
+    same, same_first, n, shared, total, lines = 0, 0, 0, [], [], []
     for path in paths:
         record = pulses.read_record(str(path))
         for H in heights:
@@ -294,20 +322,30 @@ def identical(paths, heights):
                   and a.widest_failing_width == b.widest_failing_width and a.total_runs == b.total_runs
                   and np.array_equal(a.check_widths, b.check_widths)
                   and np.array_equal(a.check_failed, b.check_failed))
-            n, same = n + 1, same + ok
+            c = rocking.required_width(H, record, overturning=True, **kw)
+            first = c.width == a.width and (c.overturning_width == over.width
+                                            or c.overturning_width <= c.overturning_above)
+            n, same, same_first = n + 1, same + ok, same_first + first
             shared.append(a.shared_runs)
             total.append(a.total_runs)
             print(f"{path.stem:28s} H {H:4.1f}: {'same' if ok else 'DIFFERENT'} {a.width:.6f} "
-                  f"{b.width:.6f}; shared {a.shared_runs} of {a.total_runs}", flush=True)
+                  f"{b.width:.6f}; shared {a.shared_runs} of {a.total_runs}; the level first: "
+                  f"{'same' if first else 'DIFFERENT'} {c.width:.6f}", flush=True)
     lines.append(f"level {LEVEL} with the overturning design's runs reused against without: the same "
                  f"answer on {same} of {n} cases; widths shared median {np.median(shared):.0f} of "
                  f"{np.median(total):.0f}")
+    lines.append(f"the level first (overturning=True) against given the whole overturning design: "
+                 f"the same design width, and the same overturning design where it is wider than "
+                 f"the level's own, on {same_first} of {n} cases")
     return lines
 
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     heights = HEIGHTS
+    global LEVEL
+    if "--level" in argv:          # the performance level R measured (default 0.5)
+        LEVEL = float(argv[argv.index("--level") + 1])
     if "--heights" in argv:
         heights = tuple(float(h) for h in argv[argv.index("--heights") + 1].split(","))
     if not SHARED.is_dir():
@@ -341,8 +379,9 @@ def main(argv=None):
         if len(seeds) > 1 or seed is not None:
             print(f"check seed {'record' if seed is None else seed}:")
         rows = measure(paths, heights, settings.replace(check_seed=seed), cache=cache,
-                       level="--no-level" not in argv, misses="--misses" in argv)
-        print("\n".join(table(rows)), flush=True)
+                       level="--no-level" not in argv, misses="--misses" in argv,
+                       dense="--runs-only" not in argv)
+        print("\n".join(table(rows, "--runs-only" not in argv)), flush=True)
     return 0
 
 

@@ -91,11 +91,21 @@ class RequiredWidth:
     vertical_width: float | None = None
     #: with a vertical record: the answer of the other motion, whole (a RequiredWidth)
     other: "RequiredWidth | None" = field(default=None, repr=False, compare=False)
-    #: a level designed given its overturning design (``overturning=``): that design's width (m;
-    #: with a vertical, the wider of the two motions'); :attr:`width` is at least it
+    #: a level designed with its overturning design (``overturning=``): that design's width (m;
+    #: with a vertical, the wider of the two motions'); :attr:`width` is at least it.  With
+    #: ``overturning=True`` that design is checked only above the level's own design width
+    #: (:attr:`overturning_above`): where it is wider it is the whole overturning design width,
+    #: and where not, the whole one lies between it and :attr:`overturning_above`
     overturning_width: float | None = None
+    #: ``overturning=True``: the level's own design width (m) above which its overturning design
+    #: was checked (None where a whole overturning design was given, or without a level)
+    overturning_above: float | None = None
+    #: ``overturning=True``: that overturning design (its search, its check above
+    #: :attr:`overturning_above`), with its own runs (:attr:`solver_runs`, on top of this one's)
+    overturning_design: "RequiredWidth | None" = field(default=None, repr=False, compare=False)
     #: widths of :attr:`total_runs` that the overturning design had run in the same batch (same
-    #: column, record and solver: the same computation), answered from it, not run again
+    #: column, record and solver: the same computation), answered from it, not run again (with
+    #: ``overturning=True``, the overturning design answers from the level's batches as well)
     shared_runs: int = 0
     #: a record's overturning design: every batch it ran, in order, as ``(widths, overturned,
     #: max|theta|/alpha)`` arrays (a level given this design reuses the same batches)
@@ -187,13 +197,13 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     eta : float, optional
         Restitution for the exact rule (default Eq. 5 at each width).
     limit : float, optional
-        ``rule="exact"``: the performance level R in (0, 1]: the design keeps
-        ``max|theta|/alpha <= R`` (a width fails where it exceeds R or the column overturns);
-        None (default): overturning, the paper's question (docs/design.md, "Performance levels").
-    overturning : RequiredWidth, optional
-        With ``limit`` under a record: its overturning design (same column, record and ``vertical``;
-        with one, :func:`governing`'s answer); the level with each motion is at least that
-        motion's overturning width, reusing its runs (docs/design.md, "Performance levels").
+        ``rule="exact"``: the performance level R in (0, 1]: the design keeps ``max|theta|/alpha
+        <= R`` (a width fails where it exceeds R or the column overturns); None (default):
+        overturning, the paper's question.
+    overturning : RequiredWidth or True, optional
+        With ``limit`` under a record: its overturning design (same column, record, ``vertical``),
+        or True: computed where it can change the level's (search, check above the level's width);
+        the level with each motion is at least its overturning width (docs/design.md, "Performance levels").
     shape, lam : str (optional), float
         ``rule="envelope"``: the shape whose factor to use (default every shape); Eq. 20's lambda.
     n_scan, n_zone, rtol : int, int, float, optional
@@ -275,22 +285,28 @@ def _check_arguments(height, rule, overturning, limit, vertical, excitation) -> 
         raise ValueError(f"height must be positive, got {height!r} m")
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
+    given = overturning is not None and overturning is not True
     if overturning is not None and (rule != "exact" or limit is None
-                                    or overturning.limit is not None
-                                    or (vertical is None) != (overturning.governed_by is None)
+                                    or (given and overturning.limit is not None)
+                                    or (given and (vertical is None) != (overturning.governed_by is None))
                                     or getattr(excitation, "shape", "record") in SHAPES):
-        raise ValueError("overturning= goes with rule='exact' under a record and a limit: the "
-                         "overturning design (limit=None) of the same column and record, with the "
-                         "vertical where vertical= is given (and only there)")
+        raise ValueError("overturning= goes with rule='exact' under a record and a limit: True, or "
+                         "the overturning design (limit=None) of the same column and record, with "
+                         "the vertical where vertical= is given (and only there)")
     return height
 
 
 def _motions(overturning, horizontal):
     """The overturning designs ``(horizontal motion alone, with the vertical)`` of a
-    :func:`governing` answer (``(None, None)`` without one); ValueError where ``horizontal`` (the
-    level's horizontal answer) was not designed given the same horizontal overturning design."""
+    :func:`governing` answer (``(None, None)`` without one, ``(True, True)`` for True); ValueError
+    where ``horizontal`` (the level's horizontal answer) was not designed given the same."""
     if overturning is None:
         return None, None
+    if overturning is True:
+        if horizontal is not None and horizontal.overturning_above is None:
+            raise ValueError("horizontal= with overturning=True: the level's horizontal answer "
+                             "designed with overturning=True too")
+        return True, True
     pair = (overturning, overturning.other)
     over_h, over_v = pair if overturning.governed_by == "horizontal" else pair[::-1]
     if horizontal is not None and horizontal.overturning_width != over_h.width:
@@ -356,7 +372,7 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
         inputs = (searches.digest(excitation.acc), float(excitation.dt),
                   None if vertical is None else (searches.digest(vertical.acc), float(vertical.dt)),
                   float(height), eta, float(gamma), model)
-        runs = _Runs(run_widths, overturning, inputs)
+        runs = _Runs(run_widths, None if overturning is True else overturning, inputs)
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
         res = _record_design(height, excitation, top, runs, criterion=criterion, eta=eta,
                              gamma=gamma, limit=limit, model=model, vertical=vertical,
@@ -386,14 +402,19 @@ class _Runs:
     at either end of their bisections where they meet."""
 
     def __init__(self, run_widths, overturning, inputs):
-        self.run_widths, self.shared = run_widths, 0
+        self.run_widths, self.shared, self.inputs = run_widths, 0, inputs
         self.known = {}
         if overturning is not None and overturning.outcomes is not None:
             if overturning.inputs != inputs:
                 raise ValueError("overturning= is the design of another record, vertical, column "
                                  "or model: the overturning design of the same ones")
-            self.known = {x.tobytes(): (o, r) for x, o, r in overturning.outcomes}
+            self.share(overturning.outcomes)
         self.log = []
+
+    def share(self, batches):
+        """Answer from now on each of ``batches`` (``(widths, overturned, max|theta|/alpha)``, run
+        for the same inputs) from it where the same widths come again in the same order."""
+        self.known.update((x.tobytes(), (o, r)) for x, o, r in batches)
 
     def outcomes(self, widths):
         widths = np.ascontiguousarray(widths, dtype=float)
@@ -412,7 +433,8 @@ class _Runs:
 def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limit, model, vertical,
                    settings, overturning):
     """The design width under a record: the search (kept between calls, :mod:`rocking.searches`),
-    the check above it, and with ``overturning`` at least that design's width."""
+    the check above it, and with ``overturning`` (a design, or True: :func:`_overturning_above`)
+    at least that design's width."""
     def evaluate_record(widths):
         # max|theta|/alpha over the level (1 for overturning): the search's and the check's
         # "near failure" thresholds then hold for any level
@@ -444,6 +466,9 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
             seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
         check = _check_bins if binned else _check_rounds
         seen = check(res, top, evaluate_record, settings, seed, seen)
+    if overturning is True:
+        overturning = _overturning_above(res, height, excitation, top, runs, eta=eta, gamma=gamma,
+                                         model=model, vertical=vertical, settings=settings)
     if overturning is not None:
         res.overturning_width = float(overturning.width)
         if overturning.width > res.width:
@@ -644,6 +669,28 @@ def _store_check(res, checked, seen, hi, method) -> None:
     res.method = method + (f"; design width {res.width:.6g} m, just above the widest "
                            f"failing width {res.widest_failing_width:.6g} m"
                            if res.widest_failing_width else "")
+
+
+def _overturning_above(res, height, excitation, top, runs, *, eta, gamma, model, vertical,
+                       settings):
+    """The overturning design of the level ``res`` (its search and check done, ``runs`` its runs)
+    where it can change the level's answer: its search (answered from the level's batches where
+    they coincide: the geometric scan), and its binned check only above the level's width
+    (``check_above``).  That check is separable in a threshold (:mod:`rocking.binned`): it runs
+    exactly the whole check's widths above it, so the design width is the whole overturning
+    design's wherever that exceeds the level's, and at most the level's where not (then the
+    whole one is too: docs/design.md, "Performance levels").  The rounds layout, not separable,
+    is checked whole.  Sets ``res.overturning_above`` and ``res.overturning_design``."""
+    own = _Runs(runs.run_widths, None, runs.inputs)
+    own.share(runs.log)
+    if settings.check_layout == "bins":
+        settings = settings.replace(check_above=max(float(settings.check_above), float(res.width)))
+    over = _record_design(height, excitation, top, own, criterion="overturn", eta=eta, gamma=gamma,
+                          limit=None, model=model, vertical=vertical, settings=settings,
+                          overturning=None)
+    runs.share(over.outcomes)   # the level's run at its width and a bisection above: maybe run there
+    res.overturning_above, res.overturning_design = float(res.width), over
+    return over
 
 
 def _at_least(res, overturning, evaluate, seen, settings) -> None:

@@ -158,8 +158,11 @@ def test_pipeline_run_limit(tmp_path):
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
     assert widths["half"] >= widths["over"]
-    # the level's run computed the overturning run's design width (the same text, 6 digits)
-    assert widths["half overturning"] == f"{widths['over']:g}" and widths["over overturning"] == ""
+    # the level's run computed the overturning design where it could change the level's: here the
+    # level governs (2.158 m against 1.683 m when measured), so what it established is at most the
+    # overturning run's design width (6 digits) and the level's; blank without a level
+    assert float(widths["half overturning"]) <= min(float(f"{widths['over']:g}"), widths["half"])
+    assert widths["over overturning"] == ""
 
 
 def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
@@ -183,14 +186,17 @@ def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
 
 
 def test_level_given_the_overturning_design_is_at_least_it():
-    """Kern County, Taft 021 (real, 6 m), check seed 7: the level 0.5's own design (0.5519 m when
-    measured) fell below the overturning design (0.5525 m: its check found an overturning sliver
+    """Kern County, Taft 021 (real, 6 m), check seed 3: the level 0.5's own design (0.560261 m when
+    measured) falls below the overturning design (0.560393 m: its check found an overturning sliver
     the level's check, with other widths, did not sample).  Given the overturning design, the
     level's width is at least it by construction (a width that overturns fails every level), it
     keeps max|theta|/alpha <= 0.5 under the record (an independent run), and it cost at most a
-    bisection more than the level alone."""
+    bisection more than the level alone.  With ``overturning=True`` (the level first, then the
+    overturning design where it can change it: ``pipeline run --limit``'s route) the answer is
+    the same, the overturning design computed inside is the independent one where it governs,
+    and the whole costs fewer solver runs than the overturning design followed by the level."""
     rec = pulses.read_record(shared_record("RSN15_KERN_TAF021.AT2"))
-    s = DEFAULT_SETTINGS.replace(check_seed=7)
+    s = DEFAULT_SETTINGS.replace(check_seed=3)
     over = rocking.required_width(6.0, rec, rule="exact", settings=s)
     alone = rocking.required_width(6.0, rec, rule="exact", limit=0.5, settings=s)
     given = rocking.required_width(6.0, rec, rule="exact", limit=0.5, settings=s, overturning=over)
@@ -203,6 +209,30 @@ def test_level_given_the_overturning_design_is_at_least_it():
     assert given.total_runs - alone.total_runs <= 1 + 20
     if alone.width >= over.width:                       # nothing to add: the same answer
         assert given.width == alone.width
+    # the level first: the overturning design's check above the level's width (separable) finds
+    # what the whole check finds there, so where it governs it is the same design, bit for bit
+    first = rocking.required_width(6.0, rec, rule="exact", limit=0.5, settings=s, overturning=True)
+    inner = first.overturning_design
+    assert first.overturning_above == pytest.approx(alone.width, rel=1e-5)  # before its 6 digits
+    assert (first.width, first.widest_failing_width) == (given.width, given.widest_failing_width)
+    if over.width > first.overturning_above:            # it governs (seed 3 when measured)
+        assert first.overturning_width == over.width == inner.width
+        assert inner.search_width == over.search_width and inner.check_runs < over.check_runs
+    assert first.solver_runs + inner.solver_runs < over.total_runs + given.solver_runs
+
+
+def test_overturning_true_goes_with_a_level_under_a_record_only():
+    """``overturning=True`` needs a level under a record; a horizontal answer given with it must
+    have been designed with it too (one-line errors)."""
+    rec = pulses.Record(np.sin(np.linspace(0, 20, 2000)) * 3.0, 0.01)
+    for kw in (dict(limit=None), dict(limit=0.5, rule="eq31")):
+        rule = kw.pop("rule", "exact")
+        with pytest.raises(ValueError, match="overturning="):
+            rocking.required_width(7.5, rec, rule=rule, overturning=True, **kw)
+    up = pulses.Record(np.zeros(2000), 0.01)
+    with pytest.raises(ValueError, match="horizontal="):
+        rocking.required_width(7.5, rec, rule="exact", limit=0.5, vertical=up, overturning=True,
+                               horizontal=rocking.RequiredWidth(0.5, 7.5, "exact", 0, "test", limit=0.5))
 
 
 @pytest.mark.parametrize("kw", [dict(limit=None), dict(limit=0.5, rule="eq31"),
@@ -260,8 +290,10 @@ def test_level_with_the_vertical_at_least_each_overturning_design():
     """With a vertical (the PEER download's Pacoima Dam 254 and its vertical, 7.5 m), as
     `pipeline run --limit 0.5` computes it (pipeline.batch.record.design_width): the level with
     the vertical is at least the overturning design with it, the horizontal level at least the
-    horizontal one; the reported overturning width is the governing overturning design's; the
-    design width keeps max|theta|/alpha <= 0.5 with and without the vertical (independent runs)."""
+    horizontal one (each computed apart); each motion's overturning design, checked above that
+    motion's level width, is the one computed apart where it is wider than that width, and the
+    reported overturning width is the wider of the two; the design width keeps max|theta|/alpha
+    <= 0.5 with and without the vertical (independent runs)."""
     from pipeline.batch.record import design_width
 
     if not DOWNLOAD.is_dir():
@@ -271,7 +303,18 @@ def test_level_with_the_vertical_at_least_each_overturning_design():
     level = design_width(h2, up, 7.5, 0.0, 0.5, DEFAULT_SETTINGS)
     over_h = rocking.required_width(7.5, h2, rule="exact")
     over = rocking.required_width(7.5, h2, rule="exact", vertical=up, horizontal=over_h)
-    assert level.overturning_width == over.width
+    # each motion's overturning design, checked above that motion's level width: the independent
+    # one where it is wider than that width, at most it otherwise (then the level governs)
+    def motions(res):       # (horizontal motion alone, with the vertical)
+        return (res, res.other) if res.governed_by == "horizontal" else (res.other, res)
+
+    for mine, ref in zip(motions(level), motions(over)):
+        inner = mine.overturning_design
+        if inner.width > mine.overturning_above:
+            assert inner.width == ref.width
+        else:
+            assert inner.width <= ref.width <= mine.width
+    assert level.overturning_width == max(m.overturning_design.width for m in (level, level.other))
     assert level.horizontal_width >= over.horizontal_width
     assert level.vertical_width >= over.vertical_width
     assert level.width == max(level.horizontal_width, level.vertical_width) >= over.width
@@ -292,11 +335,13 @@ def test_level_with_the_vertical_at_least_each_overturning_design():
 
 @pytest.mark.slow
 def test_pipeline_design_limit_is_at_least_the_overturning_design():
-    """`pipeline.design(..., limit=0.5)` on Kern County, Taft 021 (real, 6 m; the case whose level
-    alone fell below its overturning design): design.csv and summary.csv carry the overturning
-    design width, equal to `rocking.required_width` without a limit (to the reports' 6
-    significant digits); the design width is at least it and keeps max|theta|/alpha <= 0.5 under
-    the record (an independent run at the reported width)."""
+    """`pipeline.design(..., limit=0.5)` on Kern County, Taft 021 (real, 6 m; a case whose level
+    alone fell below its overturning design with another check seed): the design width is at
+    least the overturning design width of `rocking.required_width` without a limit (computed
+    apart), and keeps max|theta|/alpha <= 0.5 under the record (an independent run at the
+    reported width); design.csv and summary.csv carry what the run established of the overturning
+    design (its check above the level's width): at most the design width, and here, where the
+    level governs, at most the overturning design width too (to the reports' 6 digits)."""
     import pipeline
 
     path = shared_record("RSN15_KERN_TAF021.AT2")
@@ -305,8 +350,10 @@ def test_pipeline_design_limit_is_at_least_the_overturning_design():
     over = rocking.required_width(6.0, rec, rule="exact")
     for table in (run.design, run.summary):
         row = table.iloc[0]
-        assert float(row["overturning_width_m"]) == pytest.approx(over.width, rel=1e-6)
+        assert float(row["design_width_m"]) >= over.width
         assert float(row["design_width_m"]) >= float(row["overturning_width_m"])
+        if float(row["overturning_width_m"]) < float(row["design_width_m"]):   # the level governs
+            assert float(row["overturning_width_m"]) <= over.width * (1 + 1e-6)
     toppled, ratio = _ratio(6.0, float(run.design.iloc[0]["design_width_m"]), rec)
     assert not toppled and ratio <= 0.5
     # without a level the column is blank

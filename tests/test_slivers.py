@@ -276,11 +276,12 @@ def test_the_printed_design_width_is_a_width_that_survived():
 
 @pytest.mark.slow
 def test_the_printed_level_width_keeps_the_level_on_a_real_record():
-    """Kern Taft 021 at 6 m, level 0.5 given the overturning design (pipeline run --limit's
-    path): bisected to 1e-6 alone, the design width lay 0.36 um above a failing width
-    (0.5557753720 against 0.5557750122 m), and its 6-digit print, 0.555775 m, reached max
-    theta/alpha 0.715; now 0.555776 m (0.30)."""
+    """Kern Taft 021 at 6 m, level 0.5 given the overturning design, and with it computed where it
+    can change the level's (``overturning=True``, pipeline run --limit's path): bisected to 1e-6
+    alone, the design width lay 0.36 um above a failing width (0.5557753720 against 0.5557750122
+    m), and its 6-digit print, 0.555775 m, reached max theta/alpha 0.715; now 0.555776 m (0.30)."""
     record = pulses.read_record(shared_record("RSN15_KERN_TAF021.AT2"))
     over = _printed_width_is_safe(6.0, record)
-    w = _printed_width_is_safe(6.0, record, limit=0.5, overturning=over)
-    assert w.width >= over.width
+    for overturning in (over, True):
+        w = _printed_width_is_safe(6.0, record, limit=0.5, overturning=overturning)
+        assert w.width >= over.width

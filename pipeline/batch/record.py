@@ -389,12 +389,16 @@ DESIGN_WIDTH_COLUMNS = Columns(
                                 "record's vertical); blank without a vertical."),
     ("design_limit", "-", "The performance level of the design (`--limit` R: max|theta|/alpha <= R); "
                           "blank: overturning, the paper's question."),
-    ("overturning_width_m", "m", "With `--limit` R: the overturning design width of the same column "
-                                 "and record (the same search and check for not overturning; with a "
-                                 "vertical, the wider of the two motions'). The design width "
-                                 "`design_width_m` is at least it: a width that overturns fails "
-                                 "every level (docs/design.md, \"Performance levels\"). Blank without "
-                                 "`--limit`."),
+    ("overturning_width_m", "m", "With `--limit` R: the overturning design of the same column and "
+                                 "record, computed where it can change the level's (the same search, "
+                                 "its check only above the level's own design width; with a vertical, "
+                                 "the wider of the two motions'). Where it is wider than the level's "
+                                 "own width it is the overturning design width in full and "
+                                 "`design_width_m` is raised to at least it (a width that overturns "
+                                 "fails every level); where not, the level governs and this is what "
+                                 "was established: the overturning design width lies between it and "
+                                 "`design_width_m` (docs/design.md, \"Performance levels\"). Blank "
+                                 "without `--limit`."),
 )
 
 
@@ -543,17 +547,15 @@ def _process(task: Task):
 def design_width(record, up, height, cap_mass_ratio, limit, settings):
     """The design width of a column ``height`` (m) tall under ``record`` (with its vertical ``up``
     where there is one, :func:`pipeline.batch.vertical.design`).  With a level ``limit``: the
-    overturning design first (a width that overturns fails every level), then the level's given
-    it (``rocking.required_width(..., overturning=)``: at least its width with each motion, and
-    the widths it ran not run again); ``.overturning_width`` is its width."""
+    level's design first, then the overturning design where it can change it (a width that
+    overturns fails every level; ``rocking.required_width(..., overturning=True)``: its search, its
+    check above the level's width), the level with each motion at least that motion's
+    overturning width; ``.overturning_width`` is that design's width."""
     import rocking
 
     kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings)
-    over = over_h = None
-    if limit is not None:
-        over_h = _stage("verify", rocking.required_width, height, record, **kw)
-        over = _stage("verify", vertical.design, record, up, height, over_h, cap_mass_ratio)
-    alone = _stage("verify", rocking.required_width, height, record, limit=limit, overturning=over_h, **kw)
+    over = None if limit is None else True
+    alone = _stage("verify", rocking.required_width, height, record, limit=limit, overturning=over, **kw)
     return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over)
 
 

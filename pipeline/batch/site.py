@@ -179,10 +179,10 @@ def add_options(parser) -> None:
     parser.add_argument("--limit", metavar="R", default=None,
                         help="performance level: design widths for max|theta|/alpha <= R and "
                              "critical scales at which it first exceeds R, 0 < R <= 1 (default: "
-                             "overturning). Each column is designed for overturning too "
-                             "(overturning_width_m), and its design width is at least that one: "
-                             "a width that overturns fails every level (about 3,900 solver runs "
-                             "a width, twice the level's alone; docs/design.md)")
+                             "overturning). Each column's design width is at least its "
+                             "overturning design width, computed where it can change the level's "
+                             "(overturning_width_m): a width that overturns fails every level "
+                             "(about as many solver runs as an overturning design; docs/design.md)")
 
 
 def _number(text, what, lo, hi) -> float:

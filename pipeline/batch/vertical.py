@@ -147,8 +147,9 @@ def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overt
     """The design width of a column ``height`` (m) tall: ``horizontal`` (the horizontal motion's
     answer) where there is no vertical or it reaches -g, else the wider of it and the answer with
     the vertical (``rocking.required_width(..., vertical=)``, ``governed_by`` set); with a level,
-    ``overturning``: the overturning design this function gave (the level with each motion is at
-    least the overturning design with it)."""
+    ``overturning``: True (each motion's overturning design where it can change the level's: the
+    level with each motion is at least the overturning design with it), as ``horizontal`` was
+    designed, or the overturning design this function gave."""
     import numpy as np
 
     import rocking

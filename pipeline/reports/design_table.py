@@ -54,9 +54,11 @@ DESIGN_COLUMNS = Columns(
     ("design_governed_by", "-", "`horizontal` or `with vertical`: which motion sets the design width "
                                 "(blank without a vertical)."),
     ("design_limit", "-", "`--limit` R (max|theta|/alpha <= R); blank: overturning."),
-    ("overturning_width_m", "m", "With `--limit`: the overturning design width (for a pair: the widest "
-                                 "over its directions); the design width is at least it (a width that "
-                                 "overturns fails every level). Blank without `--limit`."),
+    ("overturning_width_m", "m", "With `--limit`: the overturning design width where it can change the "
+                                 "level's, as in summary.csv (for a pair: the widest over its "
+                                 "directions); the design width is at least it, and at least the "
+                                 "overturning design width in full (a width that overturns fails "
+                                 "every level). Blank without `--limit`."),
     ("eq31_below_design", "-", "The Eq. 31 width is below the design width (Eq. 31 is not conservative "
                                "for this record)."),
     ("verdict", "-", "The column as it stands: `survives`, `NO` (overturns; with `--limit`, exceeds "
@@ -441,7 +443,10 @@ def _level_print(rows) -> str:
         return ""
     return (" With the level, the design width is also at least the overturning design width "
             f"(overturning_width_m, {min(over):.3f}" + (f"-{max(over):.3f}" if max(over) > min(over) else "")
-            + " m here): a width that overturns fails every level.")
+            + " m here): a width that overturns fails every level.  It is computed where it can "
+            "change the level's: where the level's own width is wider, overturning_width_m is what "
+            "its check above that width established, and the overturning design width lies between "
+            "it and the design width.")
 
 
 def columns_markdown() -> str:
