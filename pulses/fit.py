@@ -49,7 +49,7 @@ from scipy import fft as sfft
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
 from .cwt import Matcher, _dot, unit_energy
-from .lsq import baseline_projector, levenberg_marquardt, normal_equations
+from .lsq import baseline_projector, levenberg_marquardt, pulse_normal_equations
 from .record import G, Record
 from .shapes import SHAPES, Pulse, make_pulse, shape_class
 from .weighted import WeightedWindow
@@ -456,7 +456,7 @@ def _plain_scores(x, fits, energy) -> dict:
 
 def _score(x, t, dt, shape, trial, energy):
     """Share of the record's energy a refined ``(ap, Tp, t0, window)`` explains, and its samples."""
-    p = trial[0] * unit_samples(shape, trial[1], trial[2], t, dt)
+    p = trial[0] * shape_class(shape).sampled_on_grid(trial[1], trial[2], t, dt)
     r = x - p
     return 1.0 - _dot(r, r) / energy, p
 
@@ -539,7 +539,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         return slice(i0, i1)
 
     best = (ap0, tp0, t00, None)
-    if shape_class(shape).boxcar:
+    cls = shape_class(shape)
+    if cls.boxcar:
         return _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00)
     ap, tp, t0 = ap0, tp0, t00
     for _ in range(3):  # refit when the pulse moved outside the window of the previous pass
@@ -549,15 +550,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         tw, xw = t[idx], x[idx]
         project = baseline_projector(tw, baseline)
         xp = project(xw)
-
-        def residual_and_jacobian(p):
-            m, d_tp, d_t0 = unit_samples_and_derivatives(shape, max(p[1], 1e-9), p[2], tw, dt)
-            cols = project(np.stack((m, d_tp, d_t0)))
-            cols[1:] *= p[0]
-            return xp - p[0] * cols[0], -cols.T
-
         try:
-            p_new, cost = levenberg_marquardt(normal_equations(residual_and_jacobian), np.array([ap, tp, t0]),
+            p_new, cost = levenberg_marquardt(pulse_normal_equations(cls, xp, tw, dt, baseline), np.array([ap, tp, t0]),
                                               scale=np.array([abs(ap) or 1.0, tp, tp]),
                                               lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
                                               upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
@@ -567,7 +561,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         if not all(map(math.isfinite, (ap_new, tp_new, t0_new))) or tp_new <= 2 * dt:
             break
         # accept when it beats the starting (Tp, t0) on this window's own objective
-        m0 = project(unit_samples(shape, tp, t0, tw, dt))
+        m0 = project(cls.sampled_on_grid(tp, t0, tw, dt))
         start_sse = _dot(xp, xp) - _dot(m0, xp) ** 2 / max(_dot(m0, m0), 1e-300)
         if cost > start_sse * (1 + 1e-12):
             break

@@ -3,6 +3,8 @@
 - :func:`levenberg_marquardt`: minimise a sum of squares of a few unknowns (three: ``ap``, ``Tp``,
   ``t0``) inside a box, from the normal equations the caller computes;
 - :func:`normal_equations`: those normal equations from a residual and its Jacobian;
+- :func:`pulse_normal_equations`: the same for a pulse of one shape on a window of a record,
+  the baseline projected out, its products formed on the pulse's support;
 - :func:`baseline_projector`: the removal of a straight-line baseline ``c0 + c1 (t - tc)`` from
   samples, which fits the baseline alongside a pulse (variable projection).
 
@@ -14,6 +16,12 @@ from __future__ import annotations
 import numpy as np
 
 from .cwt import _dot
+
+#: :func:`pulse_normal_equations` takes the sum of squares of the residual from its products with
+#: the record, ``xp'xp - 2 ap m'P xp + ap^2 m'P m``, which loses ``xp'xp / r'r`` of its relative
+#: precision to cancellation: where that would be more than 1e4 (a relative 1e-12, a thousandth
+#: of the step the descent stops on, ``ftol``), from the residual itself
+COST_EXPLICIT = 1e-4
 
 
 def baseline_projector(tw, baseline: bool):
@@ -70,6 +78,70 @@ def normal_equations(residual_and_jacobian):
     return normal
 
 
+def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
+    """The normal equations of the plain least squares of a pulse of one shape on a window of a
+    record, a straight-line baseline fitted alongside (projected out), for :func:`levenberg_marquardt`.
+
+    Parameters
+    ----------
+    cls : type
+        The shape's class (:func:`pulses.shape_class`): its ``support_columns``.
+    xp : ndarray, shape (n,)
+        The record's samples in the window, the baseline projected out (:func:`baseline_projector`).
+    tw : ndarray, shape (n,)
+        Their times, s (uniform, step ``dt``).
+    dt : float
+        Sampling step, s.
+    baseline : bool
+        Whether the baseline is fitted (else nothing is projected out).
+
+    Returns
+    -------
+    callable
+        ``p -> (||r||^2, J'J, J'r)`` at ``p = (ap, Tp, t0)`` (record units, s, s), with
+        ``r = xp - ap P m`` the residual, ``m`` the unit pulse sampled on ``tw``, ``P`` the
+        projector of :func:`baseline_projector` and ``J = dr/dp``: :func:`normal_equations` of that
+        residual and Jacobian, to round-off.
+
+    Notes
+    -----
+    ``P`` is the orthogonal projector on the complement of ``1`` and ``t - tc``, so with ``C`` the
+    unit pulse and its derivatives (rows), ``s`` their sums and ``q`` their products with
+    ``t - tc``, ``(P C)(P C)' = C C' - s s' / n - q q' / ||t - tc||^2``, and ``(P C) r = C r``
+    (``r`` lies in P's range): both need ``C`` on the pulse's support only, where it is not zero.
+    The residual itself is formed on the whole window, so that its sum of squares keeps its
+    relative precision when the pulse explains nearly all of the record.
+    """
+    n = tw.size
+    ramp = tw - float(tw.mean())
+    ramp_norm = _dot(ramp, ramp) or 1.0
+    xx = _dot(xp, xp)
+    # the columns the unit pulse and its derivatives are multiplied with, in one product
+    others = np.stack((xp, np.ones(n), ramp)) if baseline else xp[None]
+
+    def normal(p):
+        a, tp, t0 = float(p[0]), max(float(p[1]), 1e-9), float(p[2])
+        k, C = cls.support_columns(tp, t0, tw, dt)
+        products = np.einsum("ik,jk->ij", C, np.concatenate((C, others[:, k])))
+        G, cx = products[:, :3], products[:, 3]
+        if baseline:
+            s, q = products[:, 4], products[:, 5]
+            G = G - (np.outer(s, s / n) + np.outer(q, q / ramp_norm))
+        cr = cx - a * G[:, 0]  # C r = C xp - a (P C) m, r lying in P's range
+        cost = xx - a * (cx[0] + cr[0])
+        if cost < COST_EXPLICIT * xx:  # little left of the record: the sum of squares from r itself
+            pm = np.zeros(n)
+            pm[k] = C[0]
+            if baseline:
+                pm -= s[0] / n + ramp * (q[0] / ramp_norm)
+            r = xp - a * pm
+            cost = _dot(r, r)
+        d = np.array([1.0, a, a])  # the derivatives' columns of J scale with the amplitude
+        return cost, G * np.outer(d, d), -d * cr
+
+    return normal
+
+
 def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, max_iter=100,
                         max_calls=None):
     """Minimise a sum of squares ``||r(p)||^2`` by Levenberg-Marquardt with Marquardt's scaling.
@@ -115,15 +187,19 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
     cost, A, g = normal(p)
     calls = 1
     lam = 1e-3
+    step_tol = xtol * scale
+    on_diagonal = np.diag_indices(len(p))
     for _ in range(max_iter):
-        diag = np.diag(A).copy()
-        diag[diag <= 0] = 1.0
+        diag = np.diag(A)
+        diag = np.where(diag <= 0, 1.0, diag)
         while True:
-            step = np.linalg.solve(A + lam * np.diag(diag), -g)
+            damped = A.copy()
+            damped[on_diagonal] += lam * diag
+            step = np.linalg.solve(damped, -g)
             trial = p + step
             if max_calls is not None and calls >= max_calls:
                 return p, cost
-            if np.all(trial >= lower) and np.all(trial <= upper):
+            if (trial >= lower).all() and (trial <= upper).all():
                 cost_trial, A_trial, g_trial = normal(trial)
                 calls += 1
             else:
@@ -134,7 +210,7 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
             lam *= 4.0
             if lam > 1e12:
                 return p, cost
-        small_step = bool(np.all(np.abs(step) <= xtol * scale))
+        small_step = bool((np.abs(step) <= step_tol).all())
         small_gain = cost - cost_trial <= ftol * cost
         p, cost, A, g = trial, cost_trial, A_trial, g_trial
         if small_step or small_gain:

@@ -135,6 +135,7 @@ class WeightedWindow:
 
     def __init__(self, cls, xw, tw, dt, weights, baseline, tp):
         self.cls, self.tw, self.dt, self.baseline = cls, tw, dt, baseline
+        self.t_first = float(tw[0])
         self.nfft = nfft = sfft.next_fast_len(tw.size, real=True)
         self.w = w = weights(nfft)
         X = sfft.rfft(xw, nfft)
@@ -159,10 +160,7 @@ class WeightedWindow:
 
     def support(self, tp_, t0_):
         """Slice of the window's samples where the pulse ``(tp_, t0_)`` (s) may be non-zero."""
-        tw, dt = self.tw, self.dt
-        a = max(0, int(math.floor((t0_ + self.sup_lo * tp_ - tw[0]) / dt)) - 1)
-        b = min(tw.size, int(math.ceil((t0_ + self.sup_hi * tp_ - tw[0]) / dt)) + 2)
-        return slice(a, max(a, b))
+        return self.cls.support_slice(tp_, t0_, self.t_first, self.dt, self.tw.size)
 
     # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
     def sampled(self, tp_, t0_):
@@ -176,8 +174,8 @@ class WeightedWindow:
         """The unit pulse and its derivatives with respect to ``tp`` and ``t0`` (per s),
         zero-padded: shape ``(3, nfft)``."""
         out = np.zeros((3, self.nfft))
-        k = self.support(tp_, t0_)
-        out[:, k] = self.cls.sampled_with_derivatives(tp_, t0_, self.tw[k], self.dt)
+        k, columns = self.cls.support_columns(tp_, t0_, self.tw, self.dt)
+        out[:, k] = columns
         return out
 
     def products(self, cols):
