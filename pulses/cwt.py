@@ -29,6 +29,7 @@ coarse search; :mod:`pulses.fit` refines the best match by least squares on the 
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -87,10 +88,29 @@ def unit_energy(shape: str) -> float:
 #: are below 1e-3 of their peak (rect and sine keep their slowly decaying sinc tails out of
 #: the coarse search, which is all this transform is for)
 BAND_CYCLES = 3.0
+#: sets of matching kernels kept (:func:`_kernels`): about 6 octaves of periods by 4 shapes make a
+#: record's, at 12 periods by up to ~1,000 bins of 16 bytes each (a 60 s record's band)
+KERNELS_KEPT = 32
 #: zero padding after the record, in longest periods: the circular correlation must not wrap a
 #: pulse's support round to the other end.  The Ricker wavelets fall below 1e-8 of their peak
 #: 1.5 Tp from the centre, so 1.5 Tp is enough for the matching (it is only the coarse search)
 PAD_PERIODS = 1.5
+
+
+@functools.lru_cache(maxsize=KERNELS_KEPT)
+def _kernels(shape: str, nfft: int, dt: float, m: int, tps: bytes) -> np.ndarray:
+    """``conj`` of the DFT of the sampled unit ``shape`` at the periods ``tps`` (s; float64 bytes)
+    on the first ``m`` bins of an ``nfft``-point transform at step ``dt`` (s): shape ``(len(tps), m)``.
+
+    A function of the record's length and step only, not of its samples: kept
+    (:data:`KERNELS_KEPT`) for the next record of the same length, such as the next direction of a
+    pair.  Read-only.
+    """
+    tps = np.frombuffer(tps)[:, None]
+    freq = np.arange(m) / (nfft * dt)
+    kernels = np.conj(tps / dt * unit_spectrum(shape, freq[None, :] * tps))
+    kernels.flags.writeable = False
+    return kernels
 
 
 class Matcher:
@@ -202,8 +222,8 @@ class Matcher:
         n_out = min(sfft.next_fast_len(2 * (m - 1), real=True), self.nfft)
         m = min(m, n_out // 2 + 1)
         tps = group[:, None]
-        w_hat = tps / self.dt * unit_spectrum(shape, self.freq[None, :m] * tps)
-        c = sfft.irfft(self.spectrum[None, :m] * np.conj(w_hat), n_out, axis=1) * (n_out / self.nfft)
+        kernels = _kernels(shape, self.nfft, self.dt, m, group.tobytes())
+        c = sfft.irfft(self.spectrum[None, :m] * kernels, n_out, axis=1) * (n_out / self.nfft)
         tau = np.arange(n_out) * (self.period / n_out)
         tau = np.where(tau > self.period - PAD_PERIODS * self.tp_max, tau - self.period, tau)
         norm = unit_energy(shape) * tps / self.dt

@@ -126,7 +126,7 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
         G, cx = products[:, :3], products[:, 3]
         if baseline:
             s, q = products[:, 4], products[:, 5]
-            G = G - (np.outer(s, s / n) + np.outer(q, q / ramp_norm))
+            G = G - (s[:, None] * (s / n) + q[:, None] * (q / ramp_norm))
         cr = cx - a * G[:, 0]  # C r = C xp - a (P C) m, r lying in P's range
         cost = xx - a * (cx[0] + cr[0])
         if cost < COST_EXPLICIT * xx:  # little left of the record: the sum of squares from r itself
@@ -137,7 +137,7 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
             r = xp - a * pm
             cost = _dot(r, r)
         d = np.array([1.0, a, a])  # the derivatives' columns of J scale with the amplitude
-        return cost, G * np.outer(d, d), -d * cr
+        return cost, G * (d[:, None] * d), -d * cr
 
     return normal
 
