@@ -157,6 +157,7 @@ class WeightedWindow:
         self.k_near = np.flatnonzero(np.abs(self.shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
         # irfft counts the interior bins twice, which the weights already do
         self.Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+        self.whitened = None  # irfft(Xw_half) nfft, the record in time, for the lattice's scans
 
     def support(self, tp_, t0_):
         """Slice of the window's samples where the pulse ``(tp_, t0_)`` (s) may be non-zero."""
@@ -182,11 +183,12 @@ class WeightedWindow:
         """Weighted ``u'v`` among the columns ``cols`` (shape ``(k, nfft)``; overwritten) and with
         the record, the baseline projected out: ``(UU, UX)`` of shapes ``(k, k)`` and ``(k,)``."""
         U = sfft.rfft(cols, axis=-1, overwrite_x=True)
-        UU, UF = gram(U, U * self.w), gram(U, self.fixed)
-        UX = UF[:, 0]
+        k = U.shape[0]
+        UF = gram(U, np.concatenate((U * self.w, self.fixed)))  # one product: columns, record, baseline
+        UU, UX = UF[:, :k], UF[:, k]
         if self.baseline:
-            UB = UF[:, 1:]
-            UU -= UB @ self.BB_inv @ UB.T
+            UB = UF[:, k + 1:]
+            UU = UU - UB @ self.BB_inv @ UB.T
             UX = UX - UB @ self.BB_inv @ self.BX
         return UU, UX
 
@@ -204,7 +206,7 @@ class WeightedWindow:
         d = np.array([1.0, a, a])
         ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
         cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
-        return cost, UU * np.outer(d, d), -d * ur
+        return cost, UU * (d[:, None] * d), -d * ur
 
     def difference_covariance(self, ap, tp_, t0_):
         """:func:`difference_covariance` at the plain estimate ``(ap, tp_, t0_)`` on this window."""
@@ -265,9 +267,9 @@ class WeightedWindow:
             (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
             p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
         tps = widths / (hi_ - lo_)
-        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps,
-                                                          sfft.irfft(self.Xw_half, self.nfft) * self.nfft),
-                                               lower, upper)
+        if self.whitened is None:
+            self.whitened = sfft.irfft(self.Xw_half, self.nfft) * self.nfft
+        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps, self.whitened), lower, upper)
         if cost_lattice < cost:
             p_new, cost = p_lattice, cost_lattice
         return p_new, cost
