@@ -51,6 +51,20 @@ def _dot(a, b) -> float:
     return float(np.einsum("i,i->", a, b))
 
 
+#: longest rows :func:`_products` multiplies by BLAS: a product of a few rows by a few rows is
+#: then far below the size where OpenBLAS starts threads (m n k above 262,144)
+BLAS_ROWS = 4096
+
+
+def _products(a, b) -> np.ndarray:
+    """``a b'``: every row of ``a`` (shape ``(i, k)``) times every row of ``b`` (``(j, k)``), for a
+    few rows.  BLAS up to :data:`BLAS_ROWS` long rows (several times faster than ``einsum`` there),
+    ``einsum`` beyond (see :func:`_dot`)."""
+    if a.shape[-1] <= BLAS_ROWS:
+        return a @ b.T
+    return np.einsum("ik,jk->ij", a, b)
+
+
 def _tp_per_scale(shape: str) -> float:
     cls = shape_class(shape)
     if cls.pywt is None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .cwt import _dot
+from .cwt import _dot, _products
 
 #: :func:`pulse_normal_equations` takes the sum of squares of the residual from its products with
 #: the record, ``xp'xp - 2 ap m'P xp + ap^2 m'P m``, which loses ``xp'xp / r'r`` of its relative
@@ -122,7 +122,7 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
     def normal(p):
         a, tp, t0 = float(p[0]), max(float(p[1]), 1e-9), float(p[2])
         k, C = cls.support_columns(tp, t0, tw, dt)
-        products = np.einsum("ik,jk->ij", C, np.concatenate((C, others[:, k])))
+        products = _products(C, np.concatenate((C, others[:, k])))
         G, cx = products[:, :3], products[:, 3]
         if baseline:
             s, q = products[:, 4], products[:, 5]
@@ -187,19 +187,19 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
     cost, A, g = normal(p)
     calls = 1
     lam = 1e-3
-    step_tol = xtol * scale
-    on_diagonal = np.diag_indices(len(p))
+    p = np.asarray(p, dtype=float)
+    step_tol = (xtol * np.asarray(scale, dtype=float)).tolist()
+    lower, upper = np.broadcast_to(lower, p.shape).tolist(), np.broadcast_to(upper, p.shape).tolist()
     for _ in range(max_iter):
-        diag = np.diag(A)
-        diag = np.where(diag <= 0, 1.0, diag)
+        A_rows, minus_g = A.tolist(), (-g).tolist()
+        diag = [1.0 if row[i] <= 0 else row[i] for i, row in enumerate(A_rows)]
         while True:
-            damped = A.copy()
-            damped[on_diagonal] += lam * diag
-            step = np.linalg.solve(damped, -g)
+            step = _solve_small([[v + lam * diag[i] if i == j else v for j, v in enumerate(row)]
+                                 for i, row in enumerate(A_rows)], minus_g)
             trial = p + step
             if max_calls is not None and calls >= max_calls:
                 return p, cost
-            if (trial >= lower).all() and (trial <= upper).all():
+            if all(lo <= v <= hi for v, lo, hi in zip(trial.tolist(), lower, upper)):
                 cost_trial, A_trial, g_trial = normal(trial)
                 calls += 1
             else:
@@ -210,9 +210,40 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
             lam *= 4.0
             if lam > 1e12:
                 return p, cost
-        small_step = bool((np.abs(step) <= step_tol).all())
+        small_step = all(abs(v) <= tol for v, tol in zip(step, step_tol))
         small_gain = cost - cost_trial <= ftol * cost
         p, cost, A, g = trial, cost_trial, A_trial, g_trial
         if small_step or small_gain:
             break
     return p, cost
+
+
+def _solve_small(M, b):
+    """``x`` with ``M x = b`` for a few unknowns (lists of floats; ``M`` overwritten): Gaussian
+    elimination with partial pivoting, without numpy's per-call cost on a 3 x 3 system.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        Where a pivot is zero (``M`` singular).
+    """
+    n = len(b)
+    b = list(b)
+    for c in range(n):
+        r = max(range(c, n), key=lambda i: abs(M[i][c]))
+        if M[r][c] == 0.0:
+            raise np.linalg.LinAlgError("singular matrix")
+        if r != c:
+            M[c], M[r], b[c], b[r] = M[r], M[c], b[r], b[c]
+        pivot = M[c]
+        for i in range(c + 1, n):
+            f = M[i][c] / pivot[c]
+            if f != 0.0:
+                row = M[i]
+                for j in range(c + 1, n):
+                    row[j] -= f * pivot[j]
+                b[i] -= f * b[c]
+    x = [0.0] * n
+    for i in range(n - 1, -1, -1):
+        x[i] = (b[i] - sum(M[i][j] * x[j] for j in range(i + 1, n))) / M[i][i]
+    return np.array(x)

@@ -22,6 +22,7 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
+from .cwt import _products
 from .lsq import levenberg_marquardt
 
 #: periods scanned by the weighted search of a shape with corners before its descent, within a
@@ -59,7 +60,7 @@ def gram(U, Vw):
         ``sum(Re(U) Re(Vw) + Im(U) Im(Vw))`` over the bins (computed on the arrays' float views),
         which is ``u' S^-1 v`` when ``w`` are the weights of :meth:`pulses.fit.Background.weights`.
     """
-    return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
+    return _products(U.view(float), Vw.view(float))
 
 
 def difference_covariance(U, B, w, nfft):
