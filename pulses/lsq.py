@@ -98,7 +98,8 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
     Returns
     -------
     callable
-        ``p -> (||r||^2, J'J, J'r)`` at ``p = (ap, Tp, t0)`` (record units, s, s), with
+        ``p -> (||r||^2, J'J, J'r)`` at ``p = (ap, Tp, t0)`` (record units, s, s; the products as
+        nested lists of floats), with
         ``r = xp - ap P m`` the residual, ``m`` the unit pulse sampled on ``tw``, ``P`` the
         projector of :func:`baseline_projector` and ``J = dr/dp``: :func:`normal_equations` of that
         residual and Jacobian, to round-off.
@@ -122,12 +123,16 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
     def normal(p):
         a, tp, t0 = float(p[0]), max(float(p[1]), 1e-9), float(p[2])
         k, C = cls.support_columns(tp, t0, tw, dt)
-        products = _products(C, np.concatenate((C, others[:, k])))
-        G, cx = products[:, :3], products[:, 3]
+        # the 3 x 3 arithmetic in Python floats: cheaper than numpy's per-call cost at this size
+        products = _products(C, np.concatenate((C, others[:, k]))).tolist()
+        cx = [row[3] for row in products]
         if baseline:
-            s, q = products[:, 4], products[:, 5]
-            G = G - (s[:, None] * (s / n) + q[:, None] * (q / ramp_norm))
-        cr = cx - a * G[:, 0]  # C r = C xp - a (P C) m, r lying in P's range
+            s, q = [row[4] for row in products], [row[5] for row in products]
+            G = [[row[j] - (s[i] * (s[j] / n) + q[i] * (q[j] / ramp_norm)) for j in range(3)]
+                 for i, row in enumerate(products)]
+        else:
+            G = [row[:3] for row in products]
+        cr = [cx[i] - a * G[i][0] for i in range(3)]  # C r = C xp - a (P C) m, r lying in P's range
         cost = xx - a * (cx[0] + cr[0])
         if cost < COST_EXPLICIT * xx:  # little left of the record: the sum of squares from r itself
             pm = np.zeros(n)
@@ -136,8 +141,8 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
                 pm -= s[0] / n + ramp * (q[0] / ramp_norm)
             r = xp - a * pm
             cost = _dot(r, r)
-        d = np.array([1.0, a, a])  # the derivatives' columns of J scale with the amplitude
-        return cost, G * (d[:, None] * d), -d * cr
+        d = (1.0, a, a)  # the derivatives' columns of J scale with the amplitude
+        return cost, [[G[i][j] * (d[i] * d[j]) for j in range(3)] for i in range(3)], [-d[i] * cr[i] for i in range(3)]
 
     return normal
 
@@ -155,8 +160,9 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
     Parameters
     ----------
     normal : callable
-        ``p -> (sum of squares, J'J, J'r)`` with ``J = dr/dp`` (:func:`normal_equations`; for
-        weighted least squares the weighted products, :meth:`pulses.weighted.WeightedWindow.normal`).
+        ``p -> (sum of squares, J'J, J'r)`` (arrays or nested lists) with ``J = dr/dp``
+        (:func:`normal_equations`; :func:`pulse_normal_equations`; for weighted least squares the
+        weighted products, :meth:`pulses.weighted.WeightedWindow.normal`).
     p : ndarray, shape (k,)
         Start, inside the box.
     scale : ndarray, shape (k,)
@@ -191,7 +197,8 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
     step_tol = (xtol * np.asarray(scale, dtype=float)).tolist()
     lower, upper = np.broadcast_to(lower, p.shape).tolist(), np.broadcast_to(upper, p.shape).tolist()
     for _ in range(max_iter):
-        A_rows, minus_g = A.tolist(), (-g).tolist()
+        A_rows = A.tolist() if isinstance(A, np.ndarray) else A
+        minus_g = [-v for v in (g.tolist() if isinstance(g, np.ndarray) else g)]
         diag = [1.0 if row[i] <= 0 else row[i] for i, row in enumerate(A_rows)]
         while True:
             step = _solve_small([[v + lam * diag[i] if i == j else v for j, v in enumerate(row)]
@@ -230,7 +237,10 @@ def _solve_small(M, b):
     n = len(b)
     b = list(b)
     for c in range(n):
-        r = max(range(c, n), key=lambda i: abs(M[i][c]))
+        r = c
+        for i in range(c + 1, n):
+            if abs(M[i][c]) > abs(M[r][c]):
+                r = i
         if M[r][c] == 0.0:
             raise np.linalg.LinAlgError("singular matrix")
         if r != c:
