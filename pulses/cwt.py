@@ -51,16 +51,16 @@ def _dot(a, b) -> float:
     return float(np.einsum("i,i->", a, b))
 
 
-#: longest rows :func:`_products` multiplies by BLAS: a product of a few rows by a few rows is
-#: then far below the size where OpenBLAS starts threads (m n k above 262,144)
-BLAS_ROWS = 4096
+#: largest product :func:`_products` leaves to BLAS, in multiply-adds: half the size below which
+#: OpenBLAS runs a matrix product on one thread (m n k = 262,144)
+BLAS_PRODUCT = 131072
 
 
 def _products(a, b) -> np.ndarray:
-    """``a b'``: every row of ``a`` (shape ``(i, k)``) times every row of ``b`` (``(j, k)``), for a
-    few rows.  BLAS up to :data:`BLAS_ROWS` long rows (several times faster than ``einsum`` there),
-    ``einsum`` beyond (see :func:`_dot`)."""
-    if a.shape[-1] <= BLAS_ROWS:
+    """``a b'``: every row of ``a`` (shape ``(i, k)``) times every row of ``b`` (``(j, k)``).  BLAS
+    up to :data:`BLAS_PRODUCT` multiply-adds (several times faster than ``einsum`` on a few rows),
+    ``einsum`` beyond, where BLAS would start threads (see :func:`_dot`)."""
+    if a.shape[0] * b.shape[0] * a.shape[-1] <= BLAS_PRODUCT:
         return a @ b.T
     return np.einsum("ik,jk->ij", a, b)
 

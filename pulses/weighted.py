@@ -22,7 +22,7 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
-from .cwt import _products
+from .cwt import BLAS_PRODUCT, _products
 from .lsq import levenberg_marquardt
 
 #: periods scanned by the weighted search of a shape with corners before its descent, within a
@@ -157,8 +157,11 @@ class WeightedWindow:
         self.shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
         self.k_near = np.flatnonzero(np.abs(self.shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
         # irfft counts the interior bins twice, which the weights already do
-        self.Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
-        self.whitened = None  # irfft(Xw_half) nfft, the record in time, for the lattice's scans
+        self.half = np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+        self.Xw_half = Xw * self.half
+        # computed on first use by the scans: the record whitened in time, irfft(Xw_half) nfft,
+        # and the circulant's kernel (:meth:`norms`)
+        self.whitened = self.kernel = None
 
     def support(self, tp_, t0_):
         """Slice of the window's samples where the pulse ``(tp_, t0_)`` (s) may be non-zero."""
@@ -214,31 +217,56 @@ class WeightedWindow:
         U = sfft.rfft(self.sampled_with_derivatives(tp_, t0_), axis=-1) * np.array([[1.0], [ap], [ap]])
         return difference_covariance(U, self.B if self.baseline else None, self.w, self.nfft)
 
-    def scan(self, tps, t0s, whitened=None):
+    def scan(self, tps, t0s, reach=None):
         """The best of the pulses ``(tps, t0s)`` (arrays, s), each moved by its best whole-sample
         shift, by the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``: its ``(tp, t0)``.
 
-        Given the record ``whitened`` (in time, ``irfft(Xw)``: its circular cross-correlation with
-        ``u`` at lag ``m`` is ``u'S^-1 x`` for ``u`` moved by ``m`` samples), the shifts are within 2
-        samples, summed over the pulses' support instead of an inverse FFT each."""
+        The shifts are within ``reach`` samples (default: :data:`GLS_SHIFT` of the window's
+        period, at least 2).  ``u'S^-1 x`` for ``u`` moved by ``m`` samples is the circular
+        cross-correlation at lag ``m`` of ``u`` with the record whitened (``irfft(Xw)``, in time):
+        for short pulses and few shifts summed over the pulses' support, with ``u'S^-1 u`` from
+        ``u``'s autocorrelation, whose transform is as short as twice the support
+        (:meth:`norms`); otherwise by one transform of each pulse over the window."""
         tw, dt, nfft = self.tw, self.dt, self.nfft
         # every candidate sampled at once, over the union of their supports
         a = max(0, int(math.floor((np.min(t0s + self.sup_lo * tps) - tw[0]) / dt)) - 1)
         b = max(a, min(tw.size, int(math.ceil((np.max(t0s + self.sup_hi * tps) - tw[0]) / dt)) + 2))
-        cols = np.zeros((len(tps), nfft))
-        cols[:, a:b] = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
-        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
-        mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
-        if whitened is None:
-            lags = self.shifts[self.k_near]
-            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, self.k_near] * nfft
-        else:
-            lags = np.arange(-2, 3)
-            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        cols = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
+        lags = self.shifts[self.k_near].astype(int) if reach is None else np.arange(-reach, reach + 1)
+        if cols.size * lags.size <= BLAS_PRODUCT:  # short pulses, few shifts: sums in time
+            mm = self.norms(cols)
+            if self.whitened is None:
+                self.whitened = sfft.irfft(self.Xw_half, nfft) * nfft
+            corr = _products(cols, self.whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        else:  # one transform of each candidate and one inverse transform for all its shifts
+            padded = np.zeros((len(tps), nfft))
+            padded[:, a:b] = cols
+            M = sfft.rfft(padded, axis=-1, overwrite_x=True)
+            mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
+            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, lags % nfft] * nfft
         j = np.argmax(np.abs(corr), axis=1)
         gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
         i = int(np.argmax(gain))
         return tps[i], t0s[i] + lags[j[i]] * dt
+
+    def norms(self, cols):
+        """``u'S^-1 u`` of each row ``u`` of ``cols`` (shape ``(k, m)``: samples on ``m`` consecutive
+        samples of the window, zero elsewhere).
+
+        ``sum(w |U|^2)`` over the bins is ``nfft sum_l h_l R_l``, with ``R`` the autocorrelation of
+        ``u`` and ``h = irfft(w_half)`` the circulant's kernel: ``R`` vanishes beyond ``m - 1``
+        lags, so it is computed by transforms of about ``2 m`` points instead of ``nfft``."""
+        m = cols.shape[1]
+        if 2 * m - 1 > self.nfft:  # no shorter than the window's own transform
+            U = sfft.rfft(cols, self.nfft, axis=-1)
+            return np.einsum("ik,ik->i", U.view(float), (U * self.w).view(float))
+        if self.kernel is None:  # h_0 and 2 h_l for l > 0: R is even
+            self.kernel = sfft.irfft(self.w * self.half, self.nfft) * self.nfft
+            self.kernel[1:] *= 2.0
+        n = sfft.next_fast_len(2 * m - 1, real=True)
+        F = sfft.rfft(cols, n, axis=-1)
+        R = sfft.irfft(F.real**2 + F.imag**2, n, axis=-1)[:, :m]
+        return _products(R, self.kernel[None, :m])[:, 0]
 
     def descent(self, tp_, t0_, lower, upper):
         """``(p, cost)``: Levenberg-Marquardt from ``(tp_, t0_)`` and its profiled amplitude, inside
@@ -268,9 +296,7 @@ class WeightedWindow:
             (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
             p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
         tps = widths / (hi_ - lo_)
-        if self.whitened is None:
-            self.whitened = sfft.irfft(self.Xw_half, self.nfft) * self.nfft
-        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps, self.whitened), lower, upper)
+        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps, reach=2), lower, upper)
         if cost_lattice < cost:
             p_new, cost = p_lattice, cost_lattice
         return p_new, cost
