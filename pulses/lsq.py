@@ -142,7 +142,8 @@ def pulse_normal_equations(cls, xp, tw, dt: float, baseline: bool):
             r = xp - a * pm
             cost = _dot(r, r)
         d = (1.0, a, a)  # the derivatives' columns of J scale with the amplitude
-        return cost, [[G[i][j] * (d[i] * d[j]) for j in range(3)] for i in range(3)], [-d[i] * cr[i] for i in range(3)]
+        return (cost, [[G[i][j] * (d[i] * d[j]) for j in range(3)] for i in range(3)],
+                [-d[i] * cr[i] for i in range(3)])
 
     return normal
 

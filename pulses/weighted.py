@@ -185,32 +185,38 @@ class WeightedWindow:
 
     def products(self, cols):
         """Weighted ``u'v`` among the columns ``cols`` (shape ``(k, nfft)``; overwritten) and with
-        the record, the baseline projected out: ``(UU, UX)`` of shapes ``(k, k)`` and ``(k,)``."""
+        the record, the baseline projected out: ``(UU, UX)``, lists of floats of shapes ``(k, k)``
+        and ``(k,)`` (the small algebra in Python floats: cheaper than numpy calls at this size)."""
         U = sfft.rfft(cols, axis=-1, overwrite_x=True)
         k = U.shape[0]
-        UF = gram(U, np.concatenate((U * self.w, self.fixed)))  # one product: columns, record, baseline
-        UU, UX = UF[:, :k], UF[:, k]
-        if self.baseline:
-            UB = UF[:, k + 1:]
-            UU = UU - UB @ self.BB_inv @ UB.T
-            UX = UX - UB @ self.BB_inv @ self.BX
+        UF = gram(U, np.concatenate((U * self.w, self.fixed))).tolist()  # columns, record, baseline
+        UU, UX = [row[:k] for row in UF], [row[k] for row in UF]
+        if self.baseline:  # less (UB BB^-1) UB' and (UB BB^-1) BX
+            (b00, b01), (b10, b11) = self.BB_inv.tolist()
+            bx0, bx1 = self.BX.tolist()
+            for i, row in enumerate(UF):
+                c0, c1 = row[k + 1] * b00 + row[k + 2] * b10, row[k + 1] * b01 + row[k + 2] * b11
+                UU[i] = [UU[i][j] - (c0 * UF[j][k + 1] + c1 * UF[j][k + 2]) for j in range(k)]
+                UX[i] -= c0 * bx0 + c1 * bx1
         return UU, UX
 
     def profiled(self, tp_, t0_):
         """``(cost, ap)``: the weighted sum of squares of the record less the pulse ``(tp_, t0_)``
         of least-squares amplitude ``ap`` (record units), and that amplitude."""
         UU, UX = self.products(self.sampled(tp_, t0_))
-        return self.xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
+        return self.xx - UX[0] ** 2 / max(UU[0][0], 1e-300), UX[0] / max(UU[0][0], 1e-300)
 
     def normal(self, p):
         """The normal equations at ``p = (ap, tp, t0)`` for :func:`pulses.lsq.levenberg_marquardt`:
-        ``(r'S^-1 r, J'S^-1 J, J'S^-1 r)`` with ``r`` the residual and ``J = dr/dp``."""
-        a = p[0]
+        ``(r'S^-1 r, J'S^-1 J, J'S^-1 r)`` with ``r`` the residual and ``J = dr/dp`` (nested lists
+        of floats)."""
+        a = float(p[0])
         UU, UX = self.products(self.sampled_with_derivatives(max(p[1], 1e-9), p[2]))
-        d = np.array([1.0, a, a])
-        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
-        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
-        return cost, UU * (d[:, None] * d), -d * ur
+        d = (1.0, a, a)
+        ur = [UX[i] - a * UU[i][0] for i in range(3)]  # u' S^-1 r for r = x - a m
+        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0][0]
+        return (cost, [[UU[i][j] * (d[i] * d[j]) for j in range(3)] for i in range(3)],
+                [-d[i] * ur[i] for i in range(3)])
 
     def difference_covariance(self, ap, tp_, t0_):
         """:func:`difference_covariance` at the plain estimate ``(ap, tp_, t0_)`` on this window."""
