@@ -196,7 +196,7 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
     lam = 1e-3
     p = np.asarray(p, dtype=float)
     step_tol = (xtol * np.asarray(scale, dtype=float)).tolist()
-    lower, upper = np.broadcast_to(lower, p.shape).tolist(), np.broadcast_to(upper, p.shape).tolist()
+    lower, upper = (np.zeros(p.shape) + lower).tolist(), (np.zeros(p.shape) + upper).tolist()
     for _ in range(max_iter):
         A_rows = A.tolist() if isinstance(A, np.ndarray) else A
         minus_g = [-v for v in (g.tolist() if isinstance(g, np.ndarray) else g)]
