@@ -551,8 +551,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         project = baseline_projector(tw, baseline)
         xp = project(xw)
         try:
-            p_new, cost = levenberg_marquardt(pulse_normal_equations(cls, xp, tw, dt, baseline), np.array([ap, tp, t0]),
-                                              scale=np.array([abs(ap) or 1.0, tp, tp]),
+            p_new, cost = levenberg_marquardt(pulse_normal_equations(cls, xp, tw, dt, baseline),
+                                              np.array([ap, tp, t0]), scale=np.array([abs(ap) or 1.0, tp, tp]),
                                               lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
                                               upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
         except np.linalg.LinAlgError:
@@ -581,7 +581,7 @@ def segment_periodograms(x, dt: float, nseg: int):
     ``2 |rfft|^2 dt / sum(w^2)`` (the zero and, for an even ``nseg``, the Nyquist bins not doubled),
     in the units of ``x`` squared per Hz.  These are ``scipy.signal.spectrogram(x, 1 / dt,
     "hann", nseg, nseg // 2, detrend="constant")``'s (density scaling), computed without
-    importing ``scipy.signal`` (over a second on a cold start).
+    importing ``scipy.signal`` (half a second or more on a cold start: it imports ``scipy.stats``).
 
     Parameters
     ----------
