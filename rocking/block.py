@@ -26,6 +26,12 @@ def eta_housner(alpha: float) -> float:
     return eta_frame(alpha, 0.0)  # the frame's formula at gamma = 0: one place for Eq. 5
 
 
+def _p_alpha(height: float, width: float, gamma: float) -> tuple[float, float]:
+    """``(p, alpha)`` (rad/s, rad) of a column ``height`` x ``width`` (m), a frame's with ``gamma``."""
+    radius = math.hypot(height / 2.0, width / 2.0)
+    return frame_p(math.sqrt(3.0 * G / (4.0 * radius)), gamma), math.atan2(width, height)
+
+
 @dataclass(frozen=True)
 class Block:
     """A rocking block described by its frequency parameter and slenderness.
@@ -94,9 +100,7 @@ class Block:
         if not (math.isfinite(height) and height > 0.0 and math.isfinite(width) and width > 0.0):
             raise ValueError(f"Block: height and width must be positive and finite, got "
                              f"{height!r} x {width!r} m")
-        radius = math.hypot(height / 2.0, width / 2.0)
-        p = frame_p(math.sqrt(3.0 * G / (4.0 * radius)), gamma)
-        return cls(p, math.atan2(width, height), eta, height=height, width=width,
+        return cls(*_p_alpha(height, width, gamma), eta, height=height, width=width,
                    cap_mass_ratio=gamma)
 
     @classmethod
@@ -140,3 +144,68 @@ class Block:
             dims += f", cap_mass_ratio={self.cap_mass_ratio:g}"
         return (f"Block(p={self.p:.6g} rad/s, alpha={self.alpha:.6g} rad "
                 f"(tan {self.tan_alpha:.4g}), eta={self.eta:.4g}{dims})")
+
+
+class Blocks:
+    """Many blocks as arrays: what a search runs by the thousand, without a :class:`Block` each
+    (the same numbers as :class:`Block`, element by element).
+
+    Parameters
+    ----------
+    p, alpha : array_like
+        Frequency parameters (rad/s) and slenderness angles (rad), as :class:`Block`'s (not
+        checked again: they come from checked dimensions or a search's own values).
+    eta : float, optional
+        Coefficient of restitution of all; default Eq. 5 (the frame's with ``cap_mass_ratio``)
+        at each ``alpha``.
+    cap_mass_ratio : float, optional
+        As :class:`Block`'s.
+
+    Iterating gives the :class:`Block` of each (for solvers that run one at a time).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> many = rocking.Blocks.from_dimensions(7.5, [1.2, 1.8])
+    >>> list(many)[1] == rocking.Block.from_dimensions(7.5, 1.8)
+    True
+    """
+
+    def __init__(self, p, alpha, eta: float | None = None, *, cap_mass_ratio: float = 0.0,
+                 height: float | None = None, widths=None):
+        import numpy as np
+
+        gamma = check_cap_mass_ratio(cap_mass_ratio)
+        self.p = np.ascontiguousarray(p, dtype=float).ravel()
+        self.alpha = np.ascontiguousarray(alpha, dtype=float).ravel()
+        if eta is None:
+            self.eta = np.array([eta_frame(a, gamma) for a in self.alpha.tolist()], dtype=float)
+        else:   # checked as a Block checks it
+            self.eta = np.full(self.p.size, Block(1.0, 0.1, eta).eta)
+        self.cap_mass_ratio, self.height = gamma, height
+        self.widths = [None] * self.p.size if widths is None else widths
+
+    @classmethod
+    def from_dimensions(cls, height: float, widths, eta: float | None = None, *,
+                        cap_mass_ratio: float = 0.0) -> "Blocks":
+        """Columns ``height`` tall (m), one per width of ``widths`` (m); ``eta`` and
+        ``cap_mass_ratio`` as :meth:`Block.from_dimensions`."""
+        import numpy as np
+
+        gamma = check_cap_mass_ratio(cap_mass_ratio)
+        height = float(height)
+        widths = np.asarray(widths, dtype=float).ravel().tolist()
+        if not (math.isfinite(height) and height > 0.0
+                and all(math.isfinite(w) and w > 0.0 for w in widths)):
+            raise ValueError(f"Blocks: height and widths must be positive and finite, got "
+                             f"{height!r} x {widths!r} m")
+        pa = [_p_alpha(height, w, gamma) for w in widths]
+        return cls([x[0] for x in pa], [x[1] for x in pa], eta, cap_mass_ratio=gamma,
+                   height=height, widths=widths)
+
+    def __len__(self) -> int:
+        return int(self.p.size)
+
+    def __iter__(self):
+        for p, a, e, w in zip(self.p.tolist(), self.alpha.tolist(), self.eta.tolist(), self.widths):
+            yield Block(p, a, e, height=self.height, width=w, cap_mass_ratio=self.cap_mass_ratio)

@@ -10,7 +10,7 @@ import numpy as np
 
 from pulses import G, SHAPES, make_pulse
 
-from .block import Block
+from .block import Block, Blocks
 from .frame import check_cap_mass_ratio
 from .closed_forms import eq31
 from .search import (DEFAULT_SETTINGS, _batch, _check_criterion, _failed, _peak, _scan_points,
@@ -127,8 +127,8 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     known[:, -1] = True            # tan(alpha) = ap/g: never uplifts
 
     def evaluate(idx, tans):
-        blocks = [Block(float(p_tp[i]), math.atan(t), cap_mass_ratio=gamma)
-                  for i, t in zip(idx, tans)]
+        blocks = Blocks(p_tp[idx], [math.atan(t) for t in np.asarray(tans, dtype=float).tolist()],
+                        cap_mass_ratio=gamma)
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
     scan = _scan_refine(evaluate, x, settings, known=known, zone=settings.zone_points != 0,

@@ -24,7 +24,7 @@ import numpy as np
 from pulses import G, Pulse, Record
 
 from . import engine
-from .block import Block
+from .block import Block, Blocks
 from ._common import (ZENO_TOL, BatchResult, RockingResult, _free_rocking_horizon,
                       _pulse_extrema, _result)
 from .errors import RockingInputError
@@ -594,6 +594,14 @@ def _batch_vertical(excitation, vertical, model, method):
     return None if zero else (vval, g_min, g_max)
 
 
+def _block_arrays(blocks):
+    """``(p, alpha, eta)`` arrays of a Block, a sequence of them or a :class:`rocking.Blocks`."""
+    if isinstance(blocks, Blocks):
+        return blocks.p, blocks.alpha, blocks.eta
+    blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
+    return tuple(np.array([getattr(b, k) for b in blocks], dtype=float) for k in ("p", "alpha", "eta"))
+
+
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor",
                   threads: int | None = None, lanes: bool = True,
@@ -602,7 +610,7 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
 
     Parameters
     ----------
-    blocks : Block or sequence of Block
+    blocks : Block, sequence of Block, or rocking.Blocks
     excitation : pulses.Pulse or pulses.Record
     scales : float or array_like, optional
         Factors on the excitation's acceleration (default 1).
@@ -647,17 +655,15 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
             return dataclasses.replace(out, lifts_off=none, t_lift_off=np.full(none.shape, np.nan))
         vval, g_min, g_max = bounds
     linear = model == "linear"
-    blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
-    p = np.array([b.p for b in blocks], dtype=float)
-    alpha = np.array([b.alpha for b in blocks], dtype=float)
-    eta = np.array([b.eta for b in blocks], dtype=float)
+    p, alpha, eta = _block_arrays(blocks)
+    n_blocks = p.size
     scales = np.atleast_1d(np.asarray(1.0 if scales is None else scales, dtype=float))
     if not np.all(np.isfinite(scales)):
         raise ValueError("scales must be finite")
     if grid:
         shape = (p.size, scales.size)
         p, alpha, eta = (np.repeat(a, scales.size) for a in (p, alpha, eta))
-        scales = np.tile(scales, len(blocks))
+        scales = np.tile(scales, n_blocks)
     else:
         p, alpha, eta, scales = np.broadcast_arrays(p, alpha, eta, scales)
         shape = p.shape

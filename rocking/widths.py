@@ -13,7 +13,7 @@ import numpy as np
 from pulses import G, SHAPES
 
 from . import scan, searches
-from .block import Block
+from .block import Block, Blocks
 from .frame import check_cap_mass_ratio, frame_p
 from .closed_forms import envelope_rule, eq20, eq31
 from .search import (DEFAULT_SETTINGS, _batch, _check_criterion, _failed, _peak, _scan_points,
@@ -344,7 +344,7 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
                              cap_mass_ratio=gamma, limit=limit, search_width=0.0)
 
     def run_widths(widths):  # not `runs`: that name counts the runs below
-        blocks = [Block.from_dimensions(height, float(b), eta, cap_mass_ratio=gamma) for b in widths]
+        blocks = Blocks.from_dimensions(height, widths, eta, cap_mass_ratio=gamma)
         if vertical is not None:
             import rocking
 

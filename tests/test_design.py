@@ -440,14 +440,18 @@ def test_record_width_search_not_below_brute_force_real(name, height):
 
 @pytest.mark.slow
 def test_min_slenderness_top_bisection_same_answer():
-    """refine="top", ksection=2 (what pipeline run uses) against the default full refinement,
-    including a case with a safe island below the answer (symmetric Ricker, Rinaldi)."""
+    """refine="top" with ksection 2 and pipeline run's EXACT_KSECTION against the default full
+    refinement, including a case with a safe island below the answer (symmetric Ricker,
+    Rinaldi): within 2e-9, twice the 1e-9 brackets each ends in."""
+    from pipeline.batch.record import EXACT_KSECTION
+
     cases = [("ricker-sym", [1.381 * 0.8, 2.5], [0.71, 0.4]), ("sine", [1.1, 3.0], [0.3, 0.8])]
     for shape, ptp, apg in cases:
         full = rocking.min_slenderness_batch(shape, ptp, apg)
-        fast = rocking.min_slenderness_batch(shape, ptp, apg, refine="top", ksection=2)
-        for a, b in zip(full, fast):
-            assert b.tan_alpha == pytest.approx(a.tan_alpha, rel=2e-9)
+        for k in sorted({2, EXACT_KSECTION}):
+            fast = rocking.min_slenderness_batch(shape, ptp, apg, refine="top", ksection=k)
+            for a, b in zip(full, fast):
+                assert b.tan_alpha == pytest.approx(a.tan_alpha, rel=2e-9)
 
 
 @pytest.mark.slow

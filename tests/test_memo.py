@@ -158,3 +158,49 @@ def test_a_level_and_its_overturning_design_are_both_kept_between_passes(kept, m
     assert len(calls) == 2                       # both kept
     _same(again, fresh)
     assert again.overturning_width == fresh.overturning_width and again.check_runs > 0
+
+
+def test_a_pair_is_read_once_per_worker_and_again_once_its_file_changes(tmp_path, monkeypatch):
+    """A pair's directions read its two files once (kept by path, size, time and inode); a file
+    written since is read again, and the records are the file's as it is then."""
+    from types import SimpleNamespace
+
+    from pipeline.batch import site
+
+    a, b = _pair(tmp_path, "STM", 0.45, 0.3, 3)
+    calls = []
+    real = pulses.read_pair
+    monkeypatch.setattr(pulses, "read_pair", lambda *p, **k: calls.append(p) or real(*p, **k))
+    opts = SimpleNamespace(format=None, units=None, dt=None, column=None, trace=None)
+    task = lambda d: SimpleNamespace(peer=None, options=opts, path=a, path2=b, direction=d, scale=1.0)  # noqa: E731
+    memo.on()
+    try:
+        r0, r30 = site.read_task(task(0.0)), site.read_task(task(30.0))
+        assert len(calls) == 1
+        assert np.array_equal(r30.acc, pulses.component(*real(a, b), 30.0).acc)
+        rec = pulses.read_record(a)
+        pulses.write_sac(pulses.Record(2.0 * rec.acc, rec.dt, rec.name, 0.0, rec.metadata), a)
+        os.utime(a, ns=(os.stat(a).st_atime_ns, os.stat(a).st_mtime_ns + 10**9))
+        r0_new = site.read_task(task(0.0))
+        assert len(calls) == 2
+        # the first component doubled, as written (0 degrees is the first file's azimuth)
+        np.testing.assert_allclose(r0_new.acc, 2.0 * r0.acc, rtol=1e-6)
+    finally:
+        memo.off()
+
+
+def test_blocks_are_the_blocks_of_their_dimensions_and_run_alike():
+    """rocking.Blocks (a search's widths as arrays) holds Block.from_dimensions's numbers to the
+    last bit, and simulate_many gives the same results bit for bit."""
+    widths = np.geomspace(0.2, 2.0, 17)
+    for gamma in (0.0, 0.7):
+        many = rocking.Blocks.from_dimensions(7.5, widths, cap_mass_ratio=gamma)
+        one = [rocking.Block.from_dimensions(7.5, float(w), cap_mass_ratio=gamma) for w in widths]
+        assert list(many) == one
+        assert [b.eta for b in many] == [b.eta for b in one]
+        rec = _synthetic(0.4, 5)
+        x, y = rocking.simulate_many(many, rec), rocking.simulate_many(one, rec)
+        assert np.array_equal(x.overturned, y.overturned)
+        assert np.array_equal(x.max_rotation, y.max_rotation)
+    with pytest.raises(ValueError, match="positive and finite"):
+        rocking.Blocks.from_dimensions(7.5, [1.0, -1.0])

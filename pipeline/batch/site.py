@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from . import peer_inputs
+from . import memo, peer_inputs
 from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
 from .peer_inputs import PEER_TP
 from ..reports.pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
@@ -111,7 +111,13 @@ def read_task(task):
     if task.path2 is None:
         record = pulses.read_record(task.path, **kw)
     else:
-        first, second = pulses.read_pair(task.path, task.path2, **kw)
+        read = lambda: pulses.read_pair(task.path, task.path2, **kw)  # noqa: E731
+        try:
+            key = (memo.file_key(task.path), memo.file_key(task.path2), repr(sorted(kw.items())))
+        except OSError:  # read_pair says what is wrong
+            first, second = read()
+        else:
+            first, second = memo.remembered("pair", key, read)
         record = pulses.component(first, second, task.direction)
     return record.scaled(task.scale) if task.scale != 1.0 else record
 
