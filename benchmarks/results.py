@@ -347,6 +347,10 @@ def fit_section(d, out_dir):
               f"**{sp['fit_all_shapes_20s_200Hz_ms_median']:.1f} ms**, best {sp['fit_all_shapes_20s_200Hz_ms_min']:.1f} ms; "
               "per shape: " + ", ".join(f"{s} {sp[f'fit_{s}_20s_200Hz_ms_median']:.1f} ms"
                                        for s in ("sine", "ricker-sym", "ricker-anti", "rect")) + ".\n")
+    if d.get("records"):
+        from benchmarks import bench_fit_records
+
+        md += bench_fit_records.lines(d["records"])
     if rinaldi:
         md.append(f"Rinaldi 228 (NGA-West2 AT2): one-sine fit {rinaldi[0]:.3f} g, {rinaldi[1]:.3f} s (paper: 0.71 g, 0.8 s); "
                   f"best shape {rinaldi[2]}; {rinaldi[3] * 1e3:.0f} ms for all shapes.\n")

@@ -1,13 +1,16 @@
 """Section 4 of RESULTS.md, the pulse fitter: time against record length, error against noise and Tp."""
 from __future__ import annotations
 
+import subprocess
+
 from benchmarks.common import RECORDS_DIR, log, timed
 
 
 def measure(quick):
     """Section 4: the fitter's speed (``bench_fit.run``), its accuracy against noise and Tp
-    (``fit_accuracy.cases``) and the fit of Rinaldi 228.  Returns plain data for
-    :func:`benchmarks.results.fit_section`.
+    (``fit_accuracy.cases``), its CPU per call on real records against the fit before issue 34
+    (``bench_fit_records.run``; None where git cannot give that version) and the fit of Rinaldi
+    228.  Returns plain data for :func:`benchmarks.results.fit_section`.
     """
     log("fit: speed (benchmarks/bench_fit.py)")
     from benchmarks import bench_fit, fit_accuracy
@@ -31,6 +34,16 @@ def measure(quick):
         table.append(dict(noise=noise, tp=None, summary=s))
         log(f"  noise {noise:.0%}: {len(pooled)} fits, within 5 %: {100 * s['5']:.0f} %, right shape {100 * s['shape']:.0f} %")
 
+    log("fit: CPU per call on real records against the fit before issue 34 (benchmarks/bench_fit_records.py)")
+    from benchmarks import bench_fit_records
+
+    try:
+        records = bench_fit_records.run(rounds=1 if quick else 3)
+        log(f"  median {records['this_all_s'] * 1e3:.1f} ms per call, {records['ratio_all']:.2f}x faster")
+    except (OSError, subprocess.CalledProcessError) as exc:  # no git, or the revision is not in this clone
+        log(f"  skipped: {exc}")
+        records = None
+
     rinaldi = None
     path = RECORDS_DIR / "Rinaldi228.AT2"
     if path.is_file():
@@ -40,4 +53,4 @@ def measure(quick):
         fit, sec = timed(lambda: pulses.fit_pulse(rec))
         sine = fit["sine"]
         rinaldi = (sine.ap_g, sine.tp, fit.best.shape, sec)
-    return dict(speed=sp, accuracy=table, n=n, rinaldi=rinaldi)
+    return dict(speed=sp, accuracy=table, n=n, rinaldi=rinaldi, records=records)

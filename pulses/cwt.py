@@ -29,6 +29,7 @@ coarse search; :mod:`pulses.fit` refines the best match by least squares on the 
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -48,6 +49,20 @@ def _dot(a, b) -> float:
     """``sum(a * b)`` without BLAS: a multithreaded BLAS dot on long vectors (OpenBLAS uses
     threads above 10 000 samples) can stall for milliseconds on a busy machine."""
     return float(np.einsum("i,i->", a, b))
+
+
+#: largest product :func:`_products` leaves to BLAS, in multiply-adds: half the size below which
+#: OpenBLAS runs a matrix product on one thread (m n k = 262,144)
+BLAS_PRODUCT = 131072
+
+
+def _products(a, b) -> np.ndarray:
+    """``a b'``: every row of ``a`` (shape ``(i, k)``) times every row of ``b`` (``(j, k)``).  BLAS
+    up to :data:`BLAS_PRODUCT` multiply-adds (several times faster than ``einsum`` on a few rows),
+    ``einsum`` beyond, where BLAS would start threads (see :func:`_dot`)."""
+    if a.shape[0] * b.shape[0] * a.shape[-1] <= BLAS_PRODUCT:
+        return a @ b.T
+    return np.einsum("ik,jk->ij", a, b)
 
 
 def _tp_per_scale(shape: str) -> float:
@@ -87,10 +102,68 @@ def unit_energy(shape: str) -> float:
 #: are below 1e-3 of their peak (rect and sine keep their slowly decaying sinc tails out of
 #: the coarse search, which is all this transform is for)
 BAND_CYCLES = 3.0
+#: octaves of matching kernels kept (:func:`_band`): about 6 octaves by 4 shapes make a record's,
+#: each of 12 periods by up to ~1,000 bins of 16 bytes and ~2,000 output points (a 60 s record)
+BANDS_KEPT = 32
 #: zero padding after the record, in longest periods: the circular correlation must not wrap a
 #: pulse's support round to the other end.  The Ricker wavelets fall below 1e-8 of their peak
 #: 1.5 Tp from the centre, so 1.5 Tp is enough for the matching (it is only the coarse search)
 PAD_PERIODS = 1.5
+
+
+@functools.lru_cache(maxsize=BANDS_KEPT)
+def _band(shape: str, nfft: int, dt: float, bins: int, tp_max: float, t_end: float, tps: bytes):
+    """What matching ``shape`` at one octave of periods needs besides the record: a function of
+    the record's length and step only, kept (:data:`BANDS_KEPT`) for the next record of the
+    same length, such as the next direction of a pair.  Read-only arrays.
+
+    Parameters
+    ----------
+    shape : str
+        The shape.
+    nfft : int
+        Length of the record's (padded) transform; ``bins`` of its bins are kept (:class:`Matcher`).
+    dt : float
+        Sampling step, s.
+    tp_max : float
+        Longest period matched, s (the padding).
+    t_end : float
+        Time of the record's last sample, s.
+    tps : bytes
+        The octave's periods, s (float64).
+
+    Returns
+    -------
+    m : int
+        Bins of the band the shortest period needs.
+    n_out : int
+        Points of the inverse transform (the octave's time grid).
+    kernels : ndarray of complex, shape (len(tps), m)
+        ``conj`` of the DFT of the sampled unit shape at each period.
+    tau : ndarray, shape (n_out,)
+        Time of the shape's origin at each output point, s (past the padded end: negative).
+    allowed : ndarray of bool, shape (len(tps), n_out)
+        Whether the pulse's centre lies inside the record there.
+    norm : ndarray, shape (len(tps), 1)
+        ``||w||^2`` of the sampled unit shape at each period.
+    """
+    group = np.frombuffer(tps)
+    tps = group[:, None]
+    m = int(math.ceil(BAND_CYCLES / group[0] * nfft * dt)) + 1
+    m = max(2, min(m, bins))
+    n_out = min(sfft.next_fast_len(2 * (m - 1), real=True), nfft)
+    m = min(m, n_out // 2 + 1)
+    freq = np.arange(m) / (nfft * dt)
+    kernels = np.conj(tps / dt * unit_spectrum(shape, freq[None, :] * tps))
+    period = nfft * dt
+    tau = np.arange(n_out) * (period / n_out)
+    tau = np.where(tau > period - PAD_PERIODS * tp_max, tau - period, tau)
+    centre = shape_class(shape).centre_tau * tps
+    allowed = (tau[None, :] >= -centre) & (tau[None, :] <= t_end - centre)
+    norm = unit_energy(shape) * tps / dt
+    for a in (kernels, tau, allowed, norm):
+        a.flags.writeable = False
+    return m, n_out, kernels, tau, allowed, norm
 
 
 class Matcher:
@@ -180,10 +253,11 @@ class Matcher:
             stop = int(np.searchsorted(tps, 2.0 * tps[start], side="left"))
             stop = max(stop, start + 1)
             group = tps[start:stop]
-            share, tau = self._band_share(shape, group)
-            centre = shape_class(shape).centre_tau * group[:, None]
-            ok = (tau[None, :] >= -centre) & (tau[None, :] <= t_end - centre)
-            masked = np.where(ok, share, 0.0)
+            m, n_out, kernels, tau, allowed, norm = _band(shape, self.nfft, self.dt, self.spectrum.size,
+                                                          self.tp_max, float(t_end), group.tobytes())
+            c = sfft.irfft(self.spectrum[None, :m] * kernels, n_out, axis=1) * (n_out / self.nfft)
+            share = c * np.abs(c) / (norm * max(self.energy, 1e-300))
+            masked = np.where(allowed, share, 0.0)
             in_octave = []
             for sign, k in ((1, int(np.argmax(masked))), (-1, int(np.argmin(masked)))):
                 i, j = divmod(k, masked.shape[1])
@@ -195,16 +269,3 @@ class Matcher:
             start = stop
         by_size = lambda b: -abs(b[0])  # noqa: E731
         return sorted(best.values(), key=by_size), sorted(octaves, key=by_size)
-
-    def _band_share(self, shape, group):
-        m = int(math.ceil(BAND_CYCLES / group[0] * self.nfft * self.dt)) + 1
-        m = max(2, min(m, self.spectrum.size))
-        n_out = min(sfft.next_fast_len(2 * (m - 1), real=True), self.nfft)
-        m = min(m, n_out // 2 + 1)
-        tps = group[:, None]
-        w_hat = tps / self.dt * unit_spectrum(shape, self.freq[None, :m] * tps)
-        c = sfft.irfft(self.spectrum[None, :m] * np.conj(w_hat), n_out, axis=1) * (n_out / self.nfft)
-        tau = np.arange(n_out) * (self.period / n_out)
-        tau = np.where(tau > self.period - PAD_PERIODS * self.tp_max, tau - self.period, tau)
-        norm = unit_energy(shape) * tps / self.dt
-        return c * np.abs(c) / (norm * max(self.energy, 1e-300)), tau

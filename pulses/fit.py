@@ -49,7 +49,7 @@ from scipy import fft as sfft
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
 from .cwt import Matcher, _dot, unit_energy
-from .lsq import baseline_projector, levenberg_marquardt, normal_equations
+from .lsq import baseline_projector, levenberg_marquardt, pulse_normal_equations
 from .record import G, Record
 from .shapes import SHAPES, Pulse, make_pulse, shape_class
 from .weighted import WeightedWindow
@@ -456,7 +456,7 @@ def _plain_scores(x, fits, energy) -> dict:
 
 def _score(x, t, dt, shape, trial, energy):
     """Share of the record's energy a refined ``(ap, Tp, t0, window)`` explains, and its samples."""
-    p = trial[0] * unit_samples(shape, trial[1], trial[2], t, dt)
+    p = trial[0] * shape_class(shape).sampled_on_grid(trial[1], trial[2], t, dt)
     r = x - p
     return 1.0 - _dot(r, r) / energy, p
 
@@ -539,7 +539,8 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         return slice(i0, i1)
 
     best = (ap0, tp0, t00, None)
-    if shape_class(shape).boxcar:
+    cls = shape_class(shape)
+    if cls.boxcar:
         return _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00)
     ap, tp, t0 = ap0, tp0, t00
     for _ in range(3):  # refit when the pulse moved outside the window of the previous pass
@@ -549,16 +550,9 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         tw, xw = t[idx], x[idx]
         project = baseline_projector(tw, baseline)
         xp = project(xw)
-
-        def residual_and_jacobian(p):
-            m, d_tp, d_t0 = unit_samples_and_derivatives(shape, max(p[1], 1e-9), p[2], tw, dt)
-            cols = project(np.stack((m, d_tp, d_t0)))
-            cols[1:] *= p[0]
-            return xp - p[0] * cols[0], -cols.T
-
         try:
-            p_new, cost = levenberg_marquardt(normal_equations(residual_and_jacobian), np.array([ap, tp, t0]),
-                                              scale=np.array([abs(ap) or 1.0, tp, tp]),
+            p_new, cost = levenberg_marquardt(pulse_normal_equations(cls, xp, tw, dt, baseline),
+                                              np.array([ap, tp, t0]), scale=np.array([abs(ap) or 1.0, tp, tp]),
                                               lower=np.array([-np.inf, tp0 / TP_LEASH, t00 - tp0]),
                                               upper=np.array([np.inf, tp0 * TP_LEASH, t00 + tp0]))
         except np.linalg.LinAlgError:
@@ -567,7 +561,7 @@ def _refine(x, t, dt, shape, ap0, tp0, t00, baseline):
         if not all(map(math.isfinite, (ap_new, tp_new, t0_new))) or tp_new <= 2 * dt:
             break
         # accept when it beats the starting (Tp, t0) on this window's own objective
-        m0 = project(unit_samples(shape, tp, t0, tw, dt))
+        m0 = project(cls.sampled_on_grid(tp, t0, tw, dt))
         start_sse = _dot(xp, xp) - _dot(m0, xp) ** 2 / max(_dot(m0, m0), 1e-300)
         if cost > start_sse * (1 + 1e-12):
             break
@@ -587,7 +581,7 @@ def segment_periodograms(x, dt: float, nseg: int):
     ``2 |rfft|^2 dt / sum(w^2)`` (the zero and, for an even ``nseg``, the Nyquist bins not doubled),
     in the units of ``x`` squared per Hz.  These are ``scipy.signal.spectrogram(x, 1 / dt,
     "hann", nseg, nseg // 2, detrend="constant")``'s (density scaling), computed without
-    importing ``scipy.signal`` (over a second on a cold start).
+    importing ``scipy.signal`` (half a second or more on a cold start: it imports ``scipy.stats``).
 
     Parameters
     ----------
@@ -830,15 +824,15 @@ def _refine_edges(x, t, dt, shape, best, window, baseline, tp0, t00):
             same = k1 == k2
             w1 = np.where(same, (ends - starts) / dt, (tw[0] + (k1 + 0.5) * dt - starts) / dt)
             w2 = np.where(same, 0.0, (ends - (tw[0] + (k2 - 0.5) * dt)) / dt)
-            lo = np.clip(k1 + 1, 0, n)
-            hi = np.maximum(np.clip(k2, 0, n), lo)
+            lo = np.minimum(np.maximum(k1 + 1, 0), n)  # np.clip, without its per-call cost
+            hi = np.maximum(np.minimum(np.maximum(k2, 0), n), lo)
             mx = prefix_x[hi] - prefix_x[lo]
             m1 = (hi - lo).astype(float)
             mr = prefix_r[hi] - prefix_r[lo]
             mm = m1.copy()
             for k, w in ((k1, w1), (k2, w2)):
                 ok = (k >= 0) & (k < n)
-                kc = np.clip(k, 0, n - 1)
+                kc = np.minimum(np.maximum(k, 0), n - 1)
                 w = np.where(ok, w, 0.0)
                 mx += w * x_perp[kc]
                 m1 += w

@@ -145,14 +145,61 @@ class Pulse:
         return np.where((tau >= lo) & (tau <= hi), cls.unit(tau), 0.0)
 
     @classmethod
+    def unit_and_slope(cls, tau):
+        """:meth:`unit` and :meth:`slope` at once (a shape whose two share work computes it once)."""
+        return cls.unit(tau), cls.slope(tau)
+
+    @classmethod
     def sampled_with_derivatives(cls, tp: float, t0: float, t, dt: float):
         """:meth:`sampled` and its derivatives with respect to ``tp`` and ``t0`` (for a Jacobian)."""
         tau = (t - t0) / tp
         lo, hi = cls.support_tau
         inside = (tau >= lo) & (tau <= hi)
-        m = np.where(inside, cls.unit(tau), 0.0)
-        dw = np.where(inside, cls.slope(tau), 0.0)
+        w, dw = cls.unit_and_slope(tau)
+        m = np.where(inside, w, 0.0)
+        dw = np.where(inside, dw, 0.0)
         return m, -dw * tau / tp, -dw / tp
+
+    @classmethod
+    def support_slice(cls, tp: float, t0: float, t_first: float, dt: float, n: int) -> slice:
+        """The samples ``t_first + i dt`` (``0 <= i < n``, s) outside which :meth:`sampled` of the
+        pulse ``(tp, t0)`` is zero: its support and a sample more each side (the cell averages
+        reach half a sample beyond it, and the bounds are rounded outwards)."""
+        lo, hi = cls.support_tau
+        a = max(0, int(math.floor((t0 + lo * tp - t_first) / dt)) - 1)
+        b = min(n, int(math.ceil((t0 + hi * tp - t_first) / dt)) + 2)
+        return slice(a, max(a, b))
+
+    @classmethod
+    def support_columns(cls, tp: float, t0: float, t, dt: float):
+        """:meth:`sampled_with_derivatives` on uniform increasing sample times ``t`` (step ``dt``,
+        s), where it may be non-zero: ``(k, C)``, ``C`` of shape ``(3, len(t[k]))`` the values on
+        ``t[k]``, zero on the other samples (for products of the columns computed on the support only).
+
+        Point samples are non-zero where ``tau = (t - t0) / tp`` lies in the support, found by
+        bisection (``tau`` increases with ``t``); the same values as :meth:`sampled_with_derivatives`.
+        """
+        k = cls.support_slice(tp, t0, float(t[0]), dt, t.size)
+        tau = (t[k] - t0) / tp
+        lo, hi = cls.support_tau
+        i0, i1 = int(tau.searchsorted(lo)), int(tau.searchsorted(hi, "right"))
+        tau = tau[i0:i1]
+        out = np.empty((3, tau.size))
+        out[0], dw = cls.unit_and_slope(tau)
+        dw = -dw  # the operations of sampled_with_derivatives, written in place
+        np.multiply(dw, tau, out=out[1])
+        out[1] /= tp
+        np.divide(dw, tp, out=out[2])
+        return slice(k.start + i0, k.start + max(i0, i1)), out
+
+    @classmethod
+    def sampled_on_grid(cls, tp: float, t0: float, t, dt: float) -> np.ndarray:
+        """:meth:`sampled` on uniform sample times ``t`` (step ``dt``, s), computed on the pulse's
+        support only (:meth:`support_slice`): the same values, zero elsewhere."""
+        out = np.zeros(t.size)
+        k = cls.support_slice(tp, t0, float(t[0]), dt, t.size) if t.size else slice(0, 0)
+        out[k] = cls.sampled(tp, t0, t[k], dt)
+        return out
 
     @classmethod
     def cornered(cls) -> bool:
@@ -304,6 +351,11 @@ class Rectangular(Pulse):
         d_t0 = (end_moves.astype(float) - start_moves) / dt
         return m, d_tp, d_t0
 
+    @classmethod
+    def support_columns(cls, tp, t0, t, dt):
+        k = cls.support_slice(tp, t0, float(t[0]), dt, t.size)
+        return k, np.stack(cls.sampled_with_derivatives(tp, t0, t[k], dt))
+
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
         start, end = self.support
@@ -337,6 +389,11 @@ class OneSine(Pulse):
     @staticmethod
     def slope(tau):
         return 2.0 * np.pi * np.cos(2.0 * np.pi * tau)
+
+    @classmethod
+    def unit_and_slope(cls, tau):
+        x = 2.0 * np.pi * tau  # the same operations as unit and slope, the angle once
+        return np.sin(x), 2.0 * np.pi * np.cos(x)
 
     @staticmethod
     def spectrum(nu):
@@ -395,6 +452,12 @@ class SymmetricRicker(_Ricker):
         x2 = (np.pi * tau) ** 2
         return -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * np.exp(-x2)
 
+    @classmethod
+    def unit_and_slope(cls, tau):
+        x2 = (np.pi * tau) ** 2
+        e = np.exp(-x2)  # the same operations as unit and slope, the exponential once
+        return (1.0 - 2.0 * x2) * e, -2.0 * np.pi**2 * tau * (3.0 - 2.0 * x2) * e
+
     @staticmethod
     def spectrum(nu):
         # w = -(1/(2 pi^2)) g'' with g = exp(-pi^2 tau^2), G(nu) = exp(-nu^2)/sqrt(pi)
@@ -445,6 +508,13 @@ class AntisymmetricRicker(_Ricker):
         x = 2.0 * np.pi * tau / np.sqrt(3.0)
         x2 = x * x
         return _ANTI_X * (-x2 * x2 + 6.0 * x2 - 3.0) * np.exp(-0.5 * x2) / BETA
+
+    @classmethod
+    def unit_and_slope(cls, tau):
+        x = 2.0 * np.pi * tau / np.sqrt(3.0)
+        x2 = x * x
+        e = np.exp(-0.5 * x2)  # the same operations as unit and slope, the exponential once
+        return (x2 - 3.0) * x * e / BETA, _ANTI_X * (-x2 * x2 + 6.0 * x2 - 3.0) * e / BETA
 
     @staticmethod
     def spectrum(nu):

@@ -22,6 +22,7 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
+from .cwt import BLAS_PRODUCT, _products
 from .lsq import levenberg_marquardt
 
 #: periods scanned by the weighted search of a shape with corners before its descent, within a
@@ -59,7 +60,7 @@ def gram(U, Vw):
         ``sum(Re(U) Re(Vw) + Im(U) Im(Vw))`` over the bins (computed on the arrays' float views),
         which is ``u' S^-1 v`` when ``w`` are the weights of :meth:`pulses.fit.Background.weights`.
     """
-    return np.einsum("ik,jk->ij", U.view(float), Vw.view(float))
+    return _products(U.view(float), Vw.view(float))
 
 
 def difference_covariance(U, B, w, nfft):
@@ -135,6 +136,7 @@ class WeightedWindow:
 
     def __init__(self, cls, xw, tw, dt, weights, baseline, tp):
         self.cls, self.tw, self.dt, self.baseline = cls, tw, dt, baseline
+        self.t_first = float(tw[0])
         self.nfft = nfft = sfft.next_fast_len(tw.size, real=True)
         self.w = w = weights(nfft)
         X = sfft.rfft(xw, nfft)
@@ -155,14 +157,15 @@ class WeightedWindow:
         self.shifts = np.fft.fftfreq(nfft, 1.0 / nfft)  # sample shift of each lag of the correlation
         self.k_near = np.flatnonzero(np.abs(self.shifts) <= max(2, int(GLS_SHIFT * tp / dt)))
         # irfft counts the interior bins twice, which the weights already do
-        self.Xw_half = Xw * np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+        self.half = np.where((np.arange(w.size) == 0) | (2 * np.arange(w.size) == nfft), 1.0, 0.5)
+        self.Xw_half = Xw * self.half
+        # computed on first use by the scans: the record whitened in time, irfft(Xw_half) nfft,
+        # and the circulant's kernel (:meth:`norms`)
+        self.whitened = self.kernel = None
 
     def support(self, tp_, t0_):
         """Slice of the window's samples where the pulse ``(tp_, t0_)`` (s) may be non-zero."""
-        tw, dt = self.tw, self.dt
-        a = max(0, int(math.floor((t0_ + self.sup_lo * tp_ - tw[0]) / dt)) - 1)
-        b = min(tw.size, int(math.ceil((t0_ + self.sup_hi * tp_ - tw[0]) / dt)) + 2)
-        return slice(a, max(a, b))
+        return self.cls.support_slice(tp_, t0_, self.t_first, self.dt, self.tw.size)
 
     # columns are built zero-padded to the FFT's length, which spares the FFT a padded copy
     def sampled(self, tp_, t0_):
@@ -176,68 +179,100 @@ class WeightedWindow:
         """The unit pulse and its derivatives with respect to ``tp`` and ``t0`` (per s),
         zero-padded: shape ``(3, nfft)``."""
         out = np.zeros((3, self.nfft))
-        k = self.support(tp_, t0_)
-        out[:, k] = self.cls.sampled_with_derivatives(tp_, t0_, self.tw[k], self.dt)
+        k, columns = self.cls.support_columns(tp_, t0_, self.tw, self.dt)
+        out[:, k] = columns
         return out
 
     def products(self, cols):
         """Weighted ``u'v`` among the columns ``cols`` (shape ``(k, nfft)``; overwritten) and with
-        the record, the baseline projected out: ``(UU, UX)`` of shapes ``(k, k)`` and ``(k,)``."""
+        the record, the baseline projected out: ``(UU, UX)``, lists of floats of shapes ``(k, k)``
+        and ``(k,)`` (the small algebra in Python floats: cheaper than numpy calls at this size)."""
         U = sfft.rfft(cols, axis=-1, overwrite_x=True)
-        UU, UF = gram(U, U * self.w), gram(U, self.fixed)
-        UX = UF[:, 0]
-        if self.baseline:
-            UB = UF[:, 1:]
-            UU -= UB @ self.BB_inv @ UB.T
-            UX = UX - UB @ self.BB_inv @ self.BX
+        k = U.shape[0]
+        UF = gram(U, np.concatenate((U * self.w, self.fixed))).tolist()  # columns, record, baseline
+        UU, UX = [row[:k] for row in UF], [row[k] for row in UF]
+        if self.baseline:  # less (UB BB^-1) UB' and (UB BB^-1) BX
+            (b00, b01), (b10, b11) = self.BB_inv.tolist()
+            bx0, bx1 = self.BX.tolist()
+            for i, row in enumerate(UF):
+                c0, c1 = row[k + 1] * b00 + row[k + 2] * b10, row[k + 1] * b01 + row[k + 2] * b11
+                UU[i] = [UU[i][j] - (c0 * UF[j][k + 1] + c1 * UF[j][k + 2]) for j in range(k)]
+                UX[i] -= c0 * bx0 + c1 * bx1
         return UU, UX
 
     def profiled(self, tp_, t0_):
         """``(cost, ap)``: the weighted sum of squares of the record less the pulse ``(tp_, t0_)``
         of least-squares amplitude ``ap`` (record units), and that amplitude."""
         UU, UX = self.products(self.sampled(tp_, t0_))
-        return self.xx - UX[0] ** 2 / max(UU[0, 0], 1e-300), UX[0] / max(UU[0, 0], 1e-300)
+        return self.xx - UX[0] ** 2 / max(UU[0][0], 1e-300), UX[0] / max(UU[0][0], 1e-300)
 
     def normal(self, p):
         """The normal equations at ``p = (ap, tp, t0)`` for :func:`pulses.lsq.levenberg_marquardt`:
-        ``(r'S^-1 r, J'S^-1 J, J'S^-1 r)`` with ``r`` the residual and ``J = dr/dp``."""
-        a = p[0]
+        ``(r'S^-1 r, J'S^-1 J, J'S^-1 r)`` with ``r`` the residual and ``J = dr/dp`` (nested lists
+        of floats)."""
+        a = float(p[0])
         UU, UX = self.products(self.sampled_with_derivatives(max(p[1], 1e-9), p[2]))
-        d = np.array([1.0, a, a])
-        ur = UX - a * UU[:, 0]  # u' S^-1 r for r = x - a m
-        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0, 0]
-        return cost, UU * np.outer(d, d), -d * ur
+        d = (1.0, a, a)
+        ur = [UX[i] - a * UU[i][0] for i in range(3)]  # u' S^-1 r for r = x - a m
+        cost = self.xx - 2.0 * a * UX[0] + a * a * UU[0][0]
+        return (cost, [[UU[i][j] * (d[i] * d[j]) for j in range(3)] for i in range(3)],
+                [-d[i] * ur[i] for i in range(3)])
 
     def difference_covariance(self, ap, tp_, t0_):
         """:func:`difference_covariance` at the plain estimate ``(ap, tp_, t0_)`` on this window."""
         U = sfft.rfft(self.sampled_with_derivatives(tp_, t0_), axis=-1) * np.array([[1.0], [ap], [ap]])
         return difference_covariance(U, self.B if self.baseline else None, self.w, self.nfft)
 
-    def scan(self, tps, t0s, whitened=None):
+    def scan(self, tps, t0s, reach=None):
         """The best of the pulses ``(tps, t0s)`` (arrays, s), each moved by its best whole-sample
         shift, by the weighted gain ``(u'S^-1 x)^2 / u'S^-1 u``: its ``(tp, t0)``.
 
-        Given the record ``whitened`` (in time, ``irfft(Xw)``: its circular cross-correlation with
-        ``u`` at lag ``m`` is ``u'S^-1 x`` for ``u`` moved by ``m`` samples), the shifts are within 2
-        samples, summed over the pulses' support instead of an inverse FFT each."""
+        The shifts are within ``reach`` samples (default: :data:`GLS_SHIFT` of the window's
+        period, at least 2).  ``u'S^-1 x`` for ``u`` moved by ``m`` samples is the circular
+        cross-correlation at lag ``m`` of ``u`` with the record whitened (``irfft(Xw)``, in time):
+        for short pulses and few shifts summed over the pulses' support, with ``u'S^-1 u`` from
+        ``u``'s autocorrelation, whose transform is as short as twice the support
+        (:meth:`norms`); otherwise by one transform of each pulse over the window."""
         tw, dt, nfft = self.tw, self.dt, self.nfft
         # every candidate sampled at once, over the union of their supports
         a = max(0, int(math.floor((np.min(t0s + self.sup_lo * tps) - tw[0]) / dt)) - 1)
         b = max(a, min(tw.size, int(math.ceil((np.max(t0s + self.sup_hi * tps) - tw[0]) / dt)) + 2))
-        cols = np.zeros((len(tps), nfft))
-        cols[:, a:b] = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
-        M = sfft.rfft(cols, axis=-1, overwrite_x=whitened is None)  # the sums below need cols
-        mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
-        if whitened is None:
-            lags = self.shifts[self.k_near]
-            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, self.k_near] * nfft
-        else:
-            lags = np.arange(-2, 3)
-            corr = np.einsum("ij,lj->il", cols[:, a:b], whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        cols = self.cls.sampled(tps[:, None], t0s[:, None], tw[a:b], dt)
+        lags = self.shifts[self.k_near].astype(int) if reach is None else np.arange(-reach, reach + 1)
+        if cols.size * lags.size <= BLAS_PRODUCT:  # short pulses, few shifts: sums in time
+            mm = self.norms(cols)
+            if self.whitened is None:
+                self.whitened = sfft.irfft(self.Xw_half, nfft) * nfft
+            corr = _products(cols, self.whitened[(np.arange(a, b)[None] + lags[:, None]) % nfft])
+        else:  # one transform of each candidate and one inverse transform for all its shifts
+            padded = np.zeros((len(tps), nfft))
+            padded[:, a:b] = cols
+            M = sfft.rfft(padded, axis=-1, overwrite_x=True)
+            mm = np.einsum("ik,ik->i", M.view(float), (M * self.w).view(float))
+            corr = sfft.irfft(self.Xw_half * M.conj(), nfft, axis=-1)[:, lags % nfft] * nfft
         j = np.argmax(np.abs(corr), axis=1)
         gain = corr[np.arange(j.size), j] ** 2 / np.maximum(mm, 1e-300)
         i = int(np.argmax(gain))
         return tps[i], t0s[i] + lags[j[i]] * dt
+
+    def norms(self, cols):
+        """``u'S^-1 u`` of each row ``u`` of ``cols`` (shape ``(k, m)``: samples on ``m`` consecutive
+        samples of the window, zero elsewhere).
+
+        ``sum(w |U|^2)`` over the bins is ``nfft sum_l h_l R_l``, with ``R`` the autocorrelation of
+        ``u`` and ``h = irfft(w_half)`` the circulant's kernel: ``R`` vanishes beyond ``m - 1``
+        lags, so it is computed by transforms of about ``2 m`` points instead of ``nfft``."""
+        m = cols.shape[1]
+        if 2 * m - 1 > self.nfft:  # no shorter than the window's own transform
+            U = sfft.rfft(cols, self.nfft, axis=-1)
+            return np.einsum("ik,ik->i", U.view(float), (U * self.w).view(float))
+        if self.kernel is None:  # h_0 and 2 h_l for l > 0: R is even
+            self.kernel = sfft.irfft(self.w * self.half, self.nfft) * self.nfft
+            self.kernel[1:] *= 2.0
+        n = sfft.next_fast_len(2 * m - 1, real=True)
+        F = sfft.rfft(cols, n, axis=-1)
+        R = sfft.irfft(F.real**2 + F.imag**2, n, axis=-1)[:, :m]
+        return _products(R, self.kernel[None, :m])[:, 0]
 
     def descent(self, tp_, t0_, lower, upper):
         """``(p, cost)``: Levenberg-Marquardt from ``(tp_, t0_)`` and its profiled amplitude, inside
@@ -267,9 +302,7 @@ class WeightedWindow:
             (hi_ - lo_) * p_new[1] + dt * np.arange(-GLS_LATTICE_SPAN, GLS_LATTICE_SPAN + 1) / GLS_LATTICE,
             p_new[2] + lo_ * p_new[1] + dt * (np.arange(GLS_LATTICE) / GLS_LATTICE - 0.5)))
         tps = widths / (hi_ - lo_)
-        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps,
-                                                          sfft.irfft(self.Xw_half, self.nfft) * self.nfft),
-                                               lower, upper)
+        p_lattice, cost_lattice = self.descent(*self.scan(tps, starts - lo_ * tps, reach=2), lower, upper)
         if cost_lattice < cost:
             p_new, cost = p_lattice, cost_lattice
         return p_new, cost

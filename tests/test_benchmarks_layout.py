@@ -86,3 +86,18 @@ def test_work_precision_table_from_plain_results():
         "| fast taylor, 8 steps/Tp | 2 | 100 µs (90 µs) | 2.0e-08 | 1.5e-08 | 0 |",
         "| reference | 2 | 500 ms | (the yardstick) | | |",
         "| usual | 2 | 100 ms (one run) | 1.0e-03 | 1.0e-03 | 1 |"]
+
+
+def test_fit_records_lines_from_the_data():
+    from benchmarks import bench_fit_records
+
+    r = dict(baseline="abc1234", rounds=3, records=15, directions=36, same_ranking_and_weighting=True,
+             max_rel_difference=dict(ap=1.5e-14, tp=2e-15, t0=0.0, score=3e-13),
+             baseline_record_s=0.026, this_record_s=0.013, baseline_direction_s=0.03, this_direction_s=0.012,
+             baseline_all_s=0.028, this_all_s=0.0125, ratio_all=0.028 / 0.0125)
+    md = bench_fit_records.lines(r)
+    assert md[1:6] == ["| cases | before | now | ratio |", "|---|---|---|---|",
+                       "| 15 AT2 records | 26.0 ms | 13.0 ms | 2.00x |",
+                       "| 36 directions of 3 pairs | 30.0 ms | 12.0 ms | 2.50x |",
+                       "| all | 28.0 ms | 12.5 ms | **2.24x** |"]
+    assert "ap 1.5e-14, Tp 2.0e-15, t0 0.0e+00, score 3.0e-13" in md[6]

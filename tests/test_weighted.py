@@ -337,3 +337,94 @@ def test_projector_removes_the_straight_line_and_nothing_else():
     np.testing.assert_allclose(project(rows), rows @ reference.T, atol=1e-12)
     assert baseline_projector(tw, False)(v) is v
     assert math.isclose(float(project(v) @ tw), 0.0, abs_tol=1e-9)
+
+
+# -- the fitter's fast paths against the plain formulas ----------------------------------------------
+@pytest.mark.parametrize("shape", ["rect", "sine", "ricker-sym", "ricker-anti"])
+def test_support_columns_are_sampled_with_derivatives(shape):
+    """Computed on the support only, the same values bit for bit (the same operations), zero
+    elsewhere, for pulses inside, across the ends of and outside a window."""
+    cls = shape_class(shape)
+    tw = 2.0 + 0.005 * np.arange(3000)
+    for tp, t0 in ((0.7, 3.0), (2.3, 1.0), (1.1, 16.5), (0.3, 10.0017), (1.0, 30.0), (1.0, -10.0)):
+        k, columns = cls.support_columns(tp, t0, tw, 0.005)
+        placed = np.zeros((3, tw.size))
+        placed[:, k] = columns
+        assert np.array_equal(placed, np.stack(cls.sampled_with_derivatives(tp, t0, tw, 0.005)))
+        assert np.array_equal(cls.sampled_on_grid(tp, t0, tw, 0.005), cls.sampled(tp, t0, tw, 0.005))
+
+
+@pytest.mark.parametrize("shape", ["sine", "ricker-sym", "ricker-anti"])
+@pytest.mark.parametrize("baseline", [True, False])
+@pytest.mark.parametrize("noise", [0.1, 1e-9])
+def test_pulse_normal_equations_are_those_of_the_projected_residual(shape, baseline, noise):
+    """:func:`pulses.lsq.pulse_normal_equations` (products on the pulse's support, the projector
+    applied algebraically) against :func:`normal_equations` of the residual ``xp - ap P m`` and its
+    Jacobian formed on the whole window.  Two roundings of the same sums over ~400 samples:
+    ``J'J`` to 1e-10 of its largest entry, ``J'r`` to 1e-12 of ``||J|| ||xp||`` (near the exact fit its
+    entries are differences of products that large).  With noise 1e-9 the pulse explains all but
+    1e-18 of the record and the cost comes from the residual itself (COST_EXPLICIT): still 1e-10
+    relative."""
+    from pulses.lsq import pulse_normal_equations
+
+    cls = shape_class(shape)
+    rng = np.random.default_rng(5)
+    tw = 1.0 + DT * np.arange(N)
+    xw = 1.3 * cls.sampled(0.8, 3.0, tw, DT) + noise * rng.normal(size=N) + 0.02 + 0.01 * tw
+    project = baseline_projector(tw, baseline)
+    xp = project(xw)
+
+    def residual_and_jacobian(p):
+        cols = project(np.stack(cls.sampled_with_derivatives(p[1], p[2], tw, DT)))
+        cols[1:] *= p[0]
+        return xp - p[0] * cols[0], -cols.T
+
+    fast = pulse_normal_equations(cls, xp, tw, DT, baseline)
+    reference = normal_equations(residual_and_jacobian)
+    for p in (np.array([1.3, 0.8, 3.0]), np.array([1.1, 0.83, 2.97]), np.array([-0.4, 1.4, 4.6])):
+        (cost, A, g), (cost_ref, A_ref, g_ref) = fast(p), reference(p)
+        assert cost == pytest.approx(cost_ref, rel=1e-10)
+        scale = np.abs(A_ref).max()
+        np.testing.assert_allclose(np.array(A), A_ref, rtol=0, atol=1e-10 * scale)
+        np.testing.assert_allclose(np.array(g), g_ref, rtol=0, atol=1e-12 * math.sqrt(scale * (xp @ xp)))
+
+
+def test_small_solve_is_numpys():
+    """Gaussian elimination with partial pivoting against LAPACK's on the damped normal
+    equations' sizes (3 and 5 unknowns, condition numbers up to ~1e6): 1e-9 relative; a singular
+    system raises numpy's LinAlgError."""
+    from pulses.lsq import _solve_small
+
+    rng = np.random.default_rng(2)
+    for k in (3, 5):
+        for scale in (1.0, 1e3):
+            J = rng.normal(size=(20, k)) * np.logspace(0, math.log10(scale), k)
+            M, b = J.T @ J, rng.normal(size=k)
+            np.testing.assert_allclose(_solve_small(M.tolist(), b.tolist()), np.linalg.solve(M, b), rtol=1e-9)
+    with pytest.raises(np.linalg.LinAlgError):
+        _solve_small([[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [0.0, 1.0, 1.0]], [1.0, 1.0, 1.0])
+
+
+@pytest.mark.parametrize("shape, tp", [("sine", 0.5), ("rect", 0.6), ("ricker-sym", 1.0)])
+def test_weighted_norms_and_scan_paths(shape, tp, window, monkeypatch):
+    """``u'S^-1 u`` from autocorrelations of twice the support (:meth:`WeightedWindow.norms`)
+    against :func:`gram` of the full transforms: 1e-12 relative (two roundings of sums of ~100
+    products).  The scan's two ways (sums in time for short pulses, a transform of each pulse
+    otherwise, forced here by a zero BLAS_PRODUCT) pick the same pulse and shift."""
+    import pulses.weighted as weighted
+
+    cls = shape_class(shape)
+    _, tw, xw = window
+    gls = WeightedWindow(cls, xw, tw, DT, weights, True, tp)
+    tps = tp * np.exp(np.linspace(-0.1, 0.1, 9))
+    t0s = 3.0 + cls.centre_tau * (tp - tps)
+    a = 20
+    cols = cls.sampled(tps[:, None], t0s[:, None], tw[a:a + 150], DT)
+    padded = np.zeros((tps.size, gls.nfft))
+    padded[:, a:a + 150] = cols
+    U = sfft.rfft(padded, axis=-1)
+    reference = np.einsum("ik,ik->i", U.view(float), (U * gls.w).view(float))
+    np.testing.assert_allclose(gls.norms(cols), reference, rtol=1e-12)
+    short = gls.scan(tps, t0s)
+    monkeypatch.setattr(weighted, "BLAS_PRODUCT", 0)
+    assert gls.scan(tps, t0s) == pytest.approx(short, rel=1e-12)
