@@ -42,8 +42,10 @@ class SearchSettings:
     ``w``: every width of the fixed grid ``top (1 + record_fine)^-k`` in
     ``(w, w (1 + record_fine_span)]`` is run (0.05 % apart: failing slivers of real records are
     often thinner than 0.2 %, and lie up to ~25 % above the main transition; README "Design" has
-    the measurements), from its widest width down in batches of ``record_chunk`` (one batch of the
-    batch engine's lanes per core), stopping at the first batch with a failure.  An optional extra
+    the measurements), from its widest width down in batches (one batch of the batch engine's
+    lanes per core): the grid's blocks of ``record_chunk`` indices ``k``, fixed on the grid, so
+    that a level's and its overturning design's searches run the same batches where their zones
+    overlap; stopping at the first batch with a failure.  An optional extra
     zone (``record_zone_points``, off by default: the fine zone covers it) of widths ``w (1 + d)``,
     ``d`` geometric from ``record_zone_first`` to ``record_zone_fraction``;
     ``record_zone_first / 4`` is also the bisection tolerance of candidates.  Above the

@@ -860,8 +860,8 @@ def _record_search(height, top, evaluate, *, criterion, eta, settings=DEFAULT_SE
        ``record_zone_first`` to ``record_zone_fraction``;
     4. the fine zone: every width of the fixed grid ``top (1 + record_fine)^-k`` between ``w`` and
        ``w (1 + record_fine_span)`` not run yet (0.05 % apart, up to 20 % above ``w``), run from
-       the widest down ``record_chunk`` at a time and stopped at the first batch with a
-       failure (the widths below it cannot move the answer);
+       the widest down a block of ``record_chunk`` grid indices at a time and stopped at the
+       first batch with a failure (the widths below it cannot move the answer);
     5. above ``w``, every gap between scanned widths wider than ``record_gap`` (relative) is
        halved, repeatedly, while either end reached ``max|theta|/alpha >= record_near``;
     6. a failure found in 3-5 moves the candidate up (back to 2; at most ``record_rounds``
@@ -938,11 +938,13 @@ def _rounds(pts, br, top, s):
             # not run yet (a later round only adds the part above the previous one)
             k_hi = math.floor(math.log(top / hi) / math.log1p(s.record_fine))
             k_lo = max(math.ceil(math.log(top / (hi * (1.0 + s.record_fine_span))) / math.log1p(s.record_fine)), 1)
-            z = top * (1.0 + s.record_fine) ** -np.arange(k_lo, k_hi + 1, dtype=float)
-            z = np.setdiff1d(z[(z > hi) & (z < top)], fine_done)
+            k = np.arange(k_lo, k_hi + 1)
+            z = top * (1.0 + s.record_fine) ** -k.astype(float)
+            keep = (z > hi) & (z < top) & ~np.isin(z, fine_done)
+            z, k = z[keep], k[keep]
             if z.size:
                 fine_done = np.union1d(fine_done, z)
-                found = _run_down(pts, z, s.record_chunk)
+                found = _run_down(pts, z, k // s.record_chunk)
         while not found:
             mids = _near_gaps(pts, hi, s)
             if not mids.size:
@@ -954,13 +956,20 @@ def _rounds(pts, br, top, s):
     return br, rounds, br is not None   # limited: failures were still being found above the candidate
 
 
-def _run_down(pts, widths, chunk) -> bool:
-    """Run ``widths`` from the widest down, ``chunk`` at a time, stopping after the first chunk with
-    a failure: narrower widths cannot change the answer (it lies above the widest failure), so
-    they are not run.  Returns whether any failed."""
-    widths = np.sort(np.asarray(widths, dtype=float))[::-1]
-    for k in range(0, widths.size, chunk):
-        if pts.add(widths[k:k + chunk]).any():
+def _run_down(pts, widths, groups) -> bool:
+    """Run ``widths`` from the widest down, a group at a time (``groups``: each width's, numbered
+    from the widest), stopping after the first group with a failure: narrower widths cannot
+    change the answer (it lies above the widest failure), so they are not run.  Returns whether
+    any failed.
+
+    The groups are fixed blocks of the fine grid (its index over ``record_chunk``), not counted
+    from where a zone starts: two searches of the same column and record (a level's and its
+    overturning design's) whose zones overlap then run the same batches there, which the second
+    answers from the first (:class:`_Runs`: only a whole batch is the same computation)."""
+    order = np.argsort(widths)[::-1]
+    widths, groups = np.asarray(widths, dtype=float)[order], np.asarray(groups)[order]
+    for g in np.unique(groups):
+        if pts.add(widths[groups == g]).any():
             return True
     return False
 

@@ -111,8 +111,15 @@ def test_same_answers_as_the_numba_engine(current, key):
     got = current[key]
     if isinstance(want, dict) and "max_rotation" in want:
         (_batch if isinstance(want["max_rotation"], list) else _single)(want, got, key)
-    elif key.startswith("real/") and key.endswith(("/width", "/critical_scale")):
-        # the answers users see: the 0.5 %, the same transitions found
+    elif key.startswith("real/") and key.endswith("/width"):
+        # the answer users see, to the 0.5 %, and the search's narrowest and widest
+        # transitions; those between are failing slivers the fine zone happened to examine
+        # below the answer, which depend on where its batches start (fixed blocks of the fine
+        # grid since 0.8, rocking.widths._run_down), not on the engine
+        _values(want["width"], got["width"], key, rel=5e-3)
+        ends = lambda t: [t[0], t[-1]] if t else []  # noqa: E731
+        _values(ends(want["transitions"]), ends(got["transitions"]), key, rel=5e-3)
+    elif key.startswith("real/") and key.endswith("/critical_scale"):
         _values(want, got, key, rel=5e-3)
     elif key == "width/synthetic":
         # the transition the numba engine found, raised to 6 significant digits (the design
