@@ -105,6 +105,23 @@ def test_every_pass_runs_in_the_workers_and_logs_its_cpu(tmp_path):
     assert all(e["cpu_seconds"] > 0 and e["stages"]["verify:required_width"] > 0 for e in entries)
 
 
+def test_under_jobs_the_main_process_draws_no_figure_and_never_imports_matplotlib(tmp_path):
+    """With workers, the run's own figures (summary, suite) are drawn in a worker too, asked for by
+    name: the main process never imports matplotlib (half a second, most of its own CPU)."""
+    import subprocess
+    import sys
+
+    pair = _pair(tmp_path, "STF", 0.45, 0.3, 1)
+    code = ("import sys\nfrom pipeline.cli import main\n"
+            f"c = main(['run', '--pair', {str(pair[0])!r}, {str(pair[1])!r}, '--block', '2.0x0.35', "
+            f"'--directions', '2', '--jobs', '2', '--quiet', '--out', {str(tmp_path / 'out')!r}])\n"
+            "print(c, 'matplotlib' in sys.modules)\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert res.stdout.split()[-2:] == ["0", "False"], res.stdout + res.stderr
+    for name in ("summary.png", "suite.png"):
+        assert (tmp_path / "out" / "plots" / name).read_bytes()[:4] == b"\x89PNG"
+
+
 def test_pairs_read_and_classified_in_workers_give_the_same_tasks(tmp_path):
     from pipeline.batch.pairs import pair_tasks
     from pipeline.batch.tasks import Column, Options

@@ -12,6 +12,7 @@ import os
 from .. import interrupts
 from ..args import ArgumentError
 from . import memo
+from ..reports.figures import draw
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, worker_failure
 
 
@@ -272,11 +273,11 @@ def execute(tasks, jobs: int | None = 1, dask: str | None = None, more=None):
 
 @contextlib.contextmanager
 def renderer(away: bool):
-    """``render(fn, *args)``: ``fn(*args)`` (a figure's PNG bytes) in a worker process where
-    ``away`` (the run's records ran elsewhere: the run's own figures, matplotlib included, are no
-    work for this process either), else here.  The worker is started at the first figure."""
+    """``render(name, *args)``: :func:`draw` in a worker process where ``away`` (the run's records
+    ran elsewhere: the run's own figures, matplotlib included, are no work for this process
+    either), else here.  The worker is started at the first figure."""
     if not away:
-        yield lambda fn, *args: fn(*args)
+        yield draw
         return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
@@ -284,14 +285,14 @@ def renderer(away: bool):
 
     pool = None
 
-    def render(fn, *args):
+    def render(name, *args):
         nonlocal pool
         if pool is None:
             methods = multiprocessing.get_all_start_methods()
             ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
             pool = ProcessPoolExecutor(1, mp_context=ctx, initializer=_init_pool_worker,
                                        initargs=(None,))
-        fut = pool.submit(fn, *args)
+        fut = pool.submit(draw, name, *args)
         while True:  # a short wait, so that Ctrl-C stops the run
             try:
                 return fut.result(timeout=0.25)

@@ -13,7 +13,7 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from ..reports import design_table, html_report, outfiles, report
+from ..reports import design_table, figures, html_report, outfiles, report
 
 from .. import interrupts
 
@@ -380,16 +380,11 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed, render)
     if options.plots:
-        from ..reports.plots import summary_figure_png
-
-        outputs.write(report.SUMMARY_PLOT, (render or _here)(summary_figure_png, rows))
+        outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
     outputs.finish()
     return design, rows
 
-
-def _here(fn, *args):
-    return fn(*args)
 
 
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------

@@ -410,25 +410,22 @@ def write_outputs(outputs, rows, fields, options, failed=None, render=None) -> N
     files, from every row of the run (``failed``: ``{pair: directions that failed}``); ``render(fn,
     *args)`` draws a figure (default: here; pipeline.batch.executors.renderer)."""
     from ..reports import report
+    from ..reports.figures import draw
 
-    render = render or (lambda fn, *args: fn(*args))
+    render = render or draw
 
     pair_fields = list(PAIR_COLUMNS.names) + list(fields)
     outputs.write(PAIRS_CSV, report.csv_text(pair_fields, governing_rows(rows, failed)))
     suite = suite_rows(rows) if rows else []
     outputs.write(SUITE_CSV, report.csv_text(list(SUITE_COLUMNS.names), suite))
     if options.plots and rows:
-        from ..reports.plot_site import suite_figure_png
-
-        outputs.write(SUITE_PLOT, render(suite_figure_png, rows, suite))
+        outputs.write(SUITE_PLOT, render("plot_site:suite_figure_png", rows, suite))
     if options.fragility:
         summary, curve, fits = fragility_tables(rows)
         outputs.write(FRAGILITY_CSV, report.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
         outputs.write(FRAGILITY_CURVE_CSV, report.csv_text(list(FRAGILITY_CURVE_COLUMNS.names), curve))
         if options.plots and fits:
-            from ..reports.plot_site import fragility_figure_png
-
-            outputs.write(FRAGILITY_PLOT, render(fragility_figure_png, fits))
+            outputs.write(FRAGILITY_PLOT, render("plot_site:fragility_figure_png", fits))
 
 
 def columns_markdown() -> str:
