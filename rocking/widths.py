@@ -398,7 +398,8 @@ class _Runs:
     batch agrees only to rounding, and the check's later stages, which rank widths by
     max|theta|/alpha, could then pick other widths (measured: 1 of 62 cases).  The same batch is
     the same computation, so the answer is the same as without the sharing, bit for bit.  The
-    batch both designs run is the search's geometric scan (131 widths), and the single widths
+    batch both designs run is the search's geometric scan (131 widths), the fine zone's blocks
+    where their zones overlap (:func:`_run_down`), and the single widths
     at either end of their bisections where they meet."""
 
     def __init__(self, run_widths, overturning, inputs):
@@ -675,7 +676,8 @@ def _overturning_above(res, height, excitation, top, runs, *, eta, gamma, model,
                        settings):
     """The overturning design of the level ``res`` (its search and check done, ``runs`` its runs)
     where it can change the level's answer: its search (answered from the level's batches where
-    they coincide: the geometric scan), and its binned check only above the level's width
+    they coincide: the geometric scan, the fine zone's blocks where the two zones overlap), and
+    its binned check only above the level's width
     (``check_above``).  That check is separable in a threshold (:mod:`rocking.binned`): it runs
     exactly the whole check's widths above it, so the design width is the whole overturning
     design's wherever that exceeds the level's, and at most the level's where not (then the
