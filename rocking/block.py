@@ -32,6 +32,15 @@ def _p_alpha(height: float, width: float, gamma: float) -> tuple[float, float]:
     return frame_p(math.sqrt(3.0 * G / (4.0 * radius)), gamma), math.atan2(width, height)
 
 
+def _restitution(eta, alpha: float, gamma: float, who: str) -> float:
+    """``eta`` checked to lie in [0, 1], or where None Eq. 5 at ``alpha`` (the frame's with
+    ``gamma``, :func:`rocking.frame.eta_frame`; Housner's at ``gamma = 0``)."""
+    value = eta_frame(alpha, gamma) if eta is None else float(eta)
+    if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+        raise ValueError(f"{who}: eta must lie in [0, 1], got {eta!r}")
+    return value
+
+
 @dataclass(frozen=True)
 class Block:
     """A rocking block described by its frequency parameter and slenderness.
@@ -75,12 +84,7 @@ class Block:
         if not (math.isfinite(alpha) and 0.0 < alpha < math.pi / 2):
             raise ValueError(f"Block: alpha must lie in (0, pi/2) rad, got {self.alpha!r}")
         gamma = check_cap_mass_ratio(self.cap_mass_ratio)
-        if self.eta is not None:
-            eta = float(self.eta)
-        else:
-            eta = eta_housner(alpha) if gamma == 0.0 else eta_frame(alpha, gamma)
-        if not (math.isfinite(eta) and 0.0 <= eta <= 1.0):
-            raise ValueError(f"Block: eta must lie in [0, 1], got {self.eta!r}")
+        eta = _restitution(self.eta, alpha, gamma, "Block")
         object.__setattr__(self, "p", p)
         object.__setattr__(self, "alpha", alpha)
         object.__setattr__(self, "eta", eta)
@@ -180,8 +184,8 @@ class Blocks:
         self.alpha = np.ascontiguousarray(alpha, dtype=float).ravel()
         if eta is None:
             self.eta = np.array([eta_frame(a, gamma) for a in self.alpha.tolist()], dtype=float)
-        else:   # checked as a Block checks it
-            self.eta = np.full(self.p.size, Block(1.0, 0.1, eta).eta)
+        else:
+            self.eta = np.full(self.p.size, _restitution(eta, 0.0, gamma, "Blocks"))
         self.cap_mass_ratio, self.height = gamma, height
         self.widths = [None] * self.p.size if widths is None else widths
 
@@ -202,6 +206,16 @@ class Blocks:
         pa = [_p_alpha(height, w, gamma) for w in widths]
         return cls([x[0] for x in pa], [x[1] for x in pa], eta, cap_mass_ratio=gamma,
                    height=height, widths=widths)
+
+    @classmethod
+    def from_tan_alpha(cls, p, tan_alpha, eta: float | None = None, *,
+                       cap_mass_ratio: float = 0.0) -> "Blocks":
+        """Blocks of frequency parameters ``p`` (rad/s) and slenderness ``tan(alpha)``, as
+        :meth:`Block.from_tan_alpha` makes each."""
+        import numpy as np
+
+        alpha = [math.atan(t) for t in np.asarray(tan_alpha, dtype=float).ravel().tolist()]
+        return cls(p, alpha, eta, cap_mass_ratio=cap_mass_ratio)
 
     def __len__(self) -> int:
         return int(self.p.size)

@@ -10,7 +10,7 @@ import numpy as np
 
 from pulses import G, SHAPES, make_pulse
 
-from .block import Block, Blocks
+from .block import Blocks
 from .frame import check_cap_mass_ratio
 from .closed_forms import eq31
 from .search import (DEFAULT_SETTINGS, _batch, _check_criterion, _failed, _peak, _scan_points,
@@ -127,8 +127,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     known[:, -1] = True            # tan(alpha) = ap/g: never uplifts
 
     def evaluate(idx, tans):
-        blocks = Blocks(p_tp[idx], [math.atan(t) for t in np.asarray(tans, dtype=float).tolist()],
-                        cap_mass_ratio=gamma)
+        blocks = Blocks.from_tan_alpha(p_tp[idx], tans, cap_mass_ratio=gamma)
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
     scan = _scan_refine(evaluate, x, settings, known=known, zone=settings.zone_points != 0,
@@ -217,7 +216,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     known[:, -1] = True
 
     def evaluate(idx, tans):
-        blocks = [Block(p, math.atan(t), cap_mass_ratio=gamma) for t in tans]
+        blocks = Blocks.from_tan_alpha(np.full(len(tans), p), tans, cap_mass_ratio=gamma)
         return _failed(_batch(blocks, pulse, None, model=model), criterion)
 
     scan = _scan_refine(evaluate, x, settings, known=known, refine="top",
