@@ -597,11 +597,12 @@ def _record_seed(record, height, criterion, eta, gamma, limit=None) -> int:
     return int.from_bytes(h.digest()[:8], "little")
 
 
-def _check_rounds(res, top, evaluate, settings, seed, seen) -> None:
+def _check_rounds(res, top, evaluate, settings, seed, seen):
     """The check above the search's answer in ``settings.check_rounds`` rounds sharing
     ``settings.check_runs``: each checks above the design width so far (its span starts there)
     and raises it above the widest failing width found (:func:`_raise_to_failures`); the later
-    rounds measure the spread over every width run before them.  Stores the outcome in ``res``."""
+    rounds measure the spread over every width run before them.  Stores the outcome in ``res``;
+    returns every width run ``(widths, failed, ratio)``."""
     rounds = int(settings.check_rounds)
     left = int(settings.check_runs)
     xs, fs, rs = (np.asarray(v) for v in seen)
