@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from .args import ArgumentError
@@ -65,6 +66,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: the BLAS libraries' thread counts, set to 1 for the command unless the user set them
+BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _one_blas_thread() -> None:
+    """One BLAS thread in this process and the worker processes it starts, unless the environment
+    says otherwise.  The package's matrices are small (the pulse fit's), so more threads never
+    speed them up, while OpenBLAS starts one per core as numpy is imported (0.06 s of CPU a
+    process here) and keeps them spinning after each call: the main process of a batch of nine
+    pairs with ``--jobs 2`` spent 1.29 s of CPU with them, 1.11 s without
+    (benchmarks/bench_directions.py).  Only before numpy is imported (as the command starts)
+    does it take effect in this process."""
+    if "numpy" not in sys.modules:
+        for name in BLAS_THREADS:
+            os.environ.setdefault(name, "1")
+
+
 def main(argv=None) -> int:
     """Run the ``pipeline`` command with ``argv``, as the shell does, and return its exit status.
 
@@ -95,6 +113,7 @@ def main(argv=None) -> int:
     """
     from . import interrupts
 
+    _one_blas_thread()
     interrupts.reset()
     # from the start: an interrupt while the sub-commands are imported is not lost either
     with interrupts.handling(to_exit=argv is None):  # argv None: the program itself, about to exit

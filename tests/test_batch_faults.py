@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from pipeline.batch import remote, runner
+from pipeline.batch import executors, remote, runner
 from pipeline.cli import main
 
 from .test_pipeline_run import BATCH_ARGS, read_csv, tree, write_good
@@ -36,10 +36,14 @@ def _check_worker_failure(out, reference, killer="good02"):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("how", [["--jobs", "2"], ["--dask", "local", "--jobs", "2"]], ids=["pool", "dask"])
+@pytest.mark.parametrize("how", [["--jobs", "2"], ["--jobs", "2", "chunks"], ["--dask", "local", "--jobs", "2"]],
+                         ids=["pool", "pool-chunks", "dask"])
 def test_a_worker_killed_at_one_record_fails_that_record_only(how, six, reference, tmp_path, monkeypatch):
     if "--dask" in how:
         pytest.importorskip("dask.distributed")
+    if "chunks" in how:  # records sent three at a time: the killer's chunk mates are run again, alone
+        how = how[:-1]
+        monkeypatch.setattr(executors, "_chunk_size", lambda queued, jobs: min(3, queued))
     import glob
     import tempfile
 
@@ -84,3 +88,14 @@ def test_dask_workers_need_no_access_to_the_inputs(six, reference, tmp_path, mon
     for name, data in reference.items():
         if name.startswith("good"):  # the rows name the path given, so compare the other cells
             assert got[name].replace(str(folder).encode(), os.path.dirname(six[0]).encode()) == data, name
+
+
+def test_records_go_to_the_workers_in_chunks_then_one_at_a_time():
+    # a long queue in chunks of CHUNK, then smaller ones as it empties, the last few alone
+    sizes, queued = [], 200
+    while queued:
+        k = executors._chunk_size(queued, 2)
+        assert 1 <= k <= min(executors.CHUNK, queued)
+        sizes.append(k)
+        queued -= k
+    assert sizes[0] == executors.CHUNK and sizes[-8:] == [1] * 8 and sizes == sorted(sizes, reverse=True)

@@ -54,3 +54,20 @@ def test_importing_the_packages_loads_no_numerics():
     code = "import sys, pulses, rocking; print(sorted(m for m in ('numpy', 'scipy') if m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
+
+
+@pytest.mark.parametrize("given", [None, "3"])
+def test_the_command_runs_one_blas_thread_unless_told_otherwise(given):
+    # numpy is imported by the command itself, after the setting, so numpy's BLAS and the worker
+    # processes the command starts see it; a value the user set stays
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    code = ("import os, sys\nfrom pipeline.cli import main\nassert 'numpy' not in sys.modules\n"
+            "main(['design', '--block', '7.5x1.8', '--pulse', 'sine', '--ap', '0.5g', '--tp', '1'])\n"
+            "assert 'numpy' in sys.modules\n"
+            "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['MKL_NUM_THREADS'])\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+    assert out.stdout.split()[-2:] == [given or "1", "1"]

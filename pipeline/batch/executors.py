@@ -13,7 +13,7 @@ from .. import interrupts
 from ..args import ArgumentError
 from . import memo
 from ..reports.figures import draw
-from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, worker_failure
+from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, work_many, worker_failure
 
 
 def _serial(tasks, more=None):
@@ -61,8 +61,9 @@ def _pool(tasks, jobs, more=None):
     # records in the pool when a worker process died: each is run once more alone, so that the
     # one that kills its worker is known and fails, and the others complete
     suspects = collections.deque()
-    # at most this many records submitted at once: a few queued per worker keep them busy, and a
-    # dead worker makes only these suspects (and the pool holds no future per record of a long batch)
+    # at most this many submissions (chunks of records, _chunk_size) at once: a few queued per
+    # worker keep them busy, and a dead worker makes only their records suspects (and the pool
+    # holds no future per record of a long batch)
     window = 2 * jobs
     pool = None
     finished = False
@@ -92,31 +93,32 @@ def _pool(tasks, jobs, more=None):
             broken = False
             while (queue or running) and not broken:
                 while queue and len(running) < window:
-                    task = queue.popleft()
+                    chunk = [queue.popleft() for _ in range(_chunk_size(len(queue), jobs))]
                     try:
-                        running[pool.submit(work, task)] = task
+                        running[pool.submit(work_many, chunk)] = chunk
                     except BrokenProcessPool:
-                        queue.appendleft(task)
+                        queue.extendleft(reversed(chunk))
                         broken = True
                         break
                 # a short wait, so that an interrupt whose exception was swallowed still stops the run
                 done, _ = wait(running, timeout=0.25, return_when=FIRST_COMPLETED)
                 interrupts.check()
                 for fut in done:
-                    task = running.pop(fut)
+                    chunk = running.pop(fut)
                     try:
-                        yield fut.result()
+                        yield from fut.result()
                     except BrokenProcessPool:
-                        suspects.append(task)
+                        suspects.extend(chunk)
                         broken = True
                     except Exception as exc:  # e.g. a result that cannot be sent back
-                        yield worker_failure(task, exc)
+                        for task in chunk:
+                            yield worker_failure(task, exc)
             if broken:  # every record still in the broken pool is a suspect
-                for fut, task in running.items():
+                for fut, chunk in running.items():
                     if fut.done() and not fut.cancelled() and fut.exception() is None:
-                        yield fut.result()
+                        yield from fut.result()
                     else:
-                        suspects.append(task)
+                        suspects.extend(chunk)
                 pool.shutdown(wait=True)
                 pool = None
         finished = True
@@ -126,6 +128,20 @@ def _pool(tasks, jobs, more=None):
                 pool.shutdown(wait=True)
             else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
                 _stop(pool, others)
+
+
+#: at most this many records go to a worker at once: each submission costs the main process
+#: about a millisecond (the task and its result through the pool's queues and threads), as much
+#: as it spends on the record's result, so a long batch sends them in chunks
+CHUNK = 8
+
+
+def _chunk_size(queued: int, jobs: int) -> int:
+    """How many of the ``queued`` records (largest first) to send in the next submission: up to
+    :data:`CHUNK` while each worker has at least four chunks' worth left, down to one record
+    at a time towards the end of the queue, so that no worker is left idle while another
+    finishes a chunk."""
+    return max(1, min(CHUNK, queued // (4 * jobs)))
 
 
 def _refill(queue, more) -> bool:

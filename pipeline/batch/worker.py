@@ -64,6 +64,12 @@ def work(task: Task) -> dict:
     return res
 
 
+def work_many(tasks: list[Task]) -> list[dict]:
+    """:func:`work` on each of ``tasks`` in turn (a pool's submission of several,
+    :data:`pipeline.batch.executors.CHUNK`)."""
+    return [work(task) for task in tasks]
+
+
 #: the result key of the record's report as CSV text (header and rows), made in the worker so that
 #: the main process only writes it (pipeline.batch.runner)
 TEXT = "text"

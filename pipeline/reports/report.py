@@ -162,12 +162,17 @@ def write_atomic(path, data) -> pathlib.Path:
     arriving during the write takes effect when the file is whole.  Unchanged files are not
     rewritten.
     """
-    from .. import interrupts
-
     path = pathlib.Path(path)
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
     if _regular_file_bytes(path) == raw:
         return path
+    return _replace(path, raw)
+
+
+def _replace(path: pathlib.Path, raw: bytes) -> pathlib.Path:
+    """:func:`write_atomic` once ``path`` is known not to hold ``raw`` already."""
+    from .. import interrupts
+
     path.parent.mkdir(parents=True, exist_ok=True)
     with interrupts.deferred(), named_errors(path):
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name[:40]}.", suffix=".tmp")
@@ -273,7 +278,7 @@ class Outputs:
         if digest not in self._written.get(rel, ()):
             self._journal(f"{digest}  {rel}\n")
             self._written.setdefault(rel, set()).add(digest)
-        return write_atomic(path, raw)
+        return _replace(path, raw)
 
     def remove(self, rel: str) -> bool:
         """Remove the tool's file at ``rel``; True if removed, False if absent; :class:`NotOurs`
