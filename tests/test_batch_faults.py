@@ -43,7 +43,7 @@ def test_a_worker_killed_at_one_record_fails_that_record_only(how, six, referenc
         pytest.importorskip("dask.distributed")
     if "chunks" in how:  # records sent three at a time: the killer's chunk mates are run again, alone
         how = how[:-1]
-        monkeypatch.setattr(executors, "_chunk_size", lambda queued, jobs: min(3, queued))
+        monkeypatch.setattr(executors, "chunk_size", lambda queued, jobs: min(3, queued))
     import glob
     import tempfile
 
@@ -94,7 +94,7 @@ def test_records_go_to_the_workers_in_chunks_then_one_at_a_time():
     # a long queue in chunks of CHUNK, then smaller ones as it empties, the last few alone
     sizes, queued = [], 200
     while queued:
-        k = executors._chunk_size(queued, 2)
+        k = executors.chunk_size(queued, 2)
         assert 1 <= k <= min(executors.CHUNK, queued)
         sizes.append(k)
         queued -= k

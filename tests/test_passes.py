@@ -163,6 +163,24 @@ def test_default_gives_the_thorough_design_width_figures_where_they_inform(pair,
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("how", [("--jobs", "2"), ("--dask", "local", "--jobs", "2")], ids=["pool", "dask"])
+def test_a_pairs_directions_sent_in_chunks_give_the_serial_runs_files(how, pair, tmp_path, monkeypatch):
+    # three records a submission (a pair's directions share their files' bytes under dask); the
+    # passes' tasks arrive in other orders, and every file is the one-process run's
+    if "--dask" in how:
+        pytest.importorskip("dask.distributed")
+    from pipeline.batch import executors
+
+    monkeypatch.setattr(executors, "chunk_size", lambda queued, jobs: min(3, queued))
+    args = ("--block", f"{H}x{B}", "--directions", "6")
+    assert _run(tmp_path / "one", pair, *args) == 0
+    assert _run(tmp_path / "chunks", pair, *args, *how) == 0
+    files = lambda out: {p.relative_to(out): p.read_bytes() for p in out.rglob("*")
+                         if p.is_file()}
+    assert files(tmp_path / "chunks") == files(tmp_path / "one")
+
+
+@pytest.mark.slow
 def test_a_level_gives_the_thorough_design_width_and_its_overturning_design(pair, tmp_path):
     """`--limit 0.5` on a pair in 6 directions: the pair's design width is --thorough's; every
     direction's design width is at least its overturning design width (overturning_width_m), and

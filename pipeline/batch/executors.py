@@ -61,7 +61,7 @@ def _pool(tasks, jobs, more=None):
     # records in the pool when a worker process died: each is run once more alone, so that the
     # one that kills its worker is known and fails, and the others complete
     suspects = collections.deque()
-    # at most this many submissions (chunks of records, _chunk_size) at once: a few queued per
+    # at most this many submissions (chunks of records, chunk_size) at once: a few queued per
     # worker keep them busy, and a dead worker makes only their records suspects (and the pool
     # holds no future per record of a long batch)
     window = 2 * jobs
@@ -93,7 +93,7 @@ def _pool(tasks, jobs, more=None):
             broken = False
             while (queue or running) and not broken:
                 while queue and len(running) < window:
-                    chunk = [queue.popleft() for _ in range(_chunk_size(len(queue), jobs))]
+                    chunk = [queue.popleft() for _ in range(chunk_size(len(queue), jobs))]
                     try:
                         running[pool.submit(work_many, chunk)] = chunk
                     except BrokenProcessPool:
@@ -136,7 +136,7 @@ def _pool(tasks, jobs, more=None):
 CHUNK = 8
 
 
-def _chunk_size(queued: int, jobs: int) -> int:
+def chunk_size(queued: int, jobs: int) -> int:
     """How many of the ``queued`` records (largest first) to send in the next submission: up to
     :data:`CHUNK` while each worker has at least four chunks' worth left, down to one record
     at a time towards the end of the queue, so that no worker is left idle while another

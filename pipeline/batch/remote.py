@@ -3,10 +3,12 @@
 The client reads each record's file and sends its bytes with the task, so a worker needs no access
 to the input paths (no shared file system): it writes them to a private temporary folder under the
 file's own name (the readers use the name's extension) and reads them from there.  Records are
-submitted a window at a time, so the client holds the bytes of only a few records at once.
+submitted a window at a time, so the client holds the bytes of only a few records at once, and in
+chunks as ``--jobs`` sends them (:func:`pipeline.batch.executors.chunk_size`): a pair's directions
+together, its files sent once.
 
-A record whose worker dies (the task comes back with an error instead of a result) is submitted
-once more, alone among the retried records; if that attempt fails too it is a ``worker`` failure.
+A record whose worker dies (the task comes back with an error instead of a result; every record of
+its chunk) is submitted once more, alone among the retried records; if that attempt fails too it is a ``worker`` failure.
 On a local cluster the scheduler gives up on a task at its first worker death
 (``distributed.scheduler.allowed-failures`` 0), so the retry is this module's; a remote scheduler
 retries by its own setting first (3 by default).
@@ -46,31 +48,38 @@ def _scratch() -> str | None:
         return None
 
 
-def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
-    """Run on a worker: :func:`pipeline.batch.worker.work` on ``data`` (and ``data2``, the second file of
-    a pair), written to private files named as the originals; the result names the original paths."""
+def work_on_bytes(tasks: list[Task], blobs: dict) -> list[dict]:
+    """Run on a worker: :func:`pipeline.batch.worker.work` on each of ``tasks``, their files
+    (``blobs``: path -> bytes, each file once: a pair's directions share theirs) written to private
+    files named as the originals; the results name the original paths."""
     from . import worker
 
     if not worker._in_worker:
         worker.init_worker()  # also in a worker the nanny restarted after a death
     folder = tempfile.mkdtemp(prefix="pipeline-record-", dir=_scratch())
-    swaps = {}
     try:
         local = {}
-        for sub, path, raw in (("1", task.path, data), ("2", task.path2, data2)):
-            if path is None:
-                continue
-            os.mkdir(os.path.join(folder, sub))  # two files of a pair may have the same name
-            local[sub] = os.path.join(folder, sub, os.path.basename(path) or "record")
-            with open(local[sub], "wb") as fh:
+        for n, (path, raw) in enumerate(blobs.items()):
+            os.mkdir(os.path.join(folder, str(n)))  # two files of a pair may have the same name
+            local[path] = os.path.join(folder, str(n), os.path.basename(path) or "record")
+            with open(local[path], "wb") as fh:
                 fh.write(raw)
-            swaps[local[sub]] = path
-        changes = {"path": local["1"]}
-        if "2" in local:
-            changes["path2"] = local["2"]
-        res = worker.work(dataclasses.replace(task, **changes))
+        out = []
+        for task in tasks:
+            changes = {"path": local[task.path]}
+            if task.path2 is not None:
+                changes["path2"] = local[task.path2]
+            res = worker.work(dataclasses.replace(task, **changes))
+            out.append(_as_given(res, task, {local[p]: p for p in (task.path, task.path2) if p is not None}))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+    return out
+
+
+def _as_given(res: dict, task: Task, swaps: dict) -> dict:
+    """``res`` of ``task`` run on private copies (``swaps``: copy -> original), naming the originals."""
+    from . import worker
+
     res["file"] = task.path
     for row in res["rows"]:
         row["file"] = task.path
@@ -84,6 +93,22 @@ def work_on_bytes(task: Task, data: bytes, data2: bytes | None = None) -> dict:
     return res
 
 
+def _files(task: Task) -> tuple:
+    return (task.path,) if task.path2 is None else (task.path, task.path2)
+
+
+def _next_chunk(queue, workers: int) -> list[Task]:
+    """The next records to send together: up to :func:`pipeline.batch.executors.chunk_size` of
+    them, from the queue's head, reading the same files (a pair's directions)."""
+    from .executors import chunk_size
+
+    chunk = [queue.popleft()]
+    k = chunk_size(len(queue) + 1, workers)
+    while queue and len(chunk) < k and _files(queue[0]) == _files(chunk[0]):
+        chunk.append(queue.popleft())
+    return chunk
+
+
 def run_dask(tasks, client, workers: int):
     """Results of every task on ``client``'s cluster, in completion order."""
     from dask.distributed import as_completed
@@ -94,49 +119,44 @@ def run_dask(tasks, client, workers: int):
     retries = collections.deque()  # records whose worker died once: one at a time
     window = max(4, 4 * workers)
     pending = as_completed()
-    owner = {}  # future key -> (task, attempt)
+    owner = {}  # future key -> (tasks, attempt)
     retrying = [False]
 
-    def submit(task, attempt):
-        data = read_bytes(task.path)
-        data2 = None if task.path2 is None else read_bytes(task.path2)
-        if data is None or (task.path2 is not None and data2 is None):
-            return process_record(task)  # fails at reading, as it would anywhere
-        fut = client.submit(work_on_bytes, task, data, data2, pure=False,
-                            key=f"record-{task.index}-{attempt}-{uuid.uuid4().hex}")
-        owner[fut.key] = (task, attempt)
+    def submit(chunk, attempt):
+        """Send ``chunk``; return the results of those that fail at reading on this client."""
+        blobs = {p: read_bytes(p) for p in dict.fromkeys(p for t in chunk for p in _files(t))}
+        if any(raw is None for raw in blobs.values()):
+            return [process_record(t) for t in chunk]  # fails at reading, as it would anywhere
+        fut = client.submit(work_on_bytes, chunk, blobs, pure=False,
+                            key=f"record-{chunk[0].index}-{attempt}-{uuid.uuid4().hex}")
+        owner[fut.key] = (chunk, attempt)
         pending.add(fut)
-        return None
+        return []
 
     def fill():
         done = []
         if retries and not retrying[0]:
             retrying[0] = True
-            res = submit(retries.popleft(), 2)
-            if res is not None:
+            res = submit([retries.popleft()], 2)
+            if res:
                 retrying[0] = False
-                done.append(res)
+                done += res
         while queue and len(owner) < window:
-            res = submit(queue.popleft(), 1)
-            if res is not None:
-                done.append(res)
+            done += submit(_next_chunk(queue, workers), 1)
         return done
 
     yield from fill()
     while owner:
         fut = next(pending)
-        task, attempt = owner.pop(fut.key)
+        chunk, attempt = owner.pop(fut.key)
         if attempt == 2:
             retrying[0] = False
         try:
-            res = fut.result()
+            results = fut.result()
         except Exception as exc:  # the worker died (or the scheduler lost it)
+            results = [] if attempt == 1 else [worker_failure(t, exc) for t in chunk]
             if attempt == 1:
-                retries.append(task)
-                res = None
-            else:
-                res = worker_failure(task, exc)
+                retries.extend(chunk)
         fut.release()
-        if res is not None:
-            yield res
+        yield from results
         yield from fill()
