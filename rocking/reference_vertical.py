@@ -25,7 +25,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from pulses import G, Record
 
@@ -206,6 +205,10 @@ class _Run:
             a = abs(rhs(t, [0.0, 0.0])[1])
             if a > 0:
                 first_step = min(end - t, 0.05 * abs(self.omega) / a)
+        # imported here: rocking.solver imports this module, and scipy.integrate costs every
+        # process that solves (a batch's every worker) 0.16 s or more to import
+        from scipy.integrate import solve_ivp
+
         sol = solve_ivp(rhs, (t, end), [self.theta, self.omega], method="DOP853", rtol=RTOL, atol=ATOL,
                         events=(impact, overturn, peak), first_step=first_step)
         if sol.status == -1:
