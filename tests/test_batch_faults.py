@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from pipeline.batch import executors, remote, runner
+from pipeline.batch import remote, runner, worker
 from pipeline.cli import main
 
 from .test_pipeline_run import BATCH_ARGS, read_csv, tree, write_good
@@ -43,7 +43,7 @@ def test_a_worker_killed_at_one_record_fails_that_record_only(how, six, referenc
         pytest.importorskip("dask.distributed")
     if "chunks" in how:  # records sent three at a time: the killer's chunk mates are run again, alone
         how = how[:-1]
-        monkeypatch.setattr(executors, "chunk_size", lambda queued, jobs: min(3, queued))
+        monkeypatch.setattr(worker, "chunk_size", lambda queued, jobs: min(3, queued))
     import glob
     import tempfile
 
@@ -94,8 +94,8 @@ def test_records_go_to_the_workers_in_chunks_then_one_at_a_time():
     # a long queue in chunks of CHUNK, then smaller ones as it empties, the last few alone
     sizes, queued = [], 200
     while queued:
-        k = executors.chunk_size(queued, 2)
-        assert 1 <= k <= min(executors.CHUNK, queued)
+        k = worker.chunk_size(queued, 2)
+        assert 1 <= k <= min(worker.CHUNK, queued)
         sizes.append(k)
         queued -= k
-    assert sizes[0] == executors.CHUNK and sizes[-8:] == [1] * 8 and sizes == sorted(sizes, reverse=True)
+    assert sizes[0] == worker.CHUNK and sizes[-8:] == [1] * 8 and sizes == sorted(sizes, reverse=True)

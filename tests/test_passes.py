@@ -169,9 +169,9 @@ def test_a_pairs_directions_sent_in_chunks_give_the_serial_runs_files(how, pair,
     # passes' tasks arrive in other orders, and every file is the one-process run's
     if "--dask" in how:
         pytest.importorskip("dask.distributed")
-    from pipeline.batch import executors
+    from pipeline.batch import worker
 
-    monkeypatch.setattr(executors, "chunk_size", lambda queued, jobs: min(3, queued))
+    monkeypatch.setattr(worker, "chunk_size", lambda queued, jobs: min(3, queued))
     args = ("--block", f"{H}x{B}", "--directions", "6")
     assert _run(tmp_path / "one", pair, *args) == 0
     assert _run(tmp_path / "chunks", pair, *args, *how) == 0

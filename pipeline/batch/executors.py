@@ -11,7 +11,7 @@ import os
 
 from .. import interrupts
 from ..args import ArgumentError
-from . import memo
+from . import memo, worker
 from ..reports.figures import draw
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, work_many, worker_failure
 
@@ -61,7 +61,7 @@ def _pool(tasks, jobs, more=None):
     # records in the pool when a worker process died: each is run once more alone, so that the
     # one that kills its worker is known and fails, and the others complete
     suspects = collections.deque()
-    # at most this many submissions (chunks of records, chunk_size) at once: a few queued per
+    # at most this many submissions (chunks of records, worker.chunk_size) at once: a few queued per
     # worker keep them busy, and a dead worker makes only their records suspects (and the pool
     # holds no future per record of a long batch)
     window = 2 * jobs
@@ -93,7 +93,7 @@ def _pool(tasks, jobs, more=None):
             broken = False
             while (queue or running) and not broken:
                 while queue and len(running) < window:
-                    chunk = [queue.popleft() for _ in range(chunk_size(len(queue), jobs))]
+                    chunk = [queue.popleft() for _ in range(worker.chunk_size(len(queue), jobs))]
                     try:
                         running[pool.submit(work_many, chunk)] = chunk
                     except BrokenProcessPool:
@@ -128,20 +128,6 @@ def _pool(tasks, jobs, more=None):
                 pool.shutdown(wait=True)
             else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
                 _stop(pool, others)
-
-
-#: at most this many records go to a worker at once: each submission costs the main process
-#: about a millisecond (the task and its result through the pool's queues and threads), as much
-#: as it spends on the record's result, so a long batch sends them in chunks
-CHUNK = 8
-
-
-def chunk_size(queued: int, jobs: int) -> int:
-    """How many of the ``queued`` records (largest first) to send in the next submission: up to
-    :data:`CHUNK` while each worker has at least four chunks' worth left, down to one record
-    at a time towards the end of the queue, so that no worker is left idle while another
-    finishes a chunk."""
-    return max(1, min(CHUNK, queued // (4 * jobs)))
 
 
 def _refill(queue, more) -> bool:

@@ -4,7 +4,7 @@ The client reads each record's file and sends its bytes with the task, so a work
 to the input paths (no shared file system): it writes them to a private temporary folder under the
 file's own name (the readers use the name's extension) and reads them from there.  Records are
 submitted a window at a time, so the client holds the bytes of only a few records at once, and in
-chunks as ``--jobs`` sends them (:func:`pipeline.batch.executors.chunk_size`): a pair's directions
+chunks as ``--jobs`` sends them (:func:`pipeline.batch.worker.chunk_size`): a pair's directions
 together, its files sent once.
 
 A record whose worker dies (the task comes back with an error instead of a result; every record of
@@ -98,12 +98,12 @@ def _files(task: Task) -> tuple:
 
 
 def _next_chunk(queue, workers: int) -> list[Task]:
-    """The next records to send together: up to :func:`pipeline.batch.executors.chunk_size` of
+    """The next records to send together: up to :func:`pipeline.batch.worker.chunk_size` of
     them, from the queue's head, reading the same files (a pair's directions)."""
-    from .executors import chunk_size
+    from . import worker
 
     chunk = [queue.popleft()]
-    k = chunk_size(len(queue) + 1, workers)
+    k = worker.chunk_size(len(queue) + 1, workers)
     while queue and len(chunk) < k and _files(queue[0]) == _files(chunk[0]):
         chunk.append(queue.popleft())
     return chunk

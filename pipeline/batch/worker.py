@@ -64,9 +64,23 @@ def work(task: Task) -> dict:
     return res
 
 
+#: at most this many records go to a worker at once: each submission costs the main process
+#: about a millisecond (the task and its result through the pool's queues and threads), as much
+#: as it spends on the record's result, so a long batch sends them in chunks
+CHUNK = 8
+
+
+def chunk_size(queued: int, jobs: int) -> int:
+    """How many of the ``queued`` records (largest first) to send in the next submission: up to
+    :data:`CHUNK` while each worker has at least four chunks' worth left, down to one record
+    at a time towards the end of the queue, so that no worker is left idle while another
+    finishes a chunk."""
+    return max(1, min(CHUNK, queued // (4 * jobs)))
+
+
 def work_many(tasks: list[Task]) -> list[dict]:
     """:func:`work` on each of ``tasks`` in turn (a pool's submission of several,
-    :data:`pipeline.batch.executors.CHUNK`)."""
+    :data:`CHUNK`)."""
     return [work(task) for task in tasks]
 
 
