@@ -111,8 +111,10 @@ def _pool(tasks, jobs, more=None):
                         suspects.extend(chunk)
                         broken = True
                     except Exception as exc:  # e.g. a result that cannot be sent back
-                        for task in chunk:
-                            yield worker_failure(task, exc)
+                        if len(chunk) > 1:  # each again alone: only the record at fault fails
+                            suspects.extend(chunk)
+                        else:
+                            yield worker_failure(chunk[0], exc)
             if broken:  # every record still in the broken pool is a suspect
                 for fut, chunk in running.items():
                     if fut.done() and not fut.cancelled() and fut.exception() is None:

@@ -7,8 +7,9 @@ submitted a window at a time, so the client holds the bytes of only a few record
 chunks as ``--jobs`` sends them (:func:`pipeline.batch.worker.chunk_size`): a pair's directions
 together, its files sent once.
 
-A record whose worker dies (the task comes back with an error instead of a result; every record of
-its chunk) is submitted once more, alone among the retried records; if that attempt fails too it is a ``worker`` failure.
+A record whose worker dies (the task comes back with an error instead of a result: every record of
+its chunk) is submitted once more, alone among the retried records; if that attempt fails too it
+is a ``worker`` failure.
 On a local cluster the scheduler gives up on a task at its first worker death
 (``distributed.scheduler.allowed-failures`` 0), so the retry is this module's; a remote scheduler
 retries by its own setting first (3 by default).
