@@ -137,6 +137,37 @@ def test_scouts_first_then_the_others_checked_above_the_scouts_widest_width():
     assert plan.held == set()
 
 
+def test_a_pair_goes_on_to_its_next_pass_while_another_pairs_tasks_are_out():
+    # a batch finishes a pair while the workers still keep its searches (pipeline.batch.memo): a
+    # pair whose results are all in gets its next pass at once, not after every other pair's
+    from pipeline.batch.tasks import Column, Options, Task
+
+    options = Options()
+    cols = (Column(7.5, 1.8),)
+    kinds = ["component-1", "even", "even", "pulse"]
+    tasks = [Task(4 * j + i, f"{name}_{i}", "a", cols, options, path2="b", direction=10.0 * i,
+                  direction_kind=k, pair=name)
+             for j, name in enumerate(("A", "B")) for i, k in enumerate(kinds)]
+    first, held = passes.first_pass(tasks, options)
+    assert held == {1, 2, 5, 6}
+    plan = passes.Plan(options, held)
+    scouts = [t for t in first if t.index not in held]
+    plan.sent(scouts)
+    row = lambda w: [{"column": "7.5x1.8", "design_width_m": w, "height_m": 7.5, "pga_g": 0.5,
+                      "widest_failing_width_m": None}]
+    plan.note(first[0], row(1.0))
+    assert plan.next_pass(first) == []              # A's pulse direction is still out
+    plan.note(first[4], row(1.1))
+    plan.note(first[3], row(1.2))                   # A's scouts are in, B's pulse direction is out
+    second = plan.next_pass(first)
+    assert [t.index for t in second] == [1, 2] and plan.held == {5, 6}
+    assert all(t.check_above == pytest.approx((1.2,), rel=1e-5) for t in second)
+    assert plan.next_pass(first) == []              # nothing new came in
+    plan.sent(second)
+    plan.note(first[7], row(0.9))                   # B's scouts are in: its held directions next
+    assert [t.index for t in plan.next_pass(first)] == [5, 6] and plan.held == set()
+
+
 @pytest.fixture(scope="module")
 def pair(tmp_path_factory):
     return _pair(tmp_path_factory.mktemp("passes"), "STP", 0.45, 0.3, 1)

@@ -17,15 +17,16 @@ from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, work_ma
 
 
 def _serial(tasks, more=None):
-    """Records one after the other in this process (then those ``more()`` gives, see :func:`execute`),
-    keeping what a later pass reuses (:mod:`pipeline.batch.memo`) while they run."""
+    """Records one after the other in this process (and those ``more()`` gives, see :func:`execute`,
+    next), keeping what a later pass reuses (:mod:`pipeline.batch.memo`) while they run."""
     memo.on()
+    queue = collections.deque(tasks)
     try:
-        while tasks:
-            for task in tasks:
-                interrupts.check()
-                yield work(task)
-            tasks = more() if more is not None else []
+        while queue:
+            interrupts.check()
+            yield work(queue.popleft())
+            if more is not None:
+                queue.extendleft(reversed(more()))
     finally:
         memo.off()
 
@@ -115,6 +116,8 @@ def _pool(tasks, jobs, more=None):
                             suspects.extend(chunk)
                         else:
                             yield worker_failure(chunk[0], exc)
+                if more is not None and done:  # a pair's next pass as soon as it has none out
+                    queue.extendleft(reversed(more()))
             if broken:  # every record still in the broken pool is a suspect
                 for fut, chunk in running.items():
                     if fut.done() and not fut.cancelled() and fut.exception() is None:
@@ -264,10 +267,11 @@ def _dask(tasks, address, jobs, more=None):
 def execute(tasks, jobs: int | None = 1, dask: str | None = None, more=None):
     """Results of :func:`process_record` for every task, in completion order.
 
-    ``jobs`` None (not given) or 1: the records in this process.  ``more``: called once every
-    result so far has been taken, it gives the tasks to run next (empty: none), on the same
-    workers (a pair's later passes, :mod:`pipeline.batch.passes`: the pool and its processes
-    are started once, and no pass runs in this process when ``jobs`` asks for workers)."""
+    ``jobs`` None (not given) or 1: the records in this process.  ``more``: called after results
+    have been taken (after each, in this process and with ``jobs``; once all are in, with dask),
+    it gives the tasks to run next (empty: none), ahead of those waiting, on the same workers (a
+    pair's later passes, :mod:`pipeline.batch.passes`: the pool and its processes are started
+    once, and no pass runs in this process when ``jobs`` asks for workers)."""
     if dask:
         return _dask(tasks, dask, jobs, more)
     if jobs is None or jobs <= 1 or (len(tasks) <= 1 and more is None):

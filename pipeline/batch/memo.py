@@ -13,9 +13,10 @@ from __future__ import annotations
 
 from rocking.searches import Kept, digest
 
-#: results kept per kind in a worker: a pool's tasks come back for their next pass after the
-#: pass's other tasks, so this covers a few pairs of 38 directions and two heights (under
-#: ``--limit`` two searches a column, the overturning design's and the level's; about 20 kB each)
+#: results kept per kind in a worker: a direction comes back for its next pass once its pair's
+#: other directions of the pass are in (pipeline.batch.passes), so this covers the few pairs a
+#: pool's workers go between, of 38 directions and two heights (under ``--limit`` two searches a
+#: column, the overturning design's and the level's; about 20 kB each)
 KEPT = 512
 #: pairs of records kept (a few hundred kB each): the pairs a pool's worker goes between
 PAIRS_KEPT = 4

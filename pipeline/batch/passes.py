@@ -31,8 +31,11 @@ the final ``D'``.  Any width a direction reports (its search width at least) is 
    width found so far, checked above that width: the whole direction again (the check uses the
    search's widths, and may raise the direction's design width, which other columns use).
 
-The directions checked above a bound say how many widths they ran (``check_runs``); those left
-unchecked say so (``check_runs`` 0, ``failing_share`` blank).  Each pass is the same
+A pair goes on to its next pass as soon as all its results are in (:meth:`Plan.next_pass`),
+whatever the batch's other pairs are doing: a direction computed again in a later pass then finds
+its search, fit and exact minimum slenderness still kept by the worker (:mod:`pipeline.batch.memo`),
+however long the batch.  The directions checked above a bound say how many widths they ran
+(``check_runs``); those left unchecked say so (``check_runs`` 0, ``failing_share`` blank).  Each pass is the same
 :func:`pipeline.batch.record.process_record` on tasks whose ``check``, ``check_above`` and
 ``plot`` switches are set here; a lone record is one pass, checked whole and drawn.  With the
 former layout (``check_layout="rounds"``, not separable) ``check_above`` switches a direction's
@@ -41,6 +44,7 @@ then divided by ``step``, for the bracket above the rounds' top.
 """
 from __future__ import annotations
 
+import collections
 import dataclasses
 
 from ..reports.report import fmt
@@ -117,6 +121,15 @@ class Plan:
         self.pairs: dict[str, dict[int, _Direction]] = {}
         #: the directions held back from the first pass (indices)
         self.held = set(held)
+        #: per pair, its tasks handed out (:meth:`sent`) whose results are not noted yet: a pair
+        #: goes on to its next pass as soon as it has none, whatever the other pairs are doing,
+        #: so that a batch finishes a pair while its searches are still kept by the workers
+        self.pending: collections.Counter = collections.Counter()
+        self._out = 0  # the sum of pending
+        #: the pairs noted since the last :meth:`next_pass`, the only ones it need look at
+        self._dirty: set = set()
+        #: the held directions by pair, not handed out yet (made at the first :meth:`next_pass`)
+        self._held: dict | None = None
 
     def note(self, task, rows) -> None:
         """Record what ``task`` (as computed, with its switches) gave: its rows (empty: failed)."""
@@ -124,7 +137,12 @@ class Plan:
             return
         from .site import pair_of
 
-        group = self.pairs.setdefault(pair_of(task), {})
+        pair = pair_of(task)
+        if self.pending[pair] > 0:
+            self.pending[pair] -= 1
+            self._out -= 1
+        self._dirty.add(pair)
+        group = self.pairs.setdefault(pair, {})
         if not rows:
             group.pop(task.index, None)
             return
@@ -138,14 +156,37 @@ class Plan:
         full = bool(task.check) and not (self.separable and any(task.check_above))
         group[task.index] = _Direction(task.index, bool(task.check), bool(task.plot), cols, full)
 
+    def sent(self, tasks) -> None:
+        """Note that ``tasks`` were handed out to be computed (their results come to :meth:`note`)."""
+        from .site import pair_of
+
+        for t in tasks:
+            if staged(t, self.options):
+                self.pending[pair_of(t)] += 1
+                self._out += 1
+
     def next_pass(self, tasks) -> list:
         """The tasks to compute next (their switches set), from ``tasks`` (the run's tasks, by
-        index, as last computed); empty when every pair is settled."""
-        if self.held:
-            return self._second_pass(tasks)
+        index, as last computed): the next pass of every pair with no task out; empty when those
+        are settled.  A pair's held directions come first, then its governing direction and
+        those whose check could reach above its design width, pass after pass."""
+        from .site import pair_of
+
+        ready = {p for p in self._dirty if not self.pending[p]}
+        self._dirty -= ready
+        if self._held is None:  # the held directions by pair, once
+            self._held = {}
+            for i in sorted(self.held):
+                self._held.setdefault(pair_of(tasks[i]), []).append(i)
+        held = self._held
+        if not self._out:  # nothing out: every pair still holding some is ready
+            ready |= set(held)
         out = []
-        for group in self.pairs.values():
-            want, design, whole = _wanted(group, bool(self.options.plots))
+        for pair in sorted(ready, key=lambda p: min(held.get(p) or self.pairs.get(p) or [0])):
+            if pair in held:
+                out += self._held_pass(tasks, pair, held.pop(pair))
+                continue
+            want, design, whole = _wanted(self.pairs.get(pair, {}), bool(self.options.plots))
             for i, plot in sorted(want.items()):
                 # the governing direction's check whole; the others' rounds where they could reach
                 # above the pair's design width so far
@@ -154,22 +195,19 @@ class Plan:
                 out.append(dataclasses.replace(tasks[i], check=True, check_above=above, plot=plot or tasks[i].plot))
         return out
 
-    def _second_pass(self, tasks) -> list:
-        """The held directions, each checked where its check could reach above the widest width
-        its pair's scouts found."""
-        from .site import pair_of
-
+    def _held_pass(self, tasks, pair, indices) -> list:
+        """The held directions of ``pair`` (``indices``), each checked where its check could reach
+        above the widest width its scouts found."""
+        lower = {}  # the scouts' widest design width (not their checks': the same on a resumed run)
+        for d in self.pairs.get(pair, {}).values():
+            for label, (w, _, _) in d.columns.items():
+                lower[label] = max(lower.get(label, 0.0), w)
+        self.held -= set(indices)
         out = []
-        for i in sorted(self.held):
+        for i in indices:
             t = tasks[i]
-            group = self.pairs.get(pair_of(t), {})
-            lower = {}  # the scouts' widest design width (not their checks': the same on a resumed run)
-            for d in group.values():
-                for label, (w, _, _) in d.columns.items():
-                    lower[label] = max(lower.get(label, 0.0), w)
             above = tuple(lower.get(c.label, 0.0) * (1.0 - MARGIN) / self.below for c in t.columns)
             out.append(dataclasses.replace(t, check=True, check_above=above))
-        self.held = set()
         return out
 
 

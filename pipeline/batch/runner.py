@@ -171,6 +171,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     tasks, held = passes.first_pass(tasks, options)
     plan = passes.Plan(options, held)
     texts, keys, todo = _reusable(tasks, journal, force, options, plan, held)
+    plan.sent(todo)
     failures: list[dict | None] = [None] * len(tasks)
     computed = set()  # the tasks computed (in any pass); the others were reused
     try:
@@ -334,6 +335,7 @@ def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
     while True:
         wanted = plan.next_pass(tasks)
         if not wanted:
+            plan.sent(todo)
             return todo
         found = False
         for t in wanted:
@@ -350,6 +352,7 @@ def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
                 plan.note(t, resume.rows_from_text(kept))
                 found = True
         if todo or not found:
+            plan.sent(todo)
             return todo
 
 
