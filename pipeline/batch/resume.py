@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import functools
 import hashlib
 import io
 import os
@@ -32,8 +33,10 @@ _HEADER = ("# pipeline run: records whose reports may be kept by a later run (ke
 _LINE = re.compile(r"^([0-9a-f]{64})  ([0-9a-f]{64})  ([0-9a-f]{64}|-)  (\S+)$")
 
 
+@functools.lru_cache(maxsize=1)
 def package_version() -> str:
-    """The installed package's version, or that of the source tree's ``pyproject.toml``."""
+    """The installed package's version, or that of the source tree's ``pyproject.toml`` (looked up
+    once: 1.6 ms a time, and a batch's passes ask after each result)."""
     try:
         from importlib.metadata import version
 
