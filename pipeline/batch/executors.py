@@ -256,7 +256,7 @@ def _dask(tasks, address, jobs, more=None):
         client.run(init_worker)
         workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
         while tasks:
-            yield from run_dask(tasks, client, workers)
+            yield from run_dask(tasks, client, workers, more)
             tasks = more() if more is not None else []
     finally:
         client.close()
@@ -267,11 +267,11 @@ def _dask(tasks, address, jobs, more=None):
 def execute(tasks, jobs: int | None = 1, dask: str | None = None, more=None):
     """Results of :func:`process_record` for every task, in completion order.
 
-    ``jobs`` None (not given) or 1: the records in this process.  ``more``: called after results
-    have been taken (after each, in this process and with ``jobs``; once all are in, with dask),
-    it gives the tasks to run next (empty: none), ahead of those waiting, on the same workers (a
-    pair's later passes, :mod:`pipeline.batch.passes`: the pool and its processes are started
-    once, and no pass runs in this process when ``jobs`` asks for workers)."""
+    ``jobs`` None (not given) or 1: the records in this process.  ``more``: called after each
+    result has been taken, it gives the tasks to run next (empty: none), ahead of those waiting,
+    on the same workers (a pair's later passes, :mod:`pipeline.batch.passes`: the pool and its
+    processes are started once, and no pass runs in this process when ``jobs`` asks for
+    workers)."""
     if dask:
         return _dask(tasks, dask, jobs, more)
     if jobs is None or jobs <= 1 or (len(tasks) <= 1 and more is None):

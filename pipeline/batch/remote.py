@@ -110,8 +110,10 @@ def _next_chunk(queue, workers: int) -> list[Task]:
     return chunk
 
 
-def run_dask(tasks, client, workers: int):
-    """Results of every task on ``client``'s cluster, in completion order."""
+def run_dask(tasks, client, workers: int, more=None):
+    """Results of every task on ``client``'s cluster, in completion order; after each result
+    taken, ``more()`` gives tasks to run next, ahead of those waiting (a pair's next pass,
+    pipeline.batch.executors.execute)."""
     from dask.distributed import as_completed
 
     from .worker import worker_failure
@@ -160,4 +162,6 @@ def run_dask(tasks, client, workers: int):
                 retries.extend(chunk)
         fut.release()
         yield from results
+        if more is not None and results:
+            queue.extendleft(reversed(more()))
         yield from fill()
