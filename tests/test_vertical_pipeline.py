@@ -31,6 +31,38 @@ def rows(out, name="summary.csv"):
 
 
 @pytest.mark.slow
+def test_dask_workers_get_the_vertical_too(files, tmp_path, monkeypatch):
+    # the client ships a triplet's three files; each is spoilt on disk once read, so a worker
+    # reading a path rather than the bytes would not find a record there (the vertical: a warning, no
+    # vertical columns), and the rows (naming the files as given) are the one-process run's
+    pytest.importorskip("dask.distributed")
+    import shutil
+
+    from pipeline.batch import remote
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    copies = [str(shutil.copy(f, folder)) for f in files]
+    args = ["--triplet", *copies, *RUN_ARGS, "--scale", "5", "--directions", "4"]
+    assert main(["run", *args, "--out", str(tmp_path / "one")]) == 0
+    read = remote.read_bytes
+
+    first = {}
+
+    def read_then_spoil(path):  # the client keeps what it read first
+        if path not in first:
+            first[path] = read(path)
+            pathlib.Path(path).write_text("not a record\n")
+        return first[path]
+
+    monkeypatch.setattr(remote, "read_bytes", read_then_spoil)
+    assert main(["run", *args, "--dask", "local", "--jobs", "2", "--out", str(tmp_path / "dask")]) == 0
+    assert all(pathlib.Path(p).read_text() == "not a record\n" for p in copies)
+    got, want = rows(tmp_path / "dask"), rows(tmp_path / "one")
+    assert got == want and all(r["vertical_file"] == copies[2] and r["vertical_polarity"] == "DWN" for r in got)
+
+
+@pytest.mark.slow
 def test_triplet_adds_the_response_with_the_vertical(files, tmp_path):
     out = tmp_path / "out"
     # scaled by 5 (PGA 0.1 to 0.13 g): the column rocks in some directions; the vertical is scaled too

@@ -1,6 +1,6 @@
 """``pipeline run --dask``: records shipped to dask workers as bytes, a dead worker's records retried.
 
-The client reads each record's file and sends its bytes with the task, so a worker needs no access
+The client reads each record's files (a pair's two, and its vertical) and sends their bytes with the task, so a worker needs no access
 to the input paths (no shared file system): it writes them to a private temporary folder under the
 file's own name (the readers use the name's extension) and reads them from there.  Records are
 submitted a window at a time, so the client holds the bytes of only a few records at once, and in
@@ -67,11 +67,9 @@ def work_on_bytes(tasks: list[Task], blobs: dict) -> list[dict]:
                 fh.write(raw)
         out = []
         for task in tasks:
-            changes = {"path": local[task.path]}
-            if task.path2 is not None:
-                changes["path2"] = local[task.path2]
-            res = worker.work(dataclasses.replace(task, **changes))
-            out.append(_as_given(res, task, {local[p]: p for p in (task.path, task.path2) if p is not None}))
+            fields = _file_fields(task)
+            res = worker.work(dataclasses.replace(task, **{f: local[getattr(task, f)] for f in fields}))
+            out.append(_as_given(res, task, {local[getattr(task, f)]: getattr(task, f) for f in fields}))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     return out
@@ -81,21 +79,34 @@ def _as_given(res: dict, task: Task, swaps: dict) -> dict:
     """``res`` of ``task`` run on private copies (``swaps``: copy -> original), naming the originals."""
     from . import worker
 
+    def given(text):
+        for here, there in swaps.items():
+            text = text.replace(here, there)
+        return text
+
     res["file"] = task.path
     for row in res["rows"]:
+        for k, v in row.items():  # the vertical's file, a warning naming a file ...
+            if isinstance(v, str):
+                row[k] = given(v)
         row["file"] = task.path
         if "file2" in row:
             row["file2"] = task.path2
     res[worker.TEXT] = worker.rows_text(res["rows"])  # with the paths as given
     if res["failure"]:
         res["failure"]["file"] = task.path
-        for here, there in swaps.items():
-            res["failure"]["reason"] = res["failure"]["reason"].replace(here, there)
+        res["failure"]["reason"] = given(res["failure"]["reason"])
     return res
 
 
+def _file_fields(task: Task) -> tuple:
+    """The fields of ``task`` naming the files it reads: ``path``, and ``path2`` and ``vertical``
+    where set."""
+    return ("path",) + tuple(f for f in ("path2", "vertical") if getattr(task, f) is not None)
+
+
 def _files(task: Task) -> tuple:
-    return (task.path,) if task.path2 is None else (task.path, task.path2)
+    return tuple(getattr(task, f) for f in _file_fields(task))
 
 
 def _next_chunk(queue, workers: int) -> list[Task]:
