@@ -62,6 +62,19 @@ def test_dask_workers_get_the_vertical_too(files, tmp_path, monkeypatch):
     assert got == want and all(r["vertical_file"] == copies[2] and r["vertical_polarity"] == "DWN" for r in got)
 
 
+
+@pytest.mark.slow
+def test_dask_leaves_a_vertical_the_client_cannot_read_to_the_worker(files, tmp_path):
+    # not shipped: the worker finds it unreadable too, and the rows say so as one process does
+    pytest.importorskip("dask.distributed")
+    unreadable = tmp_path / "RSN41_LYTLECR_ORRDWN.AT2"
+    unreadable.mkdir()  # a folder: no file to read
+    args = ["--triplet", files[0], files[1], str(unreadable), *RUN_ARGS, "--directions", "4"]
+    assert main(["run", *args, "--out", str(tmp_path / "one")]) == 0
+    assert main(["run", *args, "--dask", "local", "--jobs", "2", "--out", str(tmp_path / "dask")]) == 0
+    got, want = rows(tmp_path / "dask"), rows(tmp_path / "one")
+    assert got == want and all("vertical not used" in r["warnings"] for r in got)
+
 @pytest.mark.slow
 def test_triplet_adds_the_response_with_the_vertical(files, tmp_path):
     out = tmp_path / "out"

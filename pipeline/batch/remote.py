@@ -67,7 +67,7 @@ def work_on_bytes(tasks: list[Task], blobs: dict) -> list[dict]:
                 fh.write(raw)
         out = []
         for task in tasks:
-            fields = _file_fields(task)
+            fields = [f for f in _file_fields(task) if getattr(task, f) in local]
             res = worker.work(dataclasses.replace(task, **{f: local[getattr(task, f)] for f in fields}))
             out.append(_as_given(res, task, {local[getattr(task, f)]: getattr(task, f) for f in fields}))
     finally:
@@ -139,8 +139,11 @@ def run_dask(tasks, client, workers: int, more=None):
     def submit(chunk, attempt):
         """Send ``chunk``; return the results of those that fail at reading on this client."""
         blobs = {p: read_bytes(p) for p in dict.fromkeys(p for t in chunk for p in _files(t))}
-        if any(raw is None for raw in blobs.values()):
+        if any(blobs[t.path] is None or (t.path2 is not None and blobs[t.path2] is None) for t in chunk):
             return [process_record(t) for t in chunk]  # fails at reading, as it would anywhere
+        # a vertical that cannot be read here is left to the worker, whose row then says why it
+        # was not used, as a run in one process does
+        blobs = {p: raw for p, raw in blobs.items() if raw is not None}
         fut = client.submit(work_on_bytes, chunk, blobs, pure=False,
                             key=f"record-{chunk[0].index}-{attempt}-{uuid.uuid4().hex}")
         owner[fut.key] = (chunk, attempt)
