@@ -389,7 +389,6 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     return design, rows
 
 
-
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------
 def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
     """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
