@@ -985,10 +985,11 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
                       bint linear, int method, double zeno_tol, bint stop_at_rest, bint record,
                       long j0, double theta0, double omega0, double rest_until0, long n_end,
                       double* hist_t, double* hist_theta, double* hist_omega, double* impacts,
-                      long n_impacts_max) noexcept nogil:
+                      long n_impacts_max, long order0) noexcept nogil:
     """The engine (:func:`rocking.engine.run`) from interval ``j0`` to the end of interval
     ``n_end - 1``; it allocates nothing (the batch engine calls it for single intervals where
-    something happens)."""
+    something happens, with ``order0`` the order its lanes step at: the unrolled steps start
+    there; 0: the engine's own first order)."""
     cdef double work[2 * N_STAGES + 5 * M]
     cdef double* kt = work
     cdef double* kw = work + N_STAGES
@@ -1018,7 +1019,7 @@ cdef Outcome run_core(const Forcing* F, double t_start, double h_uniform, long n
     unrolled = method == TAYLOR and not linear
     if fixed:
         lowest, highest, low_run = ORDERS_FIRST, ORDERS_LAST, LOW_RUN_FIXED
-        order = ORDERS_START
+        order = min(max(order0, ORDERS_FIRST), ORDERS_LAST) if order0 > 0 else ORDERS_START
     else:
         # steps in a row a lower order must have sufficed: more than for records, whose steps
         # are all alike
@@ -1313,7 +1314,7 @@ def run(int kind, double amp, double tp, double t0, const double[::1] uval, doub
     with nogil:
         o = run_core(&F, t_start, h, n_sub, nodes_p, uniform, p, alpha, eta, linear, method,
                      zeno_tol, stop_at_rest, record, j0, theta0, omega0, rest_until, n_end, ht,
-                     hth, hom, imp, n_imp_max)
+                     hth, hom, imp, n_imp_max, 0)
     return (o.status, o.theta, o.omega, o.t, o.max_abs, o.n_imp, o.n_hist, bool(o.uplifted),
             o.rest_until)
 
@@ -1327,15 +1328,37 @@ cdef extern from "_taylor_lanes.h":
         R_REST, R_MX, NF
         I_STATUS, I_NIMP, I_UP, I_RUN, I_WAKE, NI
         LANES  # runs stepped together at most (rocking.lanes.LANES)
+        CF_TH2, CF_OM2, CF_S1, CF_C1, NCF
+        E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_A, E_Q, E_SA, E_CA, E_ETA, E_MX, E_OMZ
+        E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_NMX, E_WHY, NE
     int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
-                               int64_t* bad, double h, double eps, int64_t* n_low) noexcept nogil
+                               int64_t* bad, double h, double eps, int64_t* n_low,
+                               double* cf) noexcept nogil
+    void rocking_events(int64_t order, int64_t m, double* e, double h, double uj, double duj,
+                        double eps) noexcept nogil
+
+#: counts a batch in lanes keeps (rocking.lanes.STATS): steps kept in lanes, turning points and
+#: impacts taken in lanes, intervals handed to the engine (rocking lanes, lanes at rest, rocking
+#: lanes for a too low order), and the events left to the engine by why (rocking_events_N)
+cdef enum:
+    ST_KEPT = 0
+    ST_TURNS = 1
+    ST_ENGINE = 2
+    ST_REST = 3
+    ST_IMPACTS = 4
+    ST_LOW = 5
+    ST_WHY = 6   # 6 .. 11: overturning, Zeno, root, the rest's order, a second event, theta = 0
+    N_STATS = 12
 
 ctypedef struct Chunk:
     # the state of up to LANES runs stepped together: NF rows of floats, NI rows of integers,
-    # and why each lane was left by the last step (lanes_N)
+    # why each lane was left by the last step (lanes_N), each lane's polynomial of that step and
+    # its end state (NCF rows), and the events' scratch (NE rows, one column per lane gathered)
     double f[NF][LANES]
     long i[NI][LANES]
     int64_t bad[LANES]
+    double cf[NCF][LANES]
+    double e[NE][LANES]
 
 
 cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, Chunk* L, double h,
@@ -1344,8 +1367,64 @@ cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, C
     ``L``: ``(n_bad, n_low)``, the lanes left and the kept lanes a lower order would have done."""
     cdef int64_t n_low = 0
     cdef int64_t n_bad = rocking_lanes_step(order, n, uj, duj, &L.f[0][0], &L.bad[0], h, eps,
-                                            &n_low)
+                                            &n_low, &L.cf[0][0])
     return n_bad, n_low
+
+
+cdef void _events(long order, long n, double uj, double duj, Chunk* L, double h,
+                  double zeno_tol, int64_t* stats) noexcept nogil:
+    """The lanes the step left with something happening in it (bad 1), in one pass over them
+    all (rocking_events_N, on their step's polynomial): a turning point (its peak), or an impact
+    (located on the polynomial; the peak before it, the restitution, the step over the rest of
+    the interval).  Those where nothing else happens are written back (bad 0); the engine takes
+    the others through the interval (a Zeno sequence, overturning, a second event, a root or a
+    rest of the interval the pass cannot settle)."""
+    cdef long idx[LANES]
+    cdef long m = 0, top, k, r, i, rows = min(max(order, ORDERS_FIRST), ORDERS_LAST) + 1
+    cdef double ok
+    for i in range(n):
+        if L.bad[i] == 1:
+            idx[m] = i
+            m += 1
+    if m == 0:
+        return
+    top = min(LANES, (m + 3) // 4 * 4)  # whole vectors (the padding repeats the first lane)
+    for k in range(top):
+        i = idx[k] if k < m else idx[0]
+        for r in range(rows):
+            L.e[r][k] = L.cf[r][i]
+        L.e[E_TH2][k] = L.cf[CF_TH2][i]
+        L.e[E_OM2][k] = L.cf[CF_OM2][i]
+        L.e[E_S1][k] = L.cf[CF_S1][i]
+        L.e[E_C1][k] = L.cf[CF_C1][i]
+        L.e[E_OM][k] = L.f[R_OM][i]
+        L.e[E_SIDE][k] = L.f[R_SIDE][i]
+        L.e[E_A][k] = L.f[R_A][i]
+        L.e[E_Q][k] = L.f[R_Q][i]
+        L.e[E_SA][k] = L.f[R_SA][i]
+        L.e[E_CA][k] = L.f[R_CA][i]
+        L.e[E_ETA][k] = L.f[R_ETA][i]
+        L.e[E_MX][k] = L.f[R_MX][i]
+        L.e[E_OMZ][k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
+    rocking_events(order, top, &L.e[0][0], h, uj, duj, TAYLOR_EPS)
+    for k in range(m):
+        ok = L.e[E_OK][k]
+        if ok == 0.0:
+            stats[ST_WHY - 1 + <long>L.e[E_WHY][k]] += 1
+            continue
+        i = idx[k]
+        L.f[R_TH][i] = L.e[E_NTH][k]
+        L.f[R_OM][i] = L.e[E_NOM][k]
+        L.f[R_SIDE][i] = L.e[E_NSIDE][k]
+        L.f[R_SPHI][i] = L.e[E_NS][k]
+        L.f[R_CPHI][i] = L.e[E_NC][k]
+        L.f[R_MX][i] = L.e[E_NMX][k]
+        L.bad[i] = 0
+        if ok == 2.0:
+            L.i[I_NIMP][i] += 1
+            stats[ST_IMPACTS] += 1
+        else:
+            stats[ST_TURNS] += 1
 
 
 cdef inline void _swap(Chunk* L, long i, long k) noexcept nogil:
@@ -1397,42 +1476,6 @@ cdef long _wake(const double* uval, long j, long n_int, double a, double tan_a) 
     return j
 
 
-cdef bint _turn(long order, double a, const double* uval, long j, double ta, double h,
-                double theta, double omega, double side, double sa, double ca, double p,
-                double* cf, double* kt, double* kw, double* out) noexcept nogil:
-    """A step of a rocking lane whose ``omega`` changes sign inside it (a turning point) but whose
-    ``theta`` keeps its side: as :func:`run_core` takes it (the step's Taylor polynomial; the peak
-    located on it), unless the block may touch zero inside the step (then False: the engine
-    takes the interval).  ``out``: theta, omega, sin, cos at the end of the step, and the peak."""
-    cdef double u0 = a * uval[j], u1 = a * (uval[j + 1] - uval[j])
-    cdef double sn, cs, th2, wh2, s1, c1, om2, c0, c1h, c2, c3, lo, hi, peak
-    cdef bint interior
-    cdef int flag
-    cdef Forcing F
-    cdef Dyn D
-    sn, cs = corner_sincos(theta, side, sa, ca)
-    th2, wh2, s1, c1, flag = taylor_fixed(order, u0, u1, (p * h) * (p * h), theta, omega * h,
-                                          sn, cs, TAYLOR_EPS, cf)
-    om2 = wh2 / h
-    if flag == 0 or not (side * th2 > 0.0 and fabs(th2) < HALF_PI):
-        return False
-    c0, c1h, c2, c3 = _hermite(theta, omega, th2, om2, h)
-    lo, hi, interior = _first_crossing(c0, c1h, c2, c3, side, 0.0)
-    if lo >= 0.0:
-        return False
-    F.kind, F.amp, F.tp, F.t0, F.uval = NODAL, a, 1.0, 0.0, uval
-    F.vval, F.vamp = NULL, 0.0
-    D.p, D.sa, D.ca, D.linear, D.method = p, sa, ca, False, TAYLOR
-    peak = _step_peak(&F, j, ta, ta + h, ta, h, theta, omega, th2, om2, side, &D, kt, kw, h, cf,
-                      <int>order, 0.0)
-    out[0] = th2
-    out[1] = om2
-    out[2] = s1
-    out[3] = c1
-    out[4] = max(peak, fabs(th2))
-    return True
-
-
 cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double t_start,
                  double h, long n_int, const double* p, const double* alpha, const double* eta,
                  double zeno_tol, unsigned char* overturned, double* max_abs,
@@ -1440,15 +1483,11 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
     """Runs ``i0 .. i1-1`` (at most :data:`LANES`) from rest over the whole record; results
     (after the energy rule at the end of the record) written at their indices.
 
-    ``stats`` (4 integers) counts steps kept in lanes, turning points taken in lanes, and
-    intervals handed to the engine for rocking lanes and for lanes at rest.
+    ``stats`` (:data:`N_STATS` integers, the ``ST_*`` counts) is incremented by what was done
+    in lanes and what was handed to the engine.
     """
     cdef Chunk L
     cdef long n = i1 - i0, i, k, j, n_bad, n_two, w, b, st, st2
-    cdef double cf[M]
-    cdef double kt[N_STAGES]
-    cdef double kw[N_STAGES]
-    cdef double turned[5]
     cdef Forcing F
     cdef Outcome o
     cdef long order = ORDERS_START, n_low = 0, n_rocking = 0, n_live = n, next_wake = 0
@@ -1491,8 +1530,10 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
         if n_rocking > 0:
             n_bad, n_two = lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], &L, h,
                                       TAYLOR_EPS)
-            stats[0] += n_rocking - n_bad
+            stats[ST_KEPT] += n_rocking - n_bad
             all_low = n_two == n_rocking
+            if n_bad > 0:
+                _events(order, n_rocking, uval[j], uval[j + 1] - uval[j], &L, h, zeno_tol, stats)
         wake_all = j >= next_wake
         if n_bad > 0 or wake_all:  # lanes that need attention in this interval
             raise_order = False
@@ -1507,19 +1548,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                         continue
                     if b == 2:
                         raise_order = True
-                    elif L.f[R_OM][i] * L.f[R_SIDE][i] > 0.0:
-                        # moving away from zero and turning back: the peak, in the lane
-                        if _turn(order, L.f[R_A][i], uval, j, ta, h, L.f[R_TH][i], L.f[R_OM][i],
-                                 L.f[R_SIDE][i], L.f[R_SA][i], L.f[R_CA][i], L.f[R_P][i], cf, kt,
-                                 kw, turned):
-                            L.f[R_TH][i] = turned[0]
-                            L.f[R_OM][i] = turned[1]
-                            L.f[R_SPHI][i] = turned[2]
-                            L.f[R_CPHI][i] = turned[3]
-                            if turned[4] > L.f[R_MX][i]:
-                                L.f[R_MX][i] = turned[4]
-                            stats[1] += 1
-                            continue
+                        stats[ST_LOW] += 1
                 else:  # at rest: the engine only where the block may uplift in this interval
                     if L.i[I_WAKE][i] > j:
                         next_wake = min(next_wake, L.i[I_WAKE][i])
@@ -1533,12 +1562,12 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                         next_wake = min(next_wake, w)
                         continue
                 # something happens in this interval: the engine takes this lane through it
-                stats[2 if st == ROCKING else 3] += 1
+                stats[ST_ENGINE if st == ROCKING else ST_REST] += 1
                 F.amp = L.f[R_A][i]
                 o = run_core(&F, t_start, h, 1, NULL, True, L.f[R_P][i], L.f[R_ALPHA][i],
                              L.f[R_ETA][i], False, TAYLOR, zeno_tol, False, False, j,
                              L.f[R_TH][i], L.f[R_OM][i], L.f[R_REST][i], j + 1, NULL, NULL, NULL,
-                             NULL, 0)
+                             NULL, 0, order)
                 st2 = o.status
                 th = o.theta
                 om = o.omega
@@ -1619,7 +1648,7 @@ cdef void _one_by_one(long i0, long i1, int kind, const double* amp, double tp, 
         F.vamp = amp[i]
         o = run_core(&F, t_start, h, n_sub[i], nodes, uniform, p[i], alpha[i], eta[i], linear,
                      method, zeno_tol, False, False, 0, 0.0, 0.0, -INFINITY, n_int, NULL, NULL,
-                     NULL, NULL, 0)
+                     NULL, NULL, 0, 0)
         mx = o.max_abs
         if t_lift != NULL:
             t_lift[i] = o.t if o.status == LIFTOFF else NAN
@@ -1656,6 +1685,8 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
     cdef const double* uval_p = _ptr(uval)
     cdef const double* nodes_p = _ptr(nodes)
     cdef bint uniform = nodes.shape[0] == 0
+    cdef int64_t counts[N_STATS]
+    cdef long k
     if not (0 <= i0 <= i1 <= p.shape[0] and p.shape[0] <= min(amp.shape[0], alpha.shape[0],
             eta.shape[0], n_sub.shape[0], overturned.shape[0], max_abs.shape[0],
             n_impacts.shape[0], uplifted.shape[0]) and stats.shape[0] >= 4):
@@ -1679,8 +1710,12 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
         return
     with nogil:
         if lanes:
+            for k in range(N_STATS):
+                counts[k] = 0
             _chunk(i0, i1, &amp[0], uval_p, t_start, h, n_int, &p[0], &alpha[0], &eta[0],
-                   zeno_tol, &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0], &stats[0])
+                   zeno_tol, &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0], counts)
+            for k in range(min(N_STATS, stats.shape[0])):
+                stats[k] += counts[k]
         else:
             _one_by_one(i0, i1, kind, &amp[0], tp, t0, uval_p, nodes_p, uniform, t_start, h,
                         n_int, &n_sub[0], &p[0], &alpha[0], &eta[0], linear, zeno_tol, method,

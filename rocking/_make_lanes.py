@@ -11,7 +11,9 @@ written.  ``tests/test_lanes.py`` checks that the committed file matches this ge
 """
 from __future__ import annotations
 
+import math
 import pathlib
+import re
 
 try:  # the orders generated are those of the single-run steps
     from rocking._make_taylor import ORDERS, _chain_sum
@@ -69,9 +71,10 @@ def _reference(n: int) -> str:
 
 
 def reference_source() -> str:
-    """The lanes' arithmetic as plain Python functions ``_lane_N`` (tests check the compiled
-    lanes against them, bit for bit)."""
-    return "".join(_reference(n) for n in ORDERS)
+    """The lanes' arithmetic as plain Python functions ``_lane_N`` and ``_events_N`` (tests check
+    the compiled lanes against them, bit for bit)."""
+    return (PY_HELPERS + "".join(_reference(n) for n in ORDERS)
+            + "".join(_events_reference(n) for n in ORDERS))
 
 
 #: rows of a chunk's float state (one column per lane), in order, and of its integer state
@@ -88,7 +91,7 @@ def _function(n: int) -> str:
         name, expr = line.split(" = ", 1)
         body.append(f"        const double {name} = {expr.replace('abs(', 'fabs(')};")
     lines = [f"\n\nROCKING_LANES_CLONES static int64_t rocking_lanes_{n}(int64_t n, double uj, double duj, double *f,",
-             "        int64_t *bad, double h, double eps, int64_t *n_low_out) {",
+             "        int64_t *bad, double h, double eps, int64_t *n_low_out, double *cf) {",
              "    int64_t n_bad = 0, n_low = 0;",
              "    const double inv_h = 1.0 / h;",
              "    for (int64_t i = 0; i < n; i++) {",
@@ -101,6 +104,11 @@ def _function(n: int) -> str:
              "        const double C_0 = f[R_CPHI * LANES + i];",
              "        const double D_1 = om * h;"]
     lines += body
+    # the step's polynomial and end state, for the lanes left (rocking_events_N takes them)
+    lines += ["        cf[0 * LANES + i] = th;", "        cf[1 * LANES + i] = D_1;"]
+    lines += [f"        cf[{k} * LANES + i] = c_{k};" for k in range(2, n + 1)]
+    lines += [f"        cf[CF_{r} * LANES + i] = {v};"
+              for r, v in (("TH2", "th2"), ("OM2", "om2"), ("S1", "s1"), ("C1", "c1"))]
     lines += [f"        const double hi = rocking_fmax(a_{n}, a_{n - 1});",
               f"        const double lo = rocking_fmax(a_{n - 2}, a_{n - 3});",
               "        const int converged = hi <= tol;",
@@ -123,6 +131,237 @@ def _function(n: int) -> str:
               "    *n_low_out = n_low;",
               "    return n_bad;",
               "}"]
+    return "\n".join(lines) + "\n"
+
+
+# --------------------------------------------------------------------------- events in lanes
+#: rows of the per-lane polynomial written by the lanes' step: its coefficients c_0 .. c_N (rows
+#: 0 .. N), then the step's end state
+CF_ROWS = ("CF_TH2", "CF_OM2", "CF_S1", "CF_C1")
+#: rows of the events' scratch (one column per lane with an event, gathered by rocking._core):
+#: the step's coefficients (rows 0 .. N), then the inputs and the outputs below
+EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_A", "E_Q", "E_SA", "E_CA",
+         "E_ETA", "E_MX", "E_OMZ")
+EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_NMX", "E_WHY")
+#: Newton iterations of the impact on the step's polynomial, after a start on its cubic Hermite
+#: interpolant (chord, then NEWTON_CUBIC iterations there); a root not converged to
+#: ROOT_TOL (in units of the step) after them is left to the engine
+NEWTON_POLY = 2
+NEWTON_CUBIC = 2
+ROOT_TOL = 1e-13
+
+
+def _poly(c: str, n: int, x: str, d: int = 0) -> str:
+    """Horner's scheme for the ``d``-th derivative (in powers of ``x``) of ``sum c_k x^k``."""
+    def coef(k):
+        f = math.prod(range(k - d + 1, k + 1))
+        return f"{c}{k}" if f == 1 else f"{float(f)!r} * {c}{k}"
+    out = coef(n)
+    for k in range(n - 1, d - 1, -1):
+        out = f"({out}) * {x} + {coef(k)}"
+    return out
+
+
+def _cubic(c0, c1, c2, c3, x):
+    """``c0 + x (c1 + x (c2 + x c3))`` (rocking._core._cubic)."""
+    return f"{c0} + {x} * ({c1} + {x} * ({c2} + {x} * {c3}))"
+
+
+def _stationary(p: str, c1: str, c2: str, c3: str) -> list[str]:
+    """rocking._core._stationary without branches: the roots ``{p}e1``, ``{p}e2`` in (0, 1) of
+    ``c1 + 2 c2 x + 3 c3 x^2`` (sorted), and whether each is one (``k_{p}e1``, ``k_{p}e2``)."""
+    return [f"{p}a = 3.0 * {c3}",
+            f"{p}b = 2.0 * {c2}",
+            f"k_{p}lin = (fabs({p}a) < 1e-300) | (fabs({p}a) * 1e12 < fabs({p}b))",
+            f"{p}xl = fdiv(-{c1}, {p}b)",
+            f"{p}disc = {p}b * {p}b - 4.0 * {p}a * {c1}",
+            f"{p}sq = fsqrt(fmax({p}disc, 0.0))",
+            f"{p}q = -0.5 * ({p}b + copysign({p}sq, {p}b))",
+            f"{p}x1 = fdiv({p}q, {p}a)",
+            f"{p}x2 = fdiv({c1}, {p}q)",
+            f"k_{p}q0 = {p}q != 0.0",
+            f"{p}m1 = sel(k_{p}q0 & ({p}x2 < {p}x1), {p}x2, {p}x1)",
+            f"{p}m2 = sel(k_{p}q0 & ({p}x2 > {p}x1), {p}x2, {p}x1)",
+            f"{p}r1 = sel(k_{p}lin, {p}xl, {p}m1)",
+            f"k_{p}v1 = ((k_{p}lin & ({p}b != 0.0)) | ((1 - k_{p}lin) & ({p}disc >= 0.0)))"
+            f" & ({p}r1 > 0.0) & ({p}r1 < 1.0)",
+            f"k_{p}v2 = (1 - k_{p}lin) & ({p}disc >= 0.0) & ({p}m2 > 0.0) & ({p}m2 < 1.0)",
+            f"{p}e1 = sel(k_{p}v1, {p}r1, {p}m2)",
+            f"k_{p}e1 = k_{p}v1 | k_{p}v2",
+            f"{p}e2 = {p}m2",
+            f"k_{p}e2 = k_{p}v1 & k_{p}v2"]
+
+
+def _renamed(lines: list[str], prefix: str, keep=("eps", "abs")) -> list[str]:
+    """Statements with every name but ``keep`` prefixed (a second step in the same loop body)."""
+    sub = lambda m: m.group(0) if m.group(0) in keep else prefix + m.group(0)
+    return [re.sub(r"(?<![\w.])[A-Za-z_]\w*", sub, line) for line in lines]
+
+
+def _events(n: int) -> list[str]:
+    """The statements of one lane's event at order ``n`` (see :data:`EVENTS_DOC`); inputs
+    ``p0 .. pN`` (the step's polynomial in powers of x = (t - t_j) / h), the rows of
+    :data:`EV_IN` in lower case without ``E_``, and ``h``, ``inv_h``, ``uj``, ``duj``, ``eps``;
+    outputs the rows of :data:`EV_OUT` likewise (``ok``: 0 the engine takes the interval, 1 a
+    turning point, 2 an impact)."""
+    P = lambda x, d=0: _poly("p", n, x, d)
+    L = ["H1 = h * om",
+         "H2 = 3.0 * (th2 - p0) - h * (2.0 * om + om2)",
+         "H3 = 2.0 * (p0 - th2) + h * (om + om2)"]
+    L += _stationary("hs_", "H1", "H2", "H3")
+    cub = lambda x: _cubic("p0", "H1", "H2", "H3", x)
+    # the first crossing of zero on the interpolant (rocking._core._first_crossing at level 0)
+    L += [f"v1 = side * ({cub('hs_e1')})",
+          "k_f0 = k_hs_e1 & (v1 < 0.0)",
+          "lo1 = sel(k_hs_e1, hs_e1, 0.0)",
+          "k_ok2 = k_hs_e2 & (hs_e2 > lo1)",
+          f"v2 = side * ({cub('hs_e2')})",
+          "k_f1 = (1 - k_f0) & k_ok2 & (v2 < 0.0)",
+          "lo2 = sel(k_ok2, hs_e2, lo1)",
+          f"v3 = side * ({cub('1.0')})",
+          "k_f2 = (1 - k_f0) & (1 - k_f1) & ((v3 < 0.0) | ((v3 == 0.0) & (side * p0 > 0.0)))",
+          "blo = sel(k_f0, 0.0, sel(k_f1, lo1, lo2))",
+          "bhi = sel(k_f0, hs_e1, sel(k_f1, hs_e2, 1.0))",
+          # a dip of the interpolant inside the step is an impact only if the polynomial dips
+          f"pb = {P('bhi')}",
+          "k_imp = (k_f0 | k_f1 | k_f2) & ((1 - (k_f0 | k_f1)) | (side * pb <= 0.0))",
+          # the root: a chord of the bracket, Newton on the cubic, then on the polynomial
+          f"clo = {cub('blo')}",
+          f"chi = {cub('bhi')}",
+          "x0 = blo + (bhi - blo) * fdiv(clo, clo - chi)"]
+    x = "x0"
+    for it in range(NEWTON_CUBIC):
+        L += [f"y{it} = {x} - fdiv({cub(x)}, H1 + {x} * (2.0 * H2 + 3.0 * H3 * {x}))",
+              f"x{it + 1} = fmin(fmax(y{it}, blo), bhi)"]
+        x = f"x{it + 1}"
+    for it in range(NEWTON_POLY):
+        k = NEWTON_CUBIC + it
+        L += [f"z{k} = {x} - fdiv({P(x)}, {P(x, 1)})",
+              f"x{k + 1} = fmin(fmax(z{k}, 0.0), 1.0)"]
+        x = f"x{k + 1}"
+    L += [f"thx = {P(x)}",
+          f"dpx = {P(x, 1)}",
+          "k_root = (fabs(fdiv(thx, dpx)) <= %r) & (%s > 0.0)" % (ROOT_TOL, x),
+          f"xi = {x}",
+          "omx = dpx * inv_h"]
+    # the peak before the impact, or of the turning point (rocking._core._step_peak): on the
+    # interpolant of [0, xe], corrected on the polynomial
+    L += ["xe = sel(k_imp, xi, 1.0)",
+          "te = sel(k_imp, thx, th2)",
+          "oe = sel(k_imp, omx, om2)",
+          "he = xe * h",
+          "G1 = he * om",
+          "G2 = 3.0 * (te - p0) - he * (2.0 * om + oe)",
+          "G3 = 2.0 * (p0 - te) + he * (om + oe)"]
+    L += _stationary("gs_", "G1", "G2", "G3")
+    for k in (1, 2):
+        y = f"ye{k}"
+        L += [f"{y} = gs_e{k} * xe",
+              f"A{k} = {P(y)}",
+              f"B{k} = {P(y, 1)}",
+              f"C{k} = {P(y, 2)}",
+              f"w{k} = sel(C{k} != 0.0, A{k} - fdiv(0.5 * B{k} * B{k}, C{k}), A{k})",
+              f"pk{k} = sel(k_gs_e{k}, fabs(w{k}), 0.0)"]
+    # the impact (restitution, the other side) and the step over the rest of the interval
+    L += ["r = 1.0 - xi",
+          "sn = -side",
+          "omn = eta * omx",
+          "ad = a * duj",
+          "u0 = a * uj + ad * xi",
+          "u1 = ad * r",
+          "qi = q * r * r",
+          "th = 0.0",
+          "hr = h * r",
+          "D_1 = omn * hr",
+          "S_0 = sn * sa",
+          "C_0 = ca",
+          "r_inv_h = fdiv(1.0, hr)"]
+    rest = _renamed(_lane(n), "r_")
+    rest = [re.sub(r"\br_(u0|u1|qi|th|D_1|S_0|C_0)\b", r"\1", line) for line in rest]
+    rest = [line.replace("abs(", "fabs(") for line in rest
+            if not re.match(rf"r_a_({n - 2}|{n - 3}) = ", line)]   # (only the last two are read)
+    L += rest
+    L += [f"k_rconv = fmax(r_a_{n}, r_a_{n - 1}) <= r_tol",
+          "k_quiet = (omn * r_om2 > 0.0) & (sn * r_th2 > 0.0) & (fabs(r_th2) < 1.5707963267948966)",
+          "k_impok = k_imp & k_root & (fabs(omn) > omz) & k_rconv & k_quiet",
+          "k_turn = (1 - k_imp) & (side * th2 > 0.0) & (fabs(th2) < 1.5707963267948966)",
+          "k_ok = (p0 != 0.0) & (k_impok | k_turn)",
+          "ok = sel(k_ok, sel(k_imp, 2.0, 1.0), 0.0)",
+          "nth = sel(k_imp, r_th2, th2)",
+          "nom = sel(k_imp, r_om2, om2)",
+          "nside = sel(k_imp, sn, side)",
+          "ns = sel(k_imp, r_s1, s1)",
+          "nc = sel(k_imp, r_c1, c1)",
+          "nmx = fmax(fmax(mx, fmax(pk1, pk2)), fabs(nth))",
+          # why the engine takes it: 1 overturning, 2 a Zeno sequence, 3 the root, 4 the rest
+          # of the interval needs a higher order, 5 another event in it, 6 theta = 0 at the start
+          "why = sel(p0 == 0.0, 6.0, sel(k_imp, sel(1 - k_root, 3.0, sel(fabs(omn) <= omz, 2.0,"
+          " sel(1 - k_rconv, 4.0, sel(1 - k_quiet, 5.0, 0.0)))), sel(k_turn, 0.0, 1.0)))"]
+    return L
+
+
+#: the mini-language of :func:`_events` in C and in Python (``sel(k, a, b)``: ``k ? a : b``;
+#: ``fdiv``: IEEE division, inf or nan by zero; ``k_`` names are 0/1 masks)
+_C_NAMES = {"sel": "rocking_select", "fmax": "rocking_fmax", "fmin": "rocking_fmin",
+            "fdiv": "rocking_div", "fsqrt": "sqrt"}
+PY_HELPERS = '''
+import math
+
+
+def sel(k, a, b):
+    return a if k else b
+
+
+def fmax(a, b):
+    return b if b > a else a
+
+
+def fmin(a, b):
+    return b if b < a else a
+
+
+def fdiv(a, b):
+    if b != 0.0:
+        return a / b
+    if a != a or a == 0.0:
+        return math.nan
+    return math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
+fsqrt = math.sqrt
+fabs = abs
+copysign = math.copysign
+'''
+
+
+def _events_reference(n: int) -> str:
+    """One lane's event as a plain Python function ``_events_N`` (tests compare the compiled
+    events with it bit for bit)."""
+    ins = ", ".join(r[2:].lower() for r in EV_IN)
+    out = [f"\n\ndef _events_{n}(p, {ins}, h, inv_h, uj, duj, eps):"]
+    out += [f"    p{k} = p[{k}]" for k in range(n + 1)]
+    out += ["    " + line for line in _events(n)]
+    out.append("    return (" + ", ".join(r[2:].lower() for r in EV_OUT) + ")")
+    return "\n".join(out) + "\n"
+
+
+def _c_expr(expr: str) -> str:
+    return re.sub(r"\b(sel|fmax|fmin|fdiv|fsqrt)\(", lambda m: _C_NAMES[m.group(1)] + "(", expr)
+
+
+def _events_function(n: int) -> str:
+    lines = [f"\n\nROCKING_LANES_CLONES static void rocking_events_{n}(int64_t m, double *e, double h,"
+             " double uj, double duj,\n        double eps) {",
+             "    const double inv_h = 1.0 / h;",
+             "    for (int64_t i = 0; i < m; i++) {"]
+    lines += [f"        const double p{k} = e[{k} * LANES + i];" for k in range(n + 1)]
+    lines += [f"        const double {r[2:].lower()} = e[{r} * LANES + i];" for r in EV_IN]
+    for line in _events(n):
+        name, expr = line.split(" = ", 1)
+        kind = "int" if name.startswith("k_") else "double"
+        lines.append(f"        const {kind} {name} = {_c_expr(expr)};")
+    lines += [f"        e[{r} * LANES + i] = {r[2:].lower()};" for r in EV_OUT]
+    lines += ["    }", "}"]
     return "\n".join(lines) + "\n"
 
 
@@ -152,6 +391,8 @@ static inline double rocking_select(int k, double a, double b) {
     return a;
 }
 static inline double rocking_fmax(double a, double b) { return rocking_select(b > a, b, a); }
+static inline double rocking_fmin(double a, double b) { return rocking_select(b < a, b, a); }
+static inline double rocking_div(double a, double b) { return a / b; }
 """
 
 
@@ -159,17 +400,27 @@ def source() -> str:
     """Text of the generated C header."""
     defs = [f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(ROWS))}, NF = {len(ROWS)} }};",
             f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(INT_ROWS))}, NI = {len(INT_ROWS)} }};",
-            f"enum {{ LANES = {LANES} }};"]
-    args = "n, uj, duj, f, bad, h, eps, n_low"
+            f"enum {{ LANES = {LANES} }};",
+            f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(CF_ROWS, ORDERS[-1] + 1))},"
+            f" NCF = {ORDERS[-1] + 1 + len(CF_ROWS)} }};",
+            f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT, ORDERS[-1] + 1))},"
+            f" NE = {ORDERS[-1] + 1 + len(EV_IN) + len(EV_OUT)} }};"]
+    args = "n, uj, duj, f, bad, h, eps, n_low, cf"
     dispatch = ["\n\n/* the step of ORDERS order ``order`` (the highest for larger); returns the lanes left,"
                 " and in\n   ``*n_low`` the kept lanes for which a lower order would have done */",
                 "static inline int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj,"
-                " double *f,\n        int64_t *bad, double h, double eps, int64_t *n_low) {"]
+                " double *f,\n        int64_t *bad, double h, double eps, int64_t *n_low, double *cf) {"]
     for n in ORDERS[:-1]:
         dispatch.append(f"    if (order <= {n}) return rocking_lanes_{n}({args});")
-    dispatch.append(f"    return rocking_lanes_{ORDERS[-1]}({args});\n}}\n#endif")
+    dispatch.append(f"    return rocking_lanes_{ORDERS[-1]}({args});\n}}")
+    dispatch += ["\n/* the events of ORDERS order ``order`` (the highest for larger) on lanes 0 .. m-1 of e */",
+                 "static inline void rocking_events(int64_t order, int64_t m, double *e, double h, double uj,"
+                 " double duj,\n        double eps) {"]
+    for n in ORDERS[:-1]:
+        dispatch.append(f"    if (order <= {n}) {{ rocking_events_{n}(m, e, h, uj, duj, eps); return; }}")
+    dispatch.append(f"    rocking_events_{ORDERS[-1]}(m, e, h, uj, duj, eps);\n}}\n#endif")
     return (HEADER + PRELUDE + "\n" + "\n".join(defs) + "\n"
-            + "".join(_function(n) for n in ORDERS) + "\n".join(dispatch) + "\n")
+            + "".join(_function(n) + _events_function(n) for n in ORDERS) + "\n".join(dispatch) + "\n")
 
 
 TARGET = pathlib.Path(__file__).with_name("_taylor_lanes.h")

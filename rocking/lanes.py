@@ -36,6 +36,12 @@ from .engine import NODAL, TAYLOR, as_input, check_kind
 LANES = 32
 #: intervals in a row in which a lower order sufficed for every rocking lane before it is lowered
 LOW_RUN = 64
+#: counts a batch in lanes keeps (``stats`` of :func:`run_batch`), in this order: rocking steps
+#: kept in lanes, turning points and impacts taken in lanes (``rocking_events_N``), intervals
+#: handed to the engine for rocking lanes, for lanes at rest, and for rocking lanes whose order
+#: was too low; then the rocking intervals the events' pass left to the engine, by why
+STATS = ("kept", "turns", "engine", "rest", "impacts", "low", "overturning", "zeno", "root",
+         "rest_order", "second_event", "theta_zero")
 #: batches at least this large are spread over threads (:func:`run_batch`): on small batches (and
 #: on a busy machine) starting the work on other threads costs more than the work itself
 PARALLEL_MIN_RUNS = 256
@@ -81,8 +87,8 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
 
     ``threads``: how many threads share the batch (default :func:`get_threads` for batches of at
     least :data:`PARALLEL_MIN_RUNS` runs, else 1; 1 runs it on the calling thread).  ``stats``
-    (4 integers, lanes only) is incremented by the steps kept in lanes, the turning points taken
-    in lanes, and the intervals handed to the engine for rocking lanes and for lanes at rest.
+    (integers, lanes only) is incremented by the counts of :data:`STATS` (as many of them as it
+    holds, at least 4).
 
     ``vval``: node values of the vertical ground motion, scaled as the record (``1 + amp * vval`` =
     ``1 + av/g``; one by one only, docs/theory.md section 10); then a fifth array is returned, the
@@ -102,7 +108,7 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
     else:
         size = n if threads == 1 else TASK_RUNS
     starts = range(0, n, max(size, 1))
-    counts = np.zeros((len(starts), 4), dtype=np.int64)
+    counts = np.zeros((len(starts), len(STATS)), dtype=np.int64)
     f64 = as_input
     # the flags as bytes (the same memory as the boolean results)
     results = (out[0].view(np.uint8), out[1], out[2], out[3].view(np.uint8))
@@ -126,7 +132,7 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
     else:
         list(_pool(min(threads, len(starts))).map(task, range(len(starts))))
     if stats is not None:
-        stats += counts.sum(axis=0)
+        stats += counts.sum(axis=0)[:len(stats)]
     return out
 
 
