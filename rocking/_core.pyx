@@ -12,6 +12,7 @@ The unrolled Taylor steps are generated: ``_taylor_fixed.pxi`` by ``rocking/_mak
 ``_taylor_lanes.h`` (C) by ``rocking/_make_lanes.py`` (included below).
 """
 from libc.stdint cimport int64_t
+from libc.string cimport memset
 from libc.math cimport (acos, copysign, cos, exp, fabs, isnan, sin, sinh, sqrt, tan, INFINITY,
                         NAN)
 
@@ -1329,13 +1330,14 @@ cdef extern from "_taylor_lanes.h":
         I_STATUS, I_NIMP, I_UP, I_RUN, I_WAKE, NI
         LANES  # runs stepped together at most (rocking.lanes.LANES)
         CF_TH2, CF_OM2, CF_S1, CF_C1, NCF
-        E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_A, E_Q, E_SA, E_CA, E_ETA, E_MX, E_OMZ
-        E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_NMX, E_WHY, NE
+        E_NEXT, E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
+        E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
+        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW, NE
     int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
                                int64_t* bad, double h, double eps, int64_t* n_low,
                                double* cf) noexcept nogil
-    void rocking_events(int64_t order, int64_t m, double* e, double h, double uj, double duj,
-                        double eps) noexcept nogil
+    void rocking_events(int64_t order, int64_t m, double* e, double eps) noexcept nogil
+    void rocking_peaks(int64_t order, int64_t m, double* e, double eps) noexcept nogil
 
 #: counts a batch in lanes keeps (rocking.lanes.STATS): steps kept in lanes, turning points and
 #: impacts taken in lanes, intervals handed to the engine (rocking lanes, lanes at rest, rocking
@@ -1347,8 +1349,13 @@ cdef enum:
     ST_REST = 3
     ST_IMPACTS = 4
     ST_LOW = 5
-    ST_WHY = 6   # 6 .. 11: overturning, Zeno, root, the rest's order, a second event, theta = 0
-    N_STATS = 12
+    ST_WHY = 6   # 6 .. 10: overturning, uplift after a Zeno sequence, the root, the rest's
+                 # order, more events in one interval than EVENT_ROUNDS
+    N_STATS = 11
+    #: rounds of the events' pass in one interval (each takes one event per lane: a turning point,
+    #: or an impact and the step over the rest of the interval, where the next round looks; the
+    #: hops of a block coming to rest take a round each)
+    EVENT_ROUNDS = 4096
 
 ctypedef struct Chunk:
     # the state of up to LANES runs stepped together: NF rows of floats, NI rows of integers,
@@ -1371,60 +1378,111 @@ cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, C
     return n_bad, n_low
 
 
-cdef void _events(long order, long n, double uj, double duj, Chunk* L, double h,
-                  double zeno_tol, int64_t* stats) noexcept nogil:
-    """The lanes the step left with something happening in it (bad 1), in one pass over them
-    all (rocking_events_N, on their step's polynomial): a turning point (its peak), or an impact
-    (located on the polynomial; the peak before it, the restitution, the step over the rest of
-    the interval).  Those where nothing else happens are written back (bad 0); the engine takes
-    the others through the interval (a Zeno sequence, overturning, a second event, a root or a
-    rest of the interval the pass cannot settle)."""
+cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, double ta,
+                  double h, double zeno_tol) noexcept nogil:
+    """Lane ``i``'s step into column ``k`` of the events' scratch."""
+    cdef long r
+    for r in range(rows):
+        L.e[r][k] = L.cf[r][i]
+    L.e[E_TH2][k] = L.cf[CF_TH2][i]
+    L.e[E_OM2][k] = L.cf[CF_OM2][i]
+    L.e[E_S1][k] = L.cf[CF_S1][i]
+    L.e[E_C1][k] = L.cf[CF_C1][i]
+    L.e[E_OM][k] = L.f[R_OM][i]
+    L.e[E_SIDE][k] = L.f[R_SIDE][i]
+    L.e[E_H][k] = h
+    L.e[E_T][k] = ta
+    L.e[E_U0][k] = L.f[R_A][i] * uj
+    L.e[E_U1][k] = L.f[R_A][i] * duj
+    L.e[E_Q][k] = L.f[R_Q][i]
+    L.e[E_SA][k] = L.f[R_SA][i]
+    L.e[E_CA][k] = L.f[R_CA][i]
+    L.e[E_TAN][k] = L.f[R_TAN][i]
+    L.e[E_P2][k] = L.f[R_P][i] * L.f[R_P][i]
+    L.e[E_ETA][k] = L.f[R_ETA][i]
+    L.e[E_MX][k] = L.f[R_MX][i]
+    L.e[E_OMZ][k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
+    L.e[E_NIMP][k] = 0.0
+
+
+cdef void _settle(long k, long i, long j, double ok, Chunk* L, int64_t* stats) noexcept nogil:
+    """Lane ``i`` to the end of the interval as column ``k`` of the events' scratch found it."""
+    L.f[R_MX][i] = L.e[E_MX][k]
+    L.i[I_NIMP][i] += <long>L.e[E_NIMP][k]
+    L.bad[i] = 0
+    stats[ST_IMPACTS] += <long>L.e[E_NIMP][k]
+    if ok == 4.0:  # at rest after a Zeno sequence
+        L.i[I_STATUS][i] = REST
+        L.i[I_WAKE][i] = j + 1
+        L.f[R_REST][i] = L.e[E_NREST][k]
+        L.f[R_TH][i] = 0.0
+        L.f[R_OM][i] = 0.0
+        L.f[R_SIDE][i] = 0.0
+        L.f[R_SPHI][i] = 0.0
+        L.f[R_CPHI][i] = 1.0
+        return
+    L.f[R_TH][i] = L.e[E_NTH][k]
+    L.f[R_OM][i] = L.e[E_NOM][k]
+    L.f[R_SIDE][i] = L.e[E_NSIDE][k]
+    L.f[R_SPHI][i] = L.e[E_NS][k]
+    L.f[R_CPHI][i] = L.e[E_NC][k]
+    stats[ST_TURNS] += ok == 1.0
+
+
+cdef long _events(long order, long n, long j, double uj, double duj, Chunk* L, double ta,
+                  double h, double zeno_tol, int64_t* stats) noexcept nogil:
+    """The lanes the step left with something happening in it (bad 1), in rounds of one pass
+    over them all (rocking_events_N, then rocking_peaks_N where a peak may be new; on their
+    step's polynomial), each round one event per lane: a turning point, or an impact and the
+    step over the rest of the interval, where the next round looks (at the lowest order its
+    lanes' polynomials need), or a Zeno sequence summed in closed form.  Those settled are
+    written back (bad 0); the engine takes the others through the interval (overturning, a root
+    or a rest of the interval the pass cannot settle, an uplift after a Zeno sequence).  Returns
+    how many lanes came to rest."""
     cdef long idx[LANES]
-    cdef long m = 0, top, k, r, i, rows = min(max(order, ORDERS_FIRST), ORDERS_LAST) + 1
+    cdef long m = 0, m2, top, k, r, i, rounds, n_rest = 0
+    cdef long rows = min(max(order, ORDERS_FIRST), ORDERS_LAST) + 1, low
     cdef double ok
+    cdef bint peaks
     for i in range(n):
         if L.bad[i] == 1:
+            _gather(m, i, rows, uj, duj, L, ta, h, zeno_tol)
             idx[m] = i
             m += 1
-    if m == 0:
-        return
-    top = min(LANES, (m + 3) // 4 * 4)  # whole vectors (the padding repeats the first lane)
-    for k in range(top):
-        i = idx[k] if k < m else idx[0]
-        for r in range(rows):
-            L.e[r][k] = L.cf[r][i]
-        L.e[E_TH2][k] = L.cf[CF_TH2][i]
-        L.e[E_OM2][k] = L.cf[CF_OM2][i]
-        L.e[E_S1][k] = L.cf[CF_S1][i]
-        L.e[E_C1][k] = L.cf[CF_C1][i]
-        L.e[E_OM][k] = L.f[R_OM][i]
-        L.e[E_SIDE][k] = L.f[R_SIDE][i]
-        L.e[E_A][k] = L.f[R_A][i]
-        L.e[E_Q][k] = L.f[R_Q][i]
-        L.e[E_SA][k] = L.f[R_SA][i]
-        L.e[E_CA][k] = L.f[R_CA][i]
-        L.e[E_ETA][k] = L.f[R_ETA][i]
-        L.e[E_MX][k] = L.f[R_MX][i]
-        L.e[E_OMZ][k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
-    rocking_events(order, top, &L.e[0][0], h, uj, duj, TAYLOR_EPS)
-    for k in range(m):
-        ok = L.e[E_OK][k]
-        if ok == 0.0:
-            stats[ST_WHY - 1 + <long>L.e[E_WHY][k]] += 1
-            continue
-        i = idx[k]
-        L.f[R_TH][i] = L.e[E_NTH][k]
-        L.f[R_OM][i] = L.e[E_NOM][k]
-        L.f[R_SIDE][i] = L.e[E_NSIDE][k]
-        L.f[R_SPHI][i] = L.e[E_NS][k]
-        L.f[R_CPHI][i] = L.e[E_NC][k]
-        L.f[R_MX][i] = L.e[E_NMX][k]
-        L.bad[i] = 0
-        if ok == 2.0:
-            L.i[I_NIMP][i] += 1
-            stats[ST_IMPACTS] += 1
-        else:
-            stats[ST_TURNS] += 1
+    for rounds in range(EVENT_ROUNDS):
+        if m == 0:
+            return n_rest
+        top = min(LANES, (m + 3) // 4 * 4)  # whole vectors (the rest of the last one: stale)
+        rocking_events(order, top, &L.e[0][0], TAYLOR_EPS)
+        peaks = False
+        for k in range(m):
+            peaks = peaks or L.e[E_NEED][k] != 0.0
+        if peaks:
+            rocking_peaks(order, top, &L.e[0][0], TAYLOR_EPS)
+        m2 = 0
+        low = ORDERS_FIRST
+        for k in range(m):
+            ok = L.e[E_OK][k]
+            i = idx[k]
+            if ok == 0.0:
+                stats[ST_WHY - 1 + <long>L.e[E_WHY][k]] += 1
+            elif ok == 3.0:  # an impact, then more in the interval: the next round
+                for r in range(rows):
+                    L.e[r][m2] = L.e[E_NEXT + r][k]
+                if m2 != k:
+                    for r in range(E_TH2, E_NIMP + 1):
+                        L.e[r][m2] = L.e[r][k]
+                low = max(low, <long>L.e[E_LOW][k])
+                idx[m2] = i
+                m2 += 1
+            else:
+                _settle(k, i, j, ok, L, stats)
+                n_rest += ok == 4.0
+        m = m2
+        order = low
+        rows = order + 1
+    stats[ST_WHY + 4] += m  # too many events in one interval: the engine takes them
+    return n_rest
 
 
 cdef inline void _swap(Chunk* L, long i, long k) noexcept nogil:
@@ -1487,7 +1545,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
     in lanes and what was handed to the engine.
     """
     cdef Chunk L
-    cdef long n = i1 - i0, i, k, j, n_bad, n_two, w, b, st, st2
+    cdef long n = i1 - i0, i, k, j, n_bad, n_two, w, b, st, st2, n_rested
     cdef Forcing F
     cdef Outcome o
     cdef long order = ORDERS_START, n_low = 0, n_rocking = 0, n_live = n, next_wake = 0
@@ -1518,6 +1576,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
         L.bad[i] = 0
     F.kind, F.tp, F.t0, F.uval = NODAL, 1.0, 0.0, uval
     F.vval, F.vamp = NULL, 0.0
+    memset(&L.e[0][0], 0, sizeof(L.e))  # (the events' padding columns compute on what is there)
     for j in range(n_int):
         if n_live == 0:
             break
@@ -1526,6 +1585,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
         ta = t_start + j * h
         tb = t_start + (j + 1) * h
         n_bad = 0
+        n_rested = 0
         all_low = False
         if n_rocking > 0:
             n_bad, n_two = lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], &L, h,
@@ -1533,11 +1593,14 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
             stats[ST_KEPT] += n_rocking - n_bad
             all_low = n_two == n_rocking
             if n_bad > 0:
-                _events(order, n_rocking, uval[j], uval[j + 1] - uval[j], &L, h, zeno_tol, stats)
+                n_rested = _events(order, n_rocking, j, uval[j], uval[j + 1] - uval[j], &L, ta, h,
+                                   zeno_tol, stats)
+                if n_rested > 0:
+                    next_wake = min(next_wake, j + 1)
         wake_all = j >= next_wake
         if n_bad > 0 or wake_all:  # lanes that need attention in this interval
             raise_order = False
-            changed = False
+            changed = n_rested > 0
             if wake_all:
                 next_wake = n_int
             for i in range(n_rocking if not wake_all else n_live):

@@ -111,10 +111,10 @@ def _function(n: int) -> str:
               for r, v in (("TH2", "th2"), ("OM2", "om2"), ("S1", "s1"), ("C1", "c1"))]
     lines += [f"        const double hi = rocking_fmax(a_{n}, a_{n - 1});",
               f"        const double lo = rocking_fmax(a_{n - 2}, a_{n - 3});",
-              "        const int converged = hi <= tol;",
-              "        const int quiet = (om * om2 > 0.0) & (f[R_SIDE * LANES + i] * th2 > 0.0)"
+              "        const int64_t converged = hi <= tol;",
+              "        const int64_t quiet = (om * om2 > 0.0) & (f[R_SIDE * LANES + i] * th2 > 0.0)"
               " & (fabs(th2) < 1.5707963267948966);",
-              "        const int keep = converged & quiet;",
+              "        const int64_t keep = converged & quiet;",
               "        /* the new state where kept, by selects without a branch (they vectorise) */",
               "        f[R_TH * LANES + i] = rocking_select(keep, th2, th);",
               "        f[R_OM * LANES + i] = rocking_select(keep, om2, om);",
@@ -138,17 +138,30 @@ def _function(n: int) -> str:
 #: rows of the per-lane polynomial written by the lanes' step: its coefficients c_0 .. c_N (rows
 #: 0 .. N), then the step's end state
 CF_ROWS = ("CF_TH2", "CF_OM2", "CF_S1", "CF_C1")
-#: rows of the events' scratch (one column per lane with an event, gathered by rocking._core):
-#: the step's coefficients (rows 0 .. N), then the inputs and the outputs below
-EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_A", "E_Q", "E_SA", "E_CA",
-         "E_ETA", "E_MX", "E_OMZ")
-EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_NMX", "E_WHY")
-#: Newton iterations of the impact on the step's polynomial, after a start on its cubic Hermite
-#: interpolant (chord, then NEWTON_CUBIC iterations there); a root not converged to
-#: ROOT_TOL (in units of the step) after them is left to the engine
-NEWTON_POLY = 2
-NEWTON_CUBIC = 2
+#: the events' scratch (one column per lane with an event, gathered by rocking._core): the
+#: polynomial of the lane's step (rows 0 .. N), that of the step over the rest of the interval
+#: after an impact (rows E_NEXT + 0 .. N, the next round's), then the rows below
+NCOEF = ORDERS[-1] + 1
+#: the lane's step (of length h from time t, forcing u0s + u1s x, q = (p h)^2, omega and the end
+#: state th2, om2, s1, c1), the block (sin, cos and tan of alpha, p^2, the restitution eta, the
+#: Zeno threshold omz of omega) and what the rounds have found (max|theta|, impacts)
+EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_H", "E_T", "E_U0", "E_U1", "E_Q",
+         "E_SA", "E_CA", "E_TAN", "E_P2", "E_ETA", "E_MX", "E_OMZ", "E_NIMP")
+#: the round's verdict (E_OK, :func:`_events`), the lane's state at the end of the interval, why
+#: the engine must take it, the end of its rest after a Zeno sequence, whether the peak pass is
+#: needed and where it looks (E_XE, E_TE, E_OE), the lowest order the rest's polynomial needs
+EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_WHY", "E_NREST", "E_NEED",
+          "E_XE", "E_TE", "E_OE", "E_LOW")
+#: what a round writes for the next one (read where an impact is followed by more in the same
+#: interval): row, value (and the rest's polynomial, rows E_NEXT + k)
+EV_NEXT = (("E_TH2", "r_th2"), ("E_OM2", "r_om2"), ("E_S1", "r_s1"), ("E_C1", "r_c1"),
+           ("E_OM", "omn"), ("E_SIDE", "sn"), ("E_H", "hr"), ("E_T", "ti"), ("E_U0", "u0"),
+           ("E_U1", "u1"), ("E_Q", "qi"), ("E_MX", "nmx"), ("E_NIMP", "nimp"))
+#: Newton iterations of the impact on the step's polynomial (see :func:`_events`); a root not
+#: converged to ROOT_TOL (in units of the step) after them is left to the engine
+NEWTON_POLY = 4
 ROOT_TOL = 1e-13
+HALF_PI = 1.5707963267948966
 
 
 def _poly(c: str, n: int, x: str, d: int = 0) -> str:
@@ -199,13 +212,21 @@ def _renamed(lines: list[str], prefix: str, keep=("eps", "abs")) -> list[str]:
 
 
 def _events(n: int) -> list[str]:
-    """The statements of one lane's event at order ``n`` (see :data:`EVENTS_DOC`); inputs
-    ``p0 .. pN`` (the step's polynomial in powers of x = (t - t_j) / h), the rows of
-    :data:`EV_IN` in lower case without ``E_``, and ``h``, ``inv_h``, ``uj``, ``duj``, ``eps``;
-    outputs the rows of :data:`EV_OUT` likewise (``ok``: 0 the engine takes the interval, 1 a
-    turning point, 2 an impact)."""
+    """The statements of one lane's event at order ``n``: inputs ``p0 .. pN`` (the polynomial
+    of the lane's step in powers of its fraction x), the rows of :data:`EV_IN` (names
+    :func:`_in_name`) and ``eps``; outputs the rows of :data:`EV_OUT` and :data:`EV_NEXT`.
+
+    The first event of the step, located on the interpolant of its ends as the engine does
+    (``rocking._core.run_core``), then on the polynomial: a turning point (``ok`` 1; its peak is
+    :func:`_peaks`'), or an impact, then the restitution and the step over the rest of the
+    interval, quiet (``ok`` 2), with more in it (``ok`` 3: the next round takes the rest), or a
+    Zeno sequence summed in closed form, the block at rest to the end of the interval (``ok``
+    4).  ``ok`` 0: the engine takes the interval (``why``: 1 overturning, 2 the block may uplift
+    again after a Zeno sequence in the interval, 3 the root not converged, 4 the rest of the
+    interval needs a higher order)."""
     P = lambda x, d=0: _poly("p", n, x, d)
-    L = ["H1 = h * om",
+    L = ["inv_h = fdiv(1.0, h)",
+         "H1 = h * om",
          "H2 = 3.0 * (th2 - p0) - h * (2.0 * om + om2)",
          "H3 = 2.0 * (p0 - th2) + h * (om + om2)"]
     L += _stationary("hs_", "H1", "H2", "H3")
@@ -225,50 +246,52 @@ def _events(n: int) -> list[str]:
           # a dip of the interpolant inside the step is an impact only if the polynomial dips
           f"pb = {P('bhi')}",
           "k_imp = (k_f0 | k_f1 | k_f2) & ((1 - (k_f0 | k_f1)) | (side * pb <= 0.0))",
-          # the root: a chord of the bracket, Newton on the cubic, then on the polynomial
+          # the root: Newton on the polynomial kept inside the bracket, which each iteration
+          # narrows (bisecting where a step would leave it), from the root in the bracket of
+          # the step's quadratic p0 + p1 x + p2 x^2 (the hops of a block coming to rest, whose
+          # root lies close to the top of the hop, are parabolas), else from a chord
           f"clo = {cub('blo')}",
           f"chi = {cub('bhi')}",
-          "x0 = blo + (bhi - blo) * fdiv(clo, clo - chi)"]
+          "xc = blo + (bhi - blo) * fdiv(clo, clo - chi)",
+          "qd = p1 * p1 - 4.0 * p2 * p0",
+          "qq = -0.5 * (p1 + copysign(fsqrt(fmax(qd, 0.0)), p1))",
+          "ra = fdiv(qq, p2)",
+          "rb = fdiv(p0, qq)",
+          "k_ra = (qd >= 0.0) & (ra >= blo) & (ra <= bhi)",
+          "k_rb = (qd >= 0.0) & (rb >= blo) & (rb <= bhi)",
+          "x0 = sel(k_ra, ra, sel(k_rb, rb, xc))",
+          "bl0 = blo",
+          "bh0 = bhi"]
     x = "x0"
-    for it in range(NEWTON_CUBIC):
-        L += [f"y{it} = {x} - fdiv({cub(x)}, H1 + {x} * (2.0 * H2 + 3.0 * H3 * {x}))",
-              f"x{it + 1} = fmin(fmax(y{it}, blo), bhi)"]
-        x = f"x{it + 1}"
     for it in range(NEWTON_POLY):
-        k = NEWTON_CUBIC + it
-        L += [f"z{k} = {x} - fdiv({P(x)}, {P(x, 1)})",
-              f"x{k + 1} = fmin(fmax(z{k}, 0.0), 1.0)"]
-        x = f"x{k + 1}"
+        L += [f"f{it} = {P(x)}",
+              f"k_up{it} = side * f{it} > 0.0",
+              f"bl{it + 1} = sel(k_up{it}, {x}, bl{it})",
+              f"bh{it + 1} = sel(k_up{it}, bh{it}, {x})",
+              f"y{it} = {x} - fdiv(f{it}, {P(x, 1)})",
+              f"x{it + 1} = sel((y{it} >= bl{it + 1}) & (y{it} <= bh{it + 1}), y{it},"
+              f" 0.5 * (bl{it + 1} + bh{it + 1}))"]
+        x = f"x{it + 1}"
     L += [f"thx = {P(x)}",
           f"dpx = {P(x, 1)}",
           "k_root = (fabs(fdiv(thx, dpx)) <= %r) & (%s > 0.0)" % (ROOT_TOL, x),
           f"xi = {x}",
-          "omx = dpx * inv_h"]
-    # the peak before the impact, or of the turning point (rocking._core._step_peak): on the
-    # interpolant of [0, xe], corrected on the polynomial
-    L += ["xe = sel(k_imp, xi, 1.0)",
+          "omx = dpx * inv_h",
+          # where the peak pass looks: before the impact, or over the step (a turning point);
+          # needed unless the polynomial's bound keeps |theta| below the peak so far
+          # (rocking._core._below)
+          "xe = sel(k_imp, xi, 1.0)",
           "te = sel(k_imp, thx, th2)",
           "oe = sel(k_imp, omx, om2)",
-          "he = xe * h",
-          "G1 = he * om",
-          "G2 = 3.0 * (te - p0) - he * (2.0 * om + oe)",
-          "G3 = 2.0 * (p0 - te) + he * (om + oe)"]
-    L += _stationary("gs_", "G1", "G2", "G3")
-    for k in (1, 2):
-        y = f"ye{k}"
-        L += [f"{y} = gs_e{k} * xe",
-              f"A{k} = {P(y)}",
-              f"B{k} = {P(y, 1)}",
-              f"C{k} = {P(y, 2)}",
-              f"w{k} = sel(C{k} != 0.0, A{k} - fdiv(0.5 * B{k} * B{k}, C{k}), A{k})",
-              f"pk{k} = sel(k_gs_e{k}, fabs(w{k}), 0.0)"]
+          "need = sel(1.01 * (" + " + ".join(f"fabs(p{k})" for k in range(n + 1)) + ") < mx,"
+          " 0.0, 1.0)"]
     # the impact (restitution, the other side) and the step over the rest of the interval
     L += ["r = 1.0 - xi",
+          "ti = t + xi * h",
           "sn = -side",
           "omn = eta * omx",
-          "ad = a * duj",
-          "u0 = a * uj + ad * xi",
-          "u1 = ad * r",
+          "u0 = u0s + u1s * xi",
+          "u1 = u1s * r",
           "qi = q * r * r",
           "th = 0.0",
           "hr = h * r",
@@ -278,25 +301,67 @@ def _events(n: int) -> list[str]:
           "r_inv_h = fdiv(1.0, hr)"]
     rest = _renamed(_lane(n), "r_")
     rest = [re.sub(r"\br_(u0|u1|qi|th|D_1|S_0|C_0)\b", r"\1", line) for line in rest]
-    rest = [line.replace("abs(", "fabs(") for line in rest
-            if not re.match(rf"r_a_({n - 2}|{n - 3}) = ", line)]   # (only the last two are read)
-    L += rest
-    L += [f"k_rconv = fmax(r_a_{n}, r_a_{n - 1}) <= r_tol",
-          "k_quiet = (omn * r_om2 > 0.0) & (sn * r_th2 > 0.0) & (fabs(r_th2) < 1.5707963267948966)",
-          "k_impok = k_imp & k_root & (fabs(omn) > omz) & k_rconv & k_quiet",
-          "k_turn = (1 - k_imp) & (side * th2 > 0.0) & (fabs(th2) < 1.5707963267948966)",
-          "k_ok = (p0 != 0.0) & (k_impok | k_turn)",
-          "ok = sel(k_ok, sel(k_imp, 2.0, 1.0), 0.0)",
+    L += [line.replace("abs(", "fabs(") for line in rest]
+    # the lowest order at which the rest's series is summed (its terms do not depend on the
+    # order it is cut at): the next round's
+    lower = [m for m in ORDERS if m < n]
+    have = {line.split(" = ")[0] for line in L}
+    L += [f"r_a_{k} = fabs(r_D_{k})" for k in range(3, n + 1) if f"r_a_{k}" not in have
+          and any(k in (m, m - 1) for m in lower)]
+    low = f"{float(n)!r}"
+    for m in reversed(lower):
+        low = f"sel((r_a_{m} <= r_tol) & (r_a_{m - 1} <= r_tol), {float(m)!r}, {low})"
+    L += [f"low = {low}"]
+    # a Zeno sequence: the hops left summed in closed form (rocking._core._zeno_rest), the block
+    # at rest to the end of the interval unless the forcing may uplift it before
+    L += ["an = psq * (sa + sn * u0 * ca)",
+          "ao = psq * (sa - sn * u0 * ca)",
+          "k_pos = (an > 0.0) & (ao > 0.0)",
+          "rest = sel(k_pos, ti + fdiv(2.0 * fabs(omn), 1.0 - eta * eta) * (fdiv(1.0, an)"
+          " + fdiv(eta, ao)), ti)",
+          "yr = fmin(fmax(fdiv(rest - t, h), xi), 1.0)",
+          "k_still = (rest >= t + h) | ((fabs(u0s + u1s * yr) <= tan) & (fabs(u0s + u1s) <= tan))",
+          f"k_rconv = fmax(r_a_{n}, r_a_{n - 1}) <= r_tol",
+          f"k_quiet = (omn * r_om2 > 0.0) & (sn * r_th2 > 0.0) & (fabs(r_th2) < {HALF_PI!r})",
+          "k_zeno = fabs(omn) <= omz",
+          "k_impok = k_imp & k_root & (k_zeno | k_rconv)",
+          f"k_turn = (1 - k_imp) & (side * th2 > 0.0) & (fabs(th2) < {HALF_PI!r})",
+          "ok = sel(k_turn, 1.0, sel(k_impok, sel(k_zeno, sel(k_still, 4.0, 0.0),"
+          " sel(k_quiet, 2.0, 3.0)), 0.0))",
           "nth = sel(k_imp, r_th2, th2)",
           "nom = sel(k_imp, r_om2, om2)",
           "nside = sel(k_imp, sn, side)",
           "ns = sel(k_imp, r_s1, s1)",
           "nc = sel(k_imp, r_c1, c1)",
-          "nmx = fmax(fmax(mx, fmax(pk1, pk2)), fabs(nth))",
-          # why the engine takes it: 1 overturning, 2 a Zeno sequence, 3 the root, 4 the rest
-          # of the interval needs a higher order, 5 another event in it, 6 theta = 0 at the start
-          "why = sel(p0 == 0.0, 6.0, sel(k_imp, sel(1 - k_root, 3.0, sel(fabs(omn) <= omz, 2.0,"
-          " sel(1 - k_rconv, 4.0, sel(1 - k_quiet, 5.0, 0.0)))), sel(k_turn, 0.0, 1.0)))"]
+          "nrest = rest",
+          # max|theta| with the end state where the interval ends rocking (the peak pass adds
+          # the step's own)
+          "nmx = sel((ok == 1.0) | (ok == 2.0), fmax(mx, fabs(nth)), mx)",
+          "nimp = sel(k_imp, nimp0 + 1.0, nimp0)",
+          "why = sel(k_imp, sel(1 - k_root, 3.0, sel(k_zeno, 2.0, sel(1 - k_rconv, 4.0, 0.0))),"
+          " sel(k_turn, 0.0, 1.0))"]
+    return L
+
+
+def _peaks(n: int) -> list[str]:
+    """The statements of the peak of one lane's step (rocking._core._step_peak): on the cubic
+    interpolant of [0, xe] (``xe``, ``te``, ``oe``: its end, theta and omega there), corrected
+    on the polynomial; ``mx`` raised to it."""
+    P = lambda x, d=0: _poly("p", n, x, d)
+    L = ["he = xe * h",
+         "G1 = he * om",
+         "G2 = 3.0 * (te - p0) - he * (2.0 * om + oe)",
+         "G3 = 2.0 * (p0 - te) + he * (om + oe)"]
+    L += _stationary("gs_", "G1", "G2", "G3")
+    for k in (1, 2):
+        y = f"ye{k}"
+        L += [f"{y} = gs_e{k} * xe",
+              f"A{k} = {P(y)}",
+              f"B{k} = {P(y, 1)}",
+              f"C{k} = {P(y, 2)}",
+              f"w{k} = sel(C{k} != 0.0, A{k} - fdiv(0.5 * B{k} * B{k}, C{k}), A{k})",
+              f"pk{k} = sel(k_gs_e{k}, fabs(w{k}), 0.0)"]
+    L += ["nmx = fmax(mx, fmax(pk1, pk2))"]
     return L
 
 
@@ -334,14 +399,36 @@ copysign = math.copysign
 '''
 
 
+def _in_name(row: str) -> str:
+    """The local name of an input row of :data:`EV_IN` in :func:`_events`."""
+    return {"E_U0": "u0s", "E_U1": "u1s", "E_NIMP": "nimp0", "E_P2": "psq"}.get(row, row[2:].lower())
+
+
+#: the inputs of :func:`_peaks` (rows of the scratch; its polynomial, rows 0 .. N, besides)
+PEAK_IN = ("E_OM", "E_H", "E_MX", "E_XE", "E_TE", "E_OE")
+
+
+def _next(n: int) -> list[tuple[str, str]]:
+    """What a round writes (rows and values): :data:`EV_OUT`, :data:`EV_NEXT`, and the rest's
+    polynomial (rows E_NEXT + k)."""
+    return ([(r, r[2:].lower()) for r in EV_OUT] + list(EV_NEXT)
+            + [(f"E_NEXT + {k}", "th" if k == 0 else ("D_1" if k == 1 else f"r_c_{k}"))
+               for k in range(n + 1)])
+
+
 def _events_reference(n: int) -> str:
-    """One lane's event as a plain Python function ``_events_N`` (tests compare the compiled
-    events with it bit for bit)."""
-    ins = ", ".join(r[2:].lower() for r in EV_IN)
-    out = [f"\n\ndef _events_{n}(p, {ins}, h, inv_h, uj, duj, eps):"]
+    """One lane's round of events and its peak as plain Python functions ``_events_N``
+    (returning the values of :func:`_next`) and ``_peaks_N`` (tests compare the compiled
+    events with them bit for bit)."""
+    ins = ", ".join(_in_name(r) for r in EV_IN)
+    out = [f"\n\ndef _events_{n}(p, {ins}, eps):"]
     out += [f"    p{k} = p[{k}]" for k in range(n + 1)]
     out += ["    " + line for line in _events(n)]
-    out.append("    return (" + ", ".join(r[2:].lower() for r in EV_OUT) + ")")
+    out.append("    return (" + ", ".join(v for _, v in _next(n)) + ")")
+    out += [f"\n\ndef _peaks_{n}(p, {', '.join(_in_name(r) for r in PEAK_IN)}):"]
+    out += [f"    p{k} = p[{k}]" for k in range(n + 1)]
+    out += ["    " + line for line in _peaks(n)]
+    out.append("    return nmx")
     return "\n".join(out) + "\n"
 
 
@@ -349,20 +436,24 @@ def _c_expr(expr: str) -> str:
     return re.sub(r"\b(sel|fmax|fmin|fdiv|fsqrt)\(", lambda m: _C_NAMES[m.group(1)] + "(", expr)
 
 
-def _events_function(n: int) -> str:
-    lines = [f"\n\nROCKING_LANES_CLONES static void rocking_events_{n}(int64_t m, double *e, double h,"
-             " double uj, double duj,\n        double eps) {",
-             "    const double inv_h = 1.0 / h;",
+def _c_loop(name: str, n: int, rows, body: list[str], stores) -> str:
+    lines = [f"\n\nROCKING_LANES_CLONES static void {name}(int64_t m, double *e, double eps) {{",
+             "    (void)eps;",
              "    for (int64_t i = 0; i < m; i++) {"]
     lines += [f"        const double p{k} = e[{k} * LANES + i];" for k in range(n + 1)]
-    lines += [f"        const double {r[2:].lower()} = e[{r} * LANES + i];" for r in EV_IN]
-    for line in _events(n):
-        name, expr = line.split(" = ", 1)
-        kind = "int" if name.startswith("k_") else "double"
-        lines.append(f"        const {kind} {name} = {_c_expr(expr)};")
-    lines += [f"        e[{r} * LANES + i] = {r[2:].lower()};" for r in EV_OUT]
+    lines += [f"        const double {_in_name(r)} = e[{r} * LANES + i];" for r in rows]
+    for line in body:
+        var, expr = line.split(" = ", 1)
+        kind = "int64_t" if var.startswith("k_") else "double"
+        lines.append(f"        const {kind} {var} = {_c_expr(expr)};")
+    lines += [f"        e[({r}) * LANES + i] = {v};" for r, v in stores]
     lines += ["    }", "}"]
     return "\n".join(lines) + "\n"
+
+
+def _events_function(n: int) -> str:
+    return (_c_loop(f"rocking_events_{n}", n, EV_IN, _events(n), _next(n))
+            + _c_loop(f"rocking_peaks_{n}", n, PEAK_IN, _peaks(n), [("E_MX", "nmx")]))
 
 
 PRELUDE = """#ifndef ROCKING_TAYLOR_LANES_H
@@ -382,7 +473,7 @@ PRELUDE = """#ifndef ROCKING_TAYLOR_LANES_H
 
 /* ``k ? a : b`` and Python's ``max(a, b)`` without a branch: the bits of ``a`` or ``b`` chosen by
    a mask (the same value as the conditional; a branch keeps the loop from being vectorised) */
-static inline double rocking_select(int k, double a, double b) {
+static inline double rocking_select(int64_t k, double a, double b) {
     uint64_t m = (uint64_t)0 - (uint64_t)(k != 0), x, y;
     memcpy(&x, &a, 8);
     memcpy(&y, &b, 8);
@@ -403,8 +494,9 @@ def source() -> str:
             f"enum {{ LANES = {LANES} }};",
             f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(CF_ROWS, ORDERS[-1] + 1))},"
             f" NCF = {ORDERS[-1] + 1 + len(CF_ROWS)} }};",
-            f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT, ORDERS[-1] + 1))},"
-            f" NE = {ORDERS[-1] + 1 + len(EV_IN) + len(EV_OUT)} }};"]
+            f"enum {{ E_NEXT = {NCOEF}, "
+            f"{', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT, 2 * NCOEF))},"
+            f" NE = {2 * NCOEF + len(EV_IN) + len(EV_OUT)} }};"]
     args = "n, uj, duj, f, bad, h, eps, n_low, cf"
     dispatch = ["\n\n/* the step of ORDERS order ``order`` (the highest for larger); returns the lanes left,"
                 " and in\n   ``*n_low`` the kept lanes for which a lower order would have done */",
@@ -413,12 +505,13 @@ def source() -> str:
     for n in ORDERS[:-1]:
         dispatch.append(f"    if (order <= {n}) return rocking_lanes_{n}({args});")
     dispatch.append(f"    return rocking_lanes_{ORDERS[-1]}({args});\n}}")
-    dispatch += ["\n/* the events of ORDERS order ``order`` (the highest for larger) on lanes 0 .. m-1 of e */",
-                 "static inline void rocking_events(int64_t order, int64_t m, double *e, double h, double uj,"
-                 " double duj,\n        double eps) {"]
-    for n in ORDERS[:-1]:
-        dispatch.append(f"    if (order <= {n}) {{ rocking_events_{n}(m, e, h, uj, duj, eps); return; }}")
-    dispatch.append(f"    rocking_events_{ORDERS[-1]}(m, e, h, uj, duj, eps);\n}}\n#endif")
+    for what in ("events", "peaks"):
+        dispatch += [f"\n/* the {what} of ORDERS order ``order`` (the highest for larger) on lanes 0 .. m-1 of e */",
+                     f"static inline void rocking_{what}(int64_t order, int64_t m, double *e, double eps) {{"]
+        for n in ORDERS[:-1]:
+            dispatch.append(f"    if (order <= {n}) {{ rocking_{what}_{n}(m, e, eps); return; }}")
+        dispatch.append(f"    rocking_{what}_{ORDERS[-1]}(m, e, eps);\n}}")
+    dispatch.append("#endif")
     return (HEADER + PRELUDE + "\n" + "\n".join(defs) + "\n"
             + "".join(_function(n) + _events_function(n) for n in ORDERS) + "\n".join(dispatch) + "\n")
 

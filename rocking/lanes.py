@@ -40,8 +40,8 @@ LOW_RUN = 64
 #: kept in lanes, turning points and impacts taken in lanes (``rocking_events_N``), intervals
 #: handed to the engine for rocking lanes, for lanes at rest, and for rocking lanes whose order
 #: was too low; then the rocking intervals the events' pass left to the engine, by why
-STATS = ("kept", "turns", "engine", "rest", "impacts", "low", "overturning", "zeno", "root",
-         "rest_order", "second_event", "theta_zero")
+STATS = ("kept", "turns", "engine", "rest", "impacts", "low", "overturning", "zeno_uplift", "root",
+         "rest_order", "many_events")
 #: batches at least this large are spread over threads (:func:`run_batch`): on small batches (and
 #: on a busy machine) starting the work on other threads costs more than the work itself
 PARALLEL_MIN_RUNS = 256
