@@ -1332,7 +1332,7 @@ cdef extern from "_taylor_lanes.h":
         CF_TH2, CF_OM2, CF_S1, CF_C1, NCF
         E_NEXT, E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
         E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
-        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW, NE
+        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW, E_NOMN, E_NH, NE
     int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
                                int64_t* bad, double h, double eps, int64_t* n_low,
                                double* cf) noexcept nogil
@@ -1371,11 +1371,14 @@ ctypedef struct Chunk:
 cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, Chunk* L, double h,
                                     double eps) noexcept nogil:
     """The lanes' step of order ``order`` (the highest for larger) on lanes ``0 .. n-1`` of
-    ``L``: ``(n_bad, n_low)``, the lanes left and the kept lanes a lower order would have done."""
+    ``L``: ``(n_bad, n_low)``, the lanes left and the kept lanes a lower order would have done.
+    The step runs over whole vectors: the lanes after ``n`` it takes too are at rest or
+    overturned (or unused), with omega 0, which no step keeps (their ``bad`` is not read)."""
     cdef int64_t n_low = 0
-    cdef int64_t n_bad = rocking_lanes_step(order, n, uj, duj, &L.f[0][0], &L.bad[0], h, eps,
+    cdef long top = min(LANES, (n + 3) // 4 * 4)
+    cdef int64_t n_bad = rocking_lanes_step(order, top, uj, duj, &L.f[0][0], &L.bad[0], h, eps,
                                             &n_low, &L.cf[0][0])
-    return n_bad, n_low
+    return n_bad - (top - n), n_low
 
 
 cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, double ta,
@@ -1472,6 +1475,8 @@ cdef long _events(long order, long n, long j, double uj, double duj, Chunk* L, d
                 if m2 != k:
                     for r in range(E_TH2, E_NIMP + 1):
                         L.e[r][m2] = L.e[r][k]
+                L.e[E_OM][m2] = L.e[E_NOMN][k]
+                L.e[E_H][m2] = L.e[E_NH][k]
                 low = max(low, <long>L.e[E_LOW][k])
                 idx[m2] = i
                 m2 += 1
@@ -1551,6 +1556,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
     cdef long order = ORDERS_START, n_low = 0, n_rocking = 0, n_live = n, next_wake = 0
     cdef double ta, tb, th, om, pk
     cdef bint all_low, wake_all, raise_order, changed, over
+    memset(&L.f[0][0], 0, sizeof(L.f))  # (unused lanes at rest: omega 0, see lanes_step)
     for i in range(n):
         k = i0 + i
         L.f[R_A][i] = amp[k]
@@ -1914,6 +1920,7 @@ def py_lanes_step(long order, long n, double uj, double duj, double[:, ::1] stat
     rows[:] = [R_A, R_Q, R_TH, R_OM, R_SIDE, R_SPHI, R_CPHI, R_MX]
     if not (0 <= n <= LANES and state.shape[0] >= 8 and state.shape[1] >= n and bad.shape[0] >= n):
         raise ValueError("state must hold 8 rows of n <= LANES lanes")
+    memset(&L, 0, sizeof(L))
     for r in range(8):
         for i in range(n):
             L.f[rows[r]][i] = state[r, i]

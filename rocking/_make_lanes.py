@@ -151,11 +151,12 @@ EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_H", "E_T", "E_U0
 #: the engine must take it, the end of its rest after a Zeno sequence, whether the peak pass is
 #: needed and where it looks (E_XE, E_TE, E_OE), the lowest order the rest's polynomial needs
 EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_WHY", "E_NREST", "E_NEED",
-          "E_XE", "E_TE", "E_OE", "E_LOW")
+          "E_XE", "E_TE", "E_OE", "E_LOW", "E_NOMN", "E_NH")
 #: what a round writes for the next one (read where an impact is followed by more in the same
-#: interval): row, value (and the rest's polynomial, rows E_NEXT + k)
+#: interval): row, value (and the rest's polynomial, rows E_NEXT + k); omega and h go to rows
+#: of their own (E_NOMN, E_NH: the peak pass reads the round's)
 EV_NEXT = (("E_TH2", "r_th2"), ("E_OM2", "r_om2"), ("E_S1", "r_s1"), ("E_C1", "r_c1"),
-           ("E_OM", "omn"), ("E_SIDE", "sn"), ("E_H", "hr"), ("E_T", "ti"), ("E_U0", "u0"),
+           ("E_NOMN", "omn"), ("E_SIDE", "sn"), ("E_NH", "hr"), ("E_T", "ti"), ("E_U0", "u0"),
            ("E_U1", "u1"), ("E_Q", "qi"), ("E_MX", "nmx"), ("E_NIMP", "nimp"))
 #: Newton iterations of the impact on the step's polynomial (see :func:`_events`); a root not
 #: converged to ROOT_TOL (in units of the step) after them is left to the engine
@@ -411,7 +412,7 @@ PEAK_IN = ("E_OM", "E_H", "E_MX", "E_XE", "E_TE", "E_OE")
 def _next(n: int) -> list[tuple[str, str]]:
     """What a round writes (rows and values): :data:`EV_OUT`, :data:`EV_NEXT`, and the rest's
     polynomial (rows E_NEXT + k)."""
-    return ([(r, r[2:].lower()) for r in EV_OUT] + list(EV_NEXT)
+    return ([(r, r[2:].lower()) for r in EV_OUT if r not in ("E_NOMN", "E_NH")] + list(EV_NEXT)
             + [(f"E_NEXT + {k}", "th" if k == 0 else ("D_1" if k == 1 else f"r_c_{k}"))
                for k in range(n + 1)])
 

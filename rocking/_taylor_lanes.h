@@ -46,7 +46,7 @@ enum { R_A = 0, R_Q = 1, R_SA = 2, R_CA = 3, R_TAN = 4, R_P = 5, R_ALPHA = 6, R_
 enum { I_STATUS = 0, I_NIMP = 1, I_UP = 2, I_RUN = 3, I_WAKE = 4, NI = 5 };
 enum { LANES = 32 };
 enum { CF_TH2 = 17, CF_OM2 = 18, CF_S1 = 19, CF_C1 = 20, NCF = 21 };
-enum { E_NEXT = 17, E_TH2 = 34, E_OM2 = 35, E_S1 = 36, E_C1 = 37, E_OM = 38, E_SIDE = 39, E_H = 40, E_T = 41, E_U0 = 42, E_U1 = 43, E_Q = 44, E_SA = 45, E_CA = 46, E_TAN = 47, E_P2 = 48, E_ETA = 49, E_MX = 50, E_OMZ = 51, E_NIMP = 52, E_OK = 53, E_NTH = 54, E_NOM = 55, E_NSIDE = 56, E_NS = 57, E_NC = 58, E_WHY = 59, E_NREST = 60, E_NEED = 61, E_XE = 62, E_TE = 63, E_OE = 64, E_LOW = 65, NE = 66 };
+enum { E_NEXT = 17, E_TH2 = 34, E_OM2 = 35, E_S1 = 36, E_C1 = 37, E_OM = 38, E_SIDE = 39, E_H = 40, E_T = 41, E_U0 = 42, E_U1 = 43, E_Q = 44, E_SA = 45, E_CA = 46, E_TAN = 47, E_P2 = 48, E_ETA = 49, E_MX = 50, E_OMZ = 51, E_NIMP = 52, E_OK = 53, E_NTH = 54, E_NOM = 55, E_NSIDE = 56, E_NS = 57, E_NC = 58, E_WHY = 59, E_NREST = 60, E_NEED = 61, E_XE = 62, E_TE = 63, E_OE = 64, E_LOW = 65, E_NOMN = 66, E_NH = 67, NE = 68 };
 
 
 ROCKING_LANES_CLONES static int64_t rocking_lanes_4(int64_t n, double uj, double duj, double *f,
@@ -290,9 +290,9 @@ ROCKING_LANES_CLONES static void rocking_events_4(int64_t m, double *e, double e
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
@@ -624,9 +624,9 @@ ROCKING_LANES_CLONES static void rocking_events_6(int64_t m, double *e, double e
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
@@ -984,9 +984,9 @@ ROCKING_LANES_CLONES static void rocking_events_8(int64_t m, double *e, double e
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
@@ -1370,9 +1370,9 @@ ROCKING_LANES_CLONES static void rocking_events_10(int64_t m, double *e, double 
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
@@ -1782,9 +1782,9 @@ ROCKING_LANES_CLONES static void rocking_events_12(int64_t m, double *e, double 
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
@@ -2220,9 +2220,9 @@ ROCKING_LANES_CLONES static void rocking_events_14(int64_t m, double *e, double 
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
@@ -2684,9 +2684,9 @@ ROCKING_LANES_CLONES static void rocking_events_16(int64_t m, double *e, double 
         e[(E_OM2) * LANES + i] = r_om2;
         e[(E_S1) * LANES + i] = r_s1;
         e[(E_C1) * LANES + i] = r_c1;
-        e[(E_OM) * LANES + i] = omn;
+        e[(E_NOMN) * LANES + i] = omn;
         e[(E_SIDE) * LANES + i] = sn;
-        e[(E_H) * LANES + i] = hr;
+        e[(E_NH) * LANES + i] = hr;
         e[(E_T) * LANES + i] = ti;
         e[(E_U0) * LANES + i] = u0;
         e[(E_U1) * LANES + i] = u1;
