@@ -1931,3 +1931,22 @@ def py_lanes_step(long order, long n, double uj, double duj, double[:, ::1] stat
     for i in range(n):
         bad[i] = L.bad[i]
     return res
+
+
+def py_events(long order, long m, double[:, ::1] e, bint peaks):
+    """A round of the lanes' events of order ``order`` on columns ``0 .. m-1`` of ``e`` (the
+    scratch: ``NE`` rows of ``LANES`` columns, rocking._make_lanes.event_rows()), in place,
+    then its peaks where ``peaks``."""
+    cdef Chunk L
+    cdef long r, k
+    if not (0 <= m <= LANES and e.shape[0] == NE and e.shape[1] == LANES):
+        raise ValueError(f"e must be {NE} x {LANES}")
+    for r in range(NE):
+        for k in range(LANES):
+            L.e[r][k] = e[r, k]
+    rocking_events(order, m, &L.e[0][0], TAYLOR_EPS)
+    if peaks:
+        rocking_peaks(order, m, &L.e[0][0], TAYLOR_EPS)
+    for r in range(NE):
+        for k in range(LANES):
+            e[r, k] = L.e[r][k]

@@ -417,6 +417,14 @@ def _next(n: int) -> list[tuple[str, str]]:
                for k in range(n + 1)])
 
 
+def event_rows() -> dict:
+    """``{row name: index}`` of the events' scratch (the enum of the generated header)."""
+    rows = {"E_NEXT": NCOEF}
+    rows.update({r: k for k, r in enumerate(EV_IN + EV_OUT, 2 * NCOEF)})
+    rows["NE"] = 2 * NCOEF + len(EV_IN) + len(EV_OUT)
+    return rows
+
+
 def _events_reference(n: int) -> str:
     """One lane's round of events and its peak as plain Python functions ``_events_N``
     (returning the values of :func:`_next`) and ``_peaks_N`` (tests compare the compiled

@@ -10,6 +10,8 @@ transition: the widths are arbitrary, transitions are isolated points).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -102,3 +104,66 @@ def test_lanes_run_most_steps_together(record):
     # a factor 5 leaves room for other noise seeds (16 here); turning points do occur in lanes
     assert in_lanes > 5 * by_engine > 0
     assert stats[1] > 0
+
+
+def _event_case(rng, kind, n):
+    """The scratch column of one lane's step of order ``n`` with an event of ``kind``."""
+    from rocking import _core, _make_lanes
+
+    h, p, alpha = 0.01, rng.uniform(1.0, 3.0), rng.uniform(0.1, 0.3)
+    side = rng.choice([-1.0, 1.0])
+    u0, u1 = rng.uniform(-0.5, 0.5), rng.uniform(-0.05, 0.05)
+    if kind == "impact":        # moving toward zero fast enough to reach it in the step
+        theta, omega = side * rng.uniform(1e-4, 5e-3), -side * rng.uniform(0.5, 2.0)
+    elif kind == "turn":        # moving away, slowly: turns back inside the step
+        theta, omega = side * rng.uniform(0.01, 0.1), side * rng.uniform(1e-4, 2e-3)
+    else:                       # a hop from zero (after an impact)
+        theta, omega = 0.0, side * rng.uniform(1e-7, 1e-4)
+    sa, ca = math.sin(alpha), math.cos(alpha)
+    s0, c0 = (side * sa * math.cos(theta) - ca * math.sin(theta),
+              ca * math.cos(theta) + side * sa * math.sin(theta))
+    q, cf = (p * h) ** 2, np.zeros(20)
+    th2, wh2, s1, c1, flag = _core.py_taylor_fixed(n, u0, u1, q, theta, omega * h, s0, c0, 1e-15, cf)
+    values = {"E_TH2": th2, "E_OM2": wh2 / h, "E_S1": s1, "E_C1": c1, "E_OM": omega,
+              "E_SIDE": side, "E_H": h, "E_T": 3.0, "E_U0": u0, "E_U1": u1, "E_Q": q, "E_SA": sa,
+              "E_CA": ca, "E_TAN": math.tan(alpha), "E_P2": p * p, "E_ETA": 0.9,
+              "E_MX": abs(theta) * rng.uniform(0.5, 1.5), "E_OMZ": 1e-7 * p * alpha, "E_NIMP": 0.0}
+    return cf[:n + 1], [values[r] for r in _make_lanes.EV_IN]
+
+
+def test_compiled_events_compute_their_python_source():
+    """The lanes' events (rocking_events_N, rocking_peaks_N) are compiled from the same text as
+    their Python source (rocking._make_lanes): built without fused multiply-adds, the compiled
+    round gives the plain Python evaluation's bits exactly, lane by lane, in a vectorised loop."""
+    import types
+
+    from rocking import _core, _make_lanes
+
+    ref = types.SimpleNamespace()
+    exec(_make_lanes.reference_source(), vars(ref))
+    rows = _make_lanes.event_rows()
+    index = lambda name: (rows["E_NEXT"] + int(name.split("+")[1]) if name.startswith("E_NEXT")
+                          else rows[name])
+    rng = np.random.default_rng(7)
+    seen = set()
+    for n in (8, 12):
+        names = [r for r, _ in _make_lanes._next(n)]
+        for _ in range(6):
+            e = np.zeros((rows["NE"], lanes.LANES))
+            cases = [_event_case(rng, kind, n) for kind in ("impact", "turn", "hop", "impact") * 2]
+            for k, (poly, ins) in enumerate(cases):
+                e[:n + 1, k] = poly
+                for r, v in zip(_make_lanes.EV_IN, ins):
+                    e[rows[r], k] = v
+            _core.py_events(n, len(cases), e, True)
+            for k, (poly, ins) in enumerate(cases):
+                want = getattr(ref, f"_events_{n}")(list(poly), *ins, 1e-15)
+                # (E_MX: the peak pass raises it after the round)
+                got = [repr(float(e[index(r), k])) for r in names if r != "E_MX"]
+                assert got == [repr(float(v)) for r, v in zip(names, want) if r != "E_MX"]
+                out = dict(zip(names, want))
+                mx = getattr(ref, f"_peaks_{n}")(list(poly), ins[4], ins[6], out["E_MX"],
+                                                 out["E_XE"], out["E_TE"], out["E_OE"])
+                assert repr(float(e[rows["E_MX"], k])) == repr(float(mx))
+                seen.add(out["E_OK"])
+    assert {1.0, 2.0, 3.0} <= seen        # turning points, impacts, impacts followed by a hop
