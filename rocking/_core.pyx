@@ -1331,7 +1331,7 @@ cdef extern from "_taylor_lanes.h":
         LANES  # runs stepped together at most (rocking.lanes.LANES)
         CF_TH2, CF_OM2, CF_S1, CF_C1, NCF
         E_NEXT, E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
-        E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
+        E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_REM, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
         E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW, E_NOMN, E_NH, NE
     int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
                                int64_t* bad, double h, double eps, int64_t* n_low,
@@ -1406,6 +1406,7 @@ cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, do
     L.e[E_MX][k] = L.f[R_MX][i]
     L.e[E_OMZ][k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
     L.e[E_NIMP][k] = 0.0
+    L.e[E_REM][k] = 0.0
 
 
 cdef void _settle(long k, long i, long j, double ok, Chunk* L, int64_t* stats) noexcept nogil:
@@ -1473,7 +1474,7 @@ cdef long _events(long order, long n, long j, double uj, double duj, Chunk* L, d
                 for r in range(rows):
                     L.e[r][m2] = L.e[E_NEXT + r][k]
                 if m2 != k:
-                    for r in range(E_TH2, E_NIMP + 1):
+                    for r in range(E_TH2, E_REM + 1):
                         L.e[r][m2] = L.e[r][k]
                 L.e[E_OM][m2] = L.e[E_NOMN][k]
                 L.e[E_H][m2] = L.e[E_NH][k]

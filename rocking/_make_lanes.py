@@ -146,7 +146,7 @@ NCOEF = ORDERS[-1] + 1
 #: state th2, om2, s1, c1), the block (sin, cos and tan of alpha, p^2, the restitution eta, the
 #: Zeno threshold omz of omega) and what the rounds have found (max|theta|, impacts)
 EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_H", "E_T", "E_U0", "E_U1", "E_Q",
-         "E_SA", "E_CA", "E_TAN", "E_P2", "E_ETA", "E_MX", "E_OMZ", "E_NIMP")
+         "E_SA", "E_CA", "E_TAN", "E_P2", "E_ETA", "E_MX", "E_OMZ", "E_NIMP", "E_REM")
 #: the round's verdict (E_OK, :func:`_events`), the lane's state at the end of the interval, why
 #: the engine must take it, the end of its rest after a Zeno sequence, whether the peak pass is
 #: needed and where it looks (E_XE, E_TE, E_OE), the lowest order the rest's polynomial needs
@@ -156,8 +156,8 @@ EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_WHY", "E_NREST
 #: interval): row, value (and the rest's polynomial, rows E_NEXT + k); omega and h go to rows
 #: of their own (E_NOMN, E_NH: the peak pass reads the round's)
 EV_NEXT = (("E_TH2", "r_th2"), ("E_OM2", "r_om2"), ("E_S1", "r_s1"), ("E_C1", "r_c1"),
-           ("E_NOMN", "omn"), ("E_SIDE", "sn"), ("E_NH", "hr"), ("E_T", "ti"), ("E_U0", "u0"),
-           ("E_U1", "u1"), ("E_Q", "qi"), ("E_MX", "nmx"), ("E_NIMP", "nimp"))
+           ("E_NOMN", "omb"), ("E_SIDE", "sb"), ("E_NH", "hr"), ("E_T", "ts"), ("E_U0", "u0"),
+           ("E_U1", "u1"), ("E_Q", "qi"), ("E_MX", "nmx"), ("E_NIMP", "nimp"), ("E_REM", "nrem"))
 #: Newton iterations of the impact on the step's polynomial (see :func:`_events`); a root not
 #: converged to ROOT_TOL (in units of the step) after them is left to the engine
 NEWTON_POLY = 4
@@ -286,25 +286,36 @@ def _events(n: int) -> list[str]:
           "oe = sel(k_imp, omx, om2)",
           "need = sel(1.01 * (" + " + ".join(f"fabs(p{k})" for k in range(n + 1)) + ") < mx,"
           " 0.0, 1.0)"]
-    # the impact (restitution, the other side) and the step over the rest of the interval
-    L += ["r = 1.0 - xi",
-          "ti = t + xi * h",
+    # the next step: after an impact (restitution, the other side), from the impact; else, where
+    # this step ends short of the interval's end, from there; to the end of the interval, or
+    # over a hop only (its parabola's length and a quarter: the hops of a block coming to rest,
+    # each then a short step of a low order, instead of one over the rest of the interval)
+    L += ["ti = t + xi * h",
           "sn = -side",
           "omn = eta * omx",
-          "u0 = u0s + u1s * xi",
-          "u1 = u1s * r",
-          "qi = q * r * r",
-          "th = 0.0",
-          "hr = h * r",
-          "D_1 = omn * hr",
-          "S_0 = sn * sa",
-          "C_0 = ca",
+          "ue = u0s + u1s * xi",
+          "acc = -psq * (sn * sa + ue * ca)",
+          "tau = fdiv(-2.5 * omn, acc)",
+          "left = sel(k_imp, h * (1.0 - xi) + rem, rem)",
+          "k_cap = k_imp & (acc * omn < 0.0) & (tau < left)",
+          "hr = sel(k_cap, tau, left)",
+          "nrem = sel(k_cap, left - tau, 0.0)",
+          "ts = sel(k_imp, ti, t + h)",
+          "u0 = sel(k_imp, ue, u0s + u1s)",
+          "u1 = fdiv(u1s, h) * hr",
+          "qi = psq * hr * hr",
+          "th = sel(k_imp, 0.0, th2)",
+          "omb = sel(k_imp, omn, om2)",
+          "sb = sel(k_imp, sn, side)",
+          "D_1 = omb * hr",
+          "S_0 = sel(k_imp, sn * sa, s1)",
+          "C_0 = sel(k_imp, ca, c1)",
           "r_inv_h = fdiv(1.0, hr)"]
     rest = _renamed(_lane(n), "r_")
     rest = [re.sub(r"\br_(u0|u1|qi|th|D_1|S_0|C_0)\b", r"\1", line) for line in rest]
     L += [line.replace("abs(", "fabs(") for line in rest]
-    # the lowest order at which the rest's series is summed (its terms do not depend on the
-    # order it is cut at): the next round's
+    # the lowest order at which the next step's series is summed (its terms do not depend on
+    # the order it is cut at): the next round's
     lower = [m for m in ORDERS if m < n]
     have = {line.split(" = ")[0] for line in L}
     L += [f"r_a_{k} = fabs(r_D_{k})" for k in range(3, n + 1) if f"r_a_{k}" not in have
@@ -315,32 +326,38 @@ def _events(n: int) -> list[str]:
     L += [f"low = {low}"]
     # a Zeno sequence: the hops left summed in closed form (rocking._core._zeno_rest), the block
     # at rest to the end of the interval unless the forcing may uplift it before
-    L += ["an = psq * (sa + sn * u0 * ca)",
-          "ao = psq * (sa - sn * u0 * ca)",
+    L += ["an = psq * (sa + sn * ue * ca)",
+          "ao = psq * (sa - sn * ue * ca)",
           "k_pos = (an > 0.0) & (ao > 0.0)",
           "rest = sel(k_pos, ti + fdiv(2.0 * fabs(omn), 1.0 - eta * eta) * (fdiv(1.0, an)"
           " + fdiv(eta, ao)), ti)",
-          "yr = fmin(fmax(fdiv(rest - t, h), xi), 1.0)",
-          "k_still = (rest >= t + h) | ((fabs(u0s + u1s * yr) <= tan) & (fabs(u0s + u1s) <= tan))",
+          "tend = t + h + rem",
+          "k_still = (rest >= tend) | ((fabs(u0s + u1s * fdiv(fmax(rest, ti) - t, h)) <= tan)"
+          " & (fabs(u0s + u1s * fdiv(tend - t, h)) <= tan))",
           f"k_rconv = fmax(r_a_{n}, r_a_{n - 1}) <= r_tol",
-          f"k_quiet = (omn * r_om2 > 0.0) & (sn * r_th2 > 0.0) & (fabs(r_th2) < {HALF_PI!r})",
+          f"k_quiet = (omb * r_om2 > 0.0) & (sb * r_th2 > 0.0) & (fabs(r_th2) < {HALF_PI!r})",
           "k_zeno = fabs(omn) <= omz",
-          "k_impok = k_imp & k_root & (k_zeno | k_rconv)",
-          f"k_turn = (1 - k_imp) & (side * th2 > 0.0) & (fabs(th2) < {HALF_PI!r})",
-          "ok = sel(k_turn, 1.0, sel(k_impok, sel(k_zeno, sel(k_still, 4.0, 0.0),"
-          " sel(k_quiet, 2.0, 3.0)), 0.0))",
-          "nth = sel(k_imp, r_th2, th2)",
-          "nom = sel(k_imp, r_om2, om2)",
-          "nside = sel(k_imp, sn, side)",
-          "ns = sel(k_imp, r_s1, s1)",
-          "nc = sel(k_imp, r_c1, c1)",
+          f"k_on = (1 - k_imp) & (side * th2 > 0.0) & (fabs(th2) < {HALF_PI!r})",
+          # 1: a turning point or nothing, to the end of the interval; 2: the next step ends
+          # the interval with nothing in it; 3: the next round takes the next step; 4: at rest
+          "k_end = (rem == 0.0) & k_on",
+          "k_go = ((k_imp & k_root & (1 - k_zeno)) | (k_on & (1 - k_end))) & k_rconv",
+          "ok = sel(k_end, 1.0, sel(k_imp & k_root & k_zeno, sel(k_still, 4.0, 0.0),"
+          " sel(k_go, sel(k_quiet & (nrem == 0.0), 2.0, 3.0), 0.0)))",
+          "k_next = ok == 2.0",
+          "nth = sel(k_next, r_th2, th2)",
+          "nom = sel(k_next, r_om2, om2)",
+          "nside = sel(k_next, sb, side)",
+          "ns = sel(k_next, r_s1, s1)",
+          "nc = sel(k_next, r_c1, c1)",
           "nrest = rest",
-          # max|theta| with the end state where the interval ends rocking (the peak pass adds
-          # the step's own)
-          "nmx = sel((ok == 1.0) | (ok == 2.0), fmax(mx, fabs(nth)), mx)",
+          # max|theta| with this step's end (the peak pass adds its inside), and the next's end
+          # where the interval ends there
+          "mxe = sel(k_imp, mx, fmax(mx, fabs(th2)))",
+          "nmx = sel(k_next, fmax(mxe, fabs(r_th2)), mxe)",
           "nimp = sel(k_imp, nimp0 + 1.0, nimp0)",
           "why = sel(k_imp, sel(1 - k_root, 3.0, sel(k_zeno, 2.0, sel(1 - k_rconv, 4.0, 0.0))),"
-          " sel(k_turn, 0.0, 1.0))"]
+          " sel(k_on, sel(1 - k_rconv, 4.0, 0.0), 1.0))"]
     return L
 
 
@@ -471,11 +488,13 @@ PRELUDE = """#ifndef ROCKING_TAYLOR_LANES_H
 #include <stdint.h>
 #include <string.h>
 
-/* processors with AVX2 run the lanes four at a time: GCC on x86-64 Linux compiles each step twice
-   (AVX2 and the baseline) and picks one when the module is loaded; elsewhere the baseline only.
-   Neither fuses a multiply and an add (-ffp-contract=off): both give the same bits. */
+/* processors with AVX2 run the lanes four at a time, with AVX-512 eight at a time and with mask
+   registers for the selects (the events' passes, all selects, twice as fast): GCC on x86-64 Linux
+   compiles each step three times (AVX-512, AVX2 and the baseline) and picks one when the module is
+   loaded; elsewhere the baseline only.  None fuses a multiply and an add (-ffp-contract=off): all
+   give the same bits. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(ROCKING_NO_CLONES)
-#define ROCKING_LANES_CLONES __attribute__((target_clones("avx2", "default")))
+#define ROCKING_LANES_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define ROCKING_LANES_CLONES
 #endif

@@ -127,7 +127,8 @@ def _event_case(rng, kind, n):
     values = {"E_TH2": th2, "E_OM2": wh2 / h, "E_S1": s1, "E_C1": c1, "E_OM": omega,
               "E_SIDE": side, "E_H": h, "E_T": 3.0, "E_U0": u0, "E_U1": u1, "E_Q": q, "E_SA": sa,
               "E_CA": ca, "E_TAN": math.tan(alpha), "E_P2": p * p, "E_ETA": 0.9,
-              "E_MX": abs(theta) * rng.uniform(0.5, 1.5), "E_OMZ": 1e-7 * p * alpha, "E_NIMP": 0.0}
+              "E_MX": abs(theta) * rng.uniform(0.5, 1.5), "E_OMZ": 1e-7 * p * alpha, "E_NIMP": 0.0,
+              "E_REM": 0.0 if kind != "hop" else rng.choice([0.0, 1e-3])}
     return cf[:n + 1], [values[r] for r in _make_lanes.EV_IN]
 
 
