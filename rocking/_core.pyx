@@ -1332,7 +1332,8 @@ cdef extern from "_taylor_lanes.h":
         CF_TH2, CF_OM2, CF_S1, CF_C1, NCF
         E_NEXT, E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
         E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_REM, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
-        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW, E_NOMN, E_NH, NE
+        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW
+        N_TH2, N_OM2, N_S1, N_C1, N_OM, N_SIDE, N_H, N_T, N_U0, N_U1, N_Q, N_MX, N_NIMP, N_REM, NE
     int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
                                int64_t* bad, double h, double eps, int64_t* n_low,
                                double* cf) noexcept nogil
@@ -1381,12 +1382,20 @@ cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, C
     return n_bad - (top - n), n_low
 
 
+#: the E_ row of each N_ row (N_TH2 .. N_REM, the next round's inputs)
+cdef long _E_OF_N[14]
+_E_OF_N[:] = [E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_MX, E_NIMP,
+              E_REM]
+
+
 cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, double ta,
                   double h, double zeno_tol) noexcept nogil:
     """Lane ``i``'s step into column ``k`` of the events' scratch."""
     cdef long r
     for r in range(rows):
         L.e[r][k] = L.cf[r][i]
+    for r in range(rows, ORDERS_LAST + 1):  # (a round redone at a higher order reads them)
+        L.e[r][k] = 0.0
     L.e[E_TH2][k] = L.cf[CF_TH2][i]
     L.e[E_OM2][k] = L.cf[CF_OM2][i]
     L.e[E_S1][k] = L.cf[CF_S1][i]
@@ -1409,12 +1418,32 @@ cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, do
     L.e[E_REM][k] = 0.0
 
 
+cdef void _next_column(long k, long m2, long rows, bint go, Chunk* L) noexcept nogil:
+    """Column ``k`` of the events' scratch to column ``m2`` (``m2 <= k``) for the next round:
+    where ``go``, the next step the round found (its polynomial of ``rows`` terms, the rest of the
+    column's polynomial rows zero, and the N_ rows for the E_ rows); else the round's own inputs
+    (a round again at a higher order)."""
+    cdef long r
+    if go:
+        for r in range(rows):
+            L.e[r][m2] = L.e[E_NEXT + r][k]
+        for r in range(rows, ORDERS_LAST + 1):
+            L.e[r][m2] = 0.0
+        for r in range(E_SA, E_OMZ + 1):     # the block's own rows (then the new E_MX)
+            L.e[r][m2] = L.e[r][k]
+        for r in range(N_REM - N_TH2 + 1):   # N_X to E_X (in the order of EV_NEXT)
+            L.e[_E_OF_N[r]][m2] = L.e[N_TH2 + r][k]
+    elif m2 != k:
+        for r in range(NE):
+            L.e[r][m2] = L.e[r][k]
+
+
 cdef void _settle(long k, long i, long j, double ok, Chunk* L, int64_t* stats) noexcept nogil:
     """Lane ``i`` to the end of the interval as column ``k`` of the events' scratch found it."""
-    L.f[R_MX][i] = L.e[E_MX][k]
-    L.i[I_NIMP][i] += <long>L.e[E_NIMP][k]
+    L.f[R_MX][i] = L.e[N_MX][k]
+    L.i[I_NIMP][i] += <long>L.e[N_NIMP][k]
     L.bad[i] = 0
-    stats[ST_IMPACTS] += <long>L.e[E_NIMP][k]
+    stats[ST_IMPACTS] += <long>L.e[N_NIMP][k]
     if ok == 4.0:  # at rest after a Zeno sequence
         L.i[I_STATUS][i] = REST
         L.i[I_WAKE][i] = j + 1
@@ -1470,15 +1499,9 @@ cdef long _events(long order, long n, long j, double uj, double duj, Chunk* L, d
             i = idx[k]
             if ok == 0.0:
                 stats[ST_WHY - 1 + <long>L.e[E_WHY][k]] += 1
-            elif ok == 3.0:  # an impact, then more in the interval: the next round
-                for r in range(rows):
-                    L.e[r][m2] = L.e[E_NEXT + r][k]
-                if m2 != k:
-                    for r in range(E_TH2, E_REM + 1):
-                        L.e[r][m2] = L.e[r][k]
-                L.e[E_OM][m2] = L.e[E_NOMN][k]
-                L.e[E_H][m2] = L.e[E_NH][k]
-                low = max(low, <long>L.e[E_LOW][k])
+            elif ok == 3.0 or ok == 5.0:  # more in the interval: the next round
+                _next_column(k, m2, rows, ok == 3.0, L)
+                low = max(low, <long>L.e[E_LOW][k] if ok == 3.0 else order + 2)
                 idx[m2] = i
                 m2 += 1
             else:

@@ -151,16 +151,17 @@ EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_H", "E_T", "E_U0
 #: the engine must take it, the end of its rest after a Zeno sequence, whether the peak pass is
 #: needed and where it looks (E_XE, E_TE, E_OE), the lowest order the rest's polynomial needs
 EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_WHY", "E_NREST", "E_NEED",
-          "E_XE", "E_TE", "E_OE", "E_LOW", "E_NOMN", "E_NH")
-#: what a round writes for the next one (read where an impact is followed by more in the same
-#: interval): row, value (and the rest's polynomial, rows E_NEXT + k); omega and h go to rows
-#: of their own (E_NOMN, E_NH: the peak pass reads the round's)
-EV_NEXT = (("E_TH2", "r_th2"), ("E_OM2", "r_om2"), ("E_S1", "r_s1"), ("E_C1", "r_c1"),
-           ("E_NOMN", "omb"), ("E_SIDE", "sb"), ("E_NH", "hr"), ("E_T", "ts"), ("E_U0", "u0"),
-           ("E_U1", "u1"), ("E_Q", "qi"), ("E_MX", "nmx"), ("E_NIMP", "nimp"), ("E_REM", "nrem"))
-#: Newton iterations of the impact on the step's polynomial (see :func:`_events`); a root not
+          "E_XE", "E_TE", "E_OE", "E_LOW")
+#: what a round writes for the next one (read where the interval goes on after an event):
+#: the row N_X for the input row E_X, its value (and the next step's polynomial, rows E_NEXT +
+#: k); the round's own inputs are left as they were (a round redone at a higher order reads them)
+EV_NEXT = (("TH2", "r_th2"), ("OM2", "r_om2"), ("S1", "r_s1"), ("C1", "r_c1"), ("OM", "omb"),
+           ("SIDE", "sb"), ("H", "hr"), ("T", "ts"), ("U0", "u0"), ("U1", "u1"), ("Q", "qi"),
+           ("MX", "nmx"), ("NIMP", "nimp"), ("REM", "nrem"))
+EV_NX = tuple("N_" + r for r, _ in EV_NEXT)
+#: Halley's iterations of the impact on the step's polynomial (see :func:`_events`); a root not
 #: converged to ROOT_TOL (in units of the step) after them is left to the engine
-NEWTON_POLY = 4
+NEWTON_POLY = 3
 ROOT_TOL = 1e-13
 HALF_PI = 1.5707963267948966
 
@@ -174,6 +175,25 @@ def _poly(c: str, n: int, x: str, d: int = 0) -> str:
     for k in range(n - 1, d - 1, -1):
         out = f"({out}) * {x} + {coef(k)}"
     return out
+
+
+def _poly2(c: str, n: int, x: str, x2: str, d: int = 0) -> str:
+    """:func:`_poly` as two Horner chains in ``x2 = x^2`` (the even and the odd powers), half as
+    long a chain of dependent operations."""
+    def coef(k):
+        f = math.prod(range(k - d + 1, k + 1))
+        return f"{c}{k}" if f == 1 else f"{float(f)!r} * {c}{k}"
+
+    def chain(ks):
+        if not ks:
+            return "0.0"
+        out = coef(ks[-1])
+        for k in reversed(ks[:-1]):
+            out = f"({out}) * {x2} + {coef(k)}"
+        return out
+    even = [k for k in range(d, n + 1) if (k - d) % 2 == 0]
+    odd = [k for k in range(d, n + 1) if (k - d) % 2 == 1]
+    return f"({chain(even)}) + {x} * ({chain(odd)})"
 
 
 def _cubic(c0, c1, c2, c3, x):
@@ -264,17 +284,22 @@ def _events(n: int) -> list[str]:
           "bl0 = blo",
           "bh0 = bhi"]
     x = "x0"
-    for it in range(NEWTON_POLY):
-        L += [f"f{it} = {P(x)}",
+    for it in range(NEWTON_POLY):   # Halley's iterations (cubic convergence)
+        P2 = lambda d: _poly2("p", n, x, f"xx{it}", d)
+        L += [f"xx{it} = {x} * {x}",
+              f"f{it} = {P2(0)}",
+              f"g{it} = {P2(1)}",
+              f"d{it} = {P2(2)}",
               f"k_up{it} = side * f{it} > 0.0",
               f"bl{it + 1} = sel(k_up{it}, {x}, bl{it})",
               f"bh{it + 1} = sel(k_up{it}, bh{it}, {x})",
-              f"y{it} = {x} - fdiv(f{it}, {P(x, 1)})",
+              f"y{it} = {x} - fdiv(2.0 * f{it} * g{it}, 2.0 * g{it} * g{it} - f{it} * d{it})",
               f"x{it + 1} = sel((y{it} >= bl{it + 1}) & (y{it} <= bh{it + 1}), y{it},"
               f" 0.5 * (bl{it + 1} + bh{it + 1}))"]
         x = f"x{it + 1}"
-    L += [f"thx = {P(x)}",
-          f"dpx = {P(x, 1)}",
+    L += [f"xxf = {x} * {x}",
+          f"thx = {_poly2('p', n, x, 'xxf')}",
+          f"dpx = {_poly2('p', n, x, 'xxf', 1)}",
           "k_root = (fabs(fdiv(thx, dpx)) <= %r) & (%s > 0.0)" % (ROOT_TOL, x),
           f"xi = {x}",
           "omx = dpx * inv_h",
@@ -323,7 +348,7 @@ def _events(n: int) -> list[str]:
     low = f"{float(n)!r}"
     for m in reversed(lower):
         low = f"sel((r_a_{m} <= r_tol) & (r_a_{m - 1} <= r_tol), {float(m)!r}, {low})"
-    L += [f"low = {low}"]
+    L += [f"low = sel(k_cap, {low}, {float(n)!r})"]   # (a step after a hop: as low as the hop)
     # a Zeno sequence: the hops left summed in closed form (rocking._core._zeno_rest), the block
     # at rest to the end of the interval unless the forcing may uplift it before
     L += ["an = psq * (sa + sn * ue * ca)",
@@ -341,9 +366,11 @@ def _events(n: int) -> list[str]:
           # 1: a turning point or nothing, to the end of the interval; 2: the next step ends
           # the interval with nothing in it; 3: the next round takes the next step; 4: at rest
           "k_end = (rem == 0.0) & k_on",
-          "k_go = ((k_imp & k_root & (1 - k_zeno)) | (k_on & (1 - k_end))) & k_rconv",
+          "k_more = (k_imp & k_root & (1 - k_zeno)) | (k_on & (1 - k_end))",
+          # 5: the next step needs a higher order: the round again, at the next order up
           "ok = sel(k_end, 1.0, sel(k_imp & k_root & k_zeno, sel(k_still, 4.0, 0.0),"
-          " sel(k_go, sel(k_quiet & (nrem == 0.0), 2.0, 3.0), 0.0)))",
+          " sel(k_more, sel(k_rconv, sel(k_quiet & (nrem == 0.0), 2.0, 3.0), %r), 0.0)))"
+          % (5.0 if n < ORDERS[-1] else 0.0),
           "k_next = ok == 2.0",
           "nth = sel(k_next, r_th2, th2)",
           "nom = sel(k_next, r_om2, om2)",
@@ -419,17 +446,18 @@ copysign = math.copysign
 
 def _in_name(row: str) -> str:
     """The local name of an input row of :data:`EV_IN` in :func:`_events`."""
-    return {"E_U0": "u0s", "E_U1": "u1s", "E_NIMP": "nimp0", "E_P2": "psq"}.get(row, row[2:].lower())
+    return {"E_U0": "u0s", "E_U1": "u1s", "E_NIMP": "nimp0", "E_P2": "psq",
+            "N_MX": "mx"}.get(row, row[2:].lower())
 
 
 #: the inputs of :func:`_peaks` (rows of the scratch; its polynomial, rows 0 .. N, besides)
-PEAK_IN = ("E_OM", "E_H", "E_MX", "E_XE", "E_TE", "E_OE")
+PEAK_IN = ("E_OM", "E_H", "N_MX", "E_XE", "E_TE", "E_OE")
 
 
 def _next(n: int) -> list[tuple[str, str]]:
     """What a round writes (rows and values): :data:`EV_OUT`, :data:`EV_NEXT`, and the rest's
     polynomial (rows E_NEXT + k)."""
-    return ([(r, r[2:].lower()) for r in EV_OUT if r not in ("E_NOMN", "E_NH")] + list(EV_NEXT)
+    return ([(r, r[2:].lower()) for r in EV_OUT] + [("N_" + r, v) for r, v in EV_NEXT]
             + [(f"E_NEXT + {k}", "th" if k == 0 else ("D_1" if k == 1 else f"r_c_{k}"))
                for k in range(n + 1)])
 
@@ -437,8 +465,8 @@ def _next(n: int) -> list[tuple[str, str]]:
 def event_rows() -> dict:
     """``{row name: index}`` of the events' scratch (the enum of the generated header)."""
     rows = {"E_NEXT": NCOEF}
-    rows.update({r: k for k, r in enumerate(EV_IN + EV_OUT, 2 * NCOEF)})
-    rows["NE"] = 2 * NCOEF + len(EV_IN) + len(EV_OUT)
+    rows.update({r: k for k, r in enumerate(EV_IN + EV_OUT + EV_NX, 2 * NCOEF)})
+    rows["NE"] = 2 * NCOEF + len(EV_IN) + len(EV_OUT) + len(EV_NX)
     return rows
 
 
@@ -479,7 +507,7 @@ def _c_loop(name: str, n: int, rows, body: list[str], stores) -> str:
 
 def _events_function(n: int) -> str:
     return (_c_loop(f"rocking_events_{n}", n, EV_IN, _events(n), _next(n))
-            + _c_loop(f"rocking_peaks_{n}", n, PEAK_IN, _peaks(n), [("E_MX", "nmx")]))
+            + _c_loop(f"rocking_peaks_{n}", n, PEAK_IN, _peaks(n), [("N_MX", "nmx")]))
 
 
 PRELUDE = """#ifndef ROCKING_TAYLOR_LANES_H
@@ -523,8 +551,8 @@ def source() -> str:
             f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(CF_ROWS, ORDERS[-1] + 1))},"
             f" NCF = {ORDERS[-1] + 1 + len(CF_ROWS)} }};",
             f"enum {{ E_NEXT = {NCOEF}, "
-            f"{', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT, 2 * NCOEF))},"
-            f" NE = {2 * NCOEF + len(EV_IN) + len(EV_OUT)} }};"]
+            f"{', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT + EV_NX, 2 * NCOEF))},"
+            f" NE = {2 * NCOEF + len(EV_IN) + len(EV_OUT) + len(EV_NX)} }};"]
     args = "n, uj, duj, f, bad, h, eps, n_low, cf"
     dispatch = ["\n\n/* the step of ORDERS order ``order`` (the highest for larger); returns the lanes left,"
                 " and in\n   ``*n_low`` the kept lanes for which a lower order would have done */",
