@@ -1329,7 +1329,7 @@ cdef extern from "_taylor_lanes.h":
         R_REST, R_MX, NF
         I_STATUS, I_NIMP, I_UP, I_RUN, I_WAKE, NI
         LANES  # runs stepped together at most (rocking.lanes.LANES)
-        CF_TH2, CF_OM2, CF_S1, CF_C1, NCF
+        CF_TH2, CF_OM2, CF_S1, CF_C1, CF_OWN, NCF
         E_NEXT, E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
         E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_REM, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
         E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW
@@ -1394,7 +1394,7 @@ cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, do
     cdef long r
     for r in range(rows):
         L.e[r][k] = L.cf[r][i]
-    for r in range(rows, ORDERS_LAST + 1):  # (a round redone at a higher order reads them)
+    for r in range(rows, ORDERS_LAST + 1):  # (a round of a higher order reads them)
         L.e[r][k] = 0.0
     L.e[E_TH2][k] = L.cf[CF_TH2][i]
     L.e[E_OM2][k] = L.cf[CF_OM2][i]
@@ -1416,6 +1416,61 @@ cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, do
     L.e[E_OMZ][k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
     L.e[E_NIMP][k] = 0.0
     L.e[E_REM][k] = 0.0
+
+
+cdef inline long n_events(Chunk* L, long n) noexcept nogil:
+    """How many of lanes ``0 .. n-1`` the step left with something happening in it (bad 1)."""
+    cdef long i, m = 0
+    for i in range(n):
+        m += L.bad[i] == 1
+    return m
+
+
+ctypedef struct Restep:
+    # the lanes whose step needs more terms than the chunk's order, gathered (rocking_lanes_N's
+    # rows; the others unused)
+    double f[NF][LANES]
+    int64_t bad[LANES]
+    double cf[NCF][LANES]
+
+
+cdef void _restep(long order, long n, double uj, double duj, Chunk* L, double h) noexcept nogil:
+    """The lanes whose step needs more terms than ``order`` (bad 2), stepped again at the next
+    orders up (cut at their own: the same bits as in a chunk of that order), those still short at
+    the highest left to the engine (bad 2)."""
+    cdef Restep R
+    cdef long idx[LANES]
+    cdef long m = 0, k, i, r, top, o = order
+    cdef int64_t n_low = 0
+    cdef int rows[8]
+    rows[:] = [R_A, R_Q, R_TH, R_OM, R_SIDE, R_SPHI, R_CPHI, R_MX]
+    for i in range(n):
+        if L.bad[i] == 2:
+            idx[m] = i
+            m += 1
+    while m > 0 and o < ORDERS_LAST:
+        o += 2
+        top = min(LANES, (m + 3) // 4 * 4)
+        for k in range(top):   # (padding lanes: omega 0, which no step keeps)
+            for r in range(8):
+                R.f[rows[r]][k] = L.f[rows[r]][idx[k]] if k < m else 0.0
+        rocking_lanes_step(o, top, uj, duj, &R.f[0][0], &R.bad[0], h, TAYLOR_EPS, &n_low,
+                           &R.cf[0][0])
+        top = 0
+        for k in range(m):
+            i = idx[k]
+            if R.bad[k] == 2:
+                idx[top] = i
+                top += 1
+                continue
+            L.bad[i] = R.bad[k]
+            for r in range(8):
+                L.f[rows[r]][i] = R.f[rows[r]][k]
+            for r in range(o + 1):
+                L.cf[r][i] = R.cf[r][k]
+            for r in range(CF_TH2, CF_OWN + 1):
+                L.cf[r][i] = R.cf[r][k]
+        m = top
 
 
 cdef void _next_column(long k, long m2, long rows, bint go, Chunk* L) noexcept nogil:
@@ -1462,8 +1517,8 @@ cdef void _settle(long k, long i, long j, double ok, Chunk* L, int64_t* stats) n
     stats[ST_TURNS] += ok == 1.0
 
 
-cdef long _events(long order, long n, long j, double uj, double duj, Chunk* L, double ta,
-                  double h, double zeno_tol, int64_t* stats) noexcept nogil:
+cdef long _events(long n, long j, double uj, double duj, Chunk* L, double ta, double h,
+                  double zeno_tol, int64_t* stats) noexcept nogil:
     """The lanes the step left with something happening in it (bad 1), in rounds of one pass
     over them all (rocking_events_N, then rocking_peaks_N where a peak may be new; on their
     step's polynomial), each round one event per lane: a turning point, or an impact and the
@@ -1473,15 +1528,18 @@ cdef long _events(long order, long n, long j, double uj, double duj, Chunk* L, d
     or a rest of the interval the pass cannot settle, an uplift after a Zeno sequence).  Returns
     how many lanes came to rest."""
     cdef long idx[LANES]
-    cdef long m = 0, m2, top, k, r, i, rounds, n_rest = 0
-    cdef long rows = min(max(order, ORDERS_FIRST), ORDERS_LAST) + 1, low
+    cdef long m = 0, m2, top, k, r, i, rounds, n_rest = 0, own, rows, low
+    cdef long order = ORDERS_FIRST  # the first round's: the highest own order of the lanes' steps
     cdef double ok
     cdef bint peaks
     for i in range(n):
         if L.bad[i] == 1:
-            _gather(m, i, rows, uj, duj, L, ta, h, zeno_tol)
+            own = <long>L.cf[CF_OWN][i]
+            _gather(m, i, own + 1, uj, duj, L, ta, h, zeno_tol)
+            order = max(order, own)
             idx[m] = i
             m += 1
+    rows = order + 1
     for rounds in range(EVENT_ROUNDS):
         if m == 0:
             return n_rest
@@ -1579,7 +1637,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
     cdef Outcome o
     cdef long order = ORDERS_START, n_low = 0, n_rocking = 0, n_live = n, next_wake = 0
     cdef double ta, tb, th, om, pk
-    cdef bint all_low, wake_all, raise_order, changed, over
+    cdef bint all_low, wake_all, raise_order, changed, over, short
     memset(&L.f[0][0], 0, sizeof(L.f))  # (unused lanes at rest: omega 0, see lanes_step)
     for i in range(n):
         k = i0 + i
@@ -1617,19 +1675,25 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
         n_bad = 0
         n_rested = 0
         all_low = False
+        short = False
         if n_rocking > 0:
             n_bad, n_two = lanes_step(order, n_rocking, uval[j], uval[j + 1] - uval[j], &L, h,
                                       TAYLOR_EPS)
             stats[ST_KEPT] += n_rocking - n_bad
             all_low = n_two == n_rocking
+            short = False
             if n_bad > 0:
-                n_rested = _events(order, n_rocking, j, uval[j], uval[j + 1] - uval[j], &L, ta, h,
+                short = n_bad > n_events(&L, n_rocking)
+                if short:  # steps again, at higher orders (and the chunk's order raised below)
+                    stats[ST_LOW] += n_bad - n_events(&L, n_rocking)
+                    _restep(order, n_rocking, uval[j], uval[j + 1] - uval[j], &L, h)
+                n_rested = _events(n_rocking, j, uval[j], uval[j + 1] - uval[j], &L, ta, h,
                                    zeno_tol, stats)
                 if n_rested > 0:
                     next_wake = min(next_wake, j + 1)
         wake_all = j >= next_wake
         if n_bad > 0 or wake_all:  # lanes that need attention in this interval
-            raise_order = False
+            raise_order = short
             changed = n_rested > 0
             if wake_all:
                 next_wake = n_int
@@ -1639,9 +1703,6 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                     b = L.bad[i]
                     if b == 0:
                         continue
-                    if b == 2:
-                        raise_order = True
-                        stats[ST_LOW] += 1
                 else:  # at rest: the engine only where the block may uplift in this interval
                     if L.i[I_WAKE][i] > j:
                         next_wake = min(next_wake, L.i[I_WAKE][i])
@@ -1660,7 +1721,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
                 o = run_core(&F, t_start, h, 1, NULL, True, L.f[R_P][i], L.f[R_ALPHA][i],
                              L.f[R_ETA][i], False, TAYLOR, zeno_tol, False, False, j,
                              L.f[R_TH][i], L.f[R_OM][i], L.f[R_REST][i], j + 1, NULL, NULL, NULL,
-                             NULL, 0, order)
+                             NULL, 0, 0)
                 st2 = o.status
                 th = o.theta
                 om = o.omega

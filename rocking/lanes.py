@@ -5,13 +5,16 @@ Taylor step (``rocking/_taylor_fixed.pxi``) is a chain of dependent operations, 
 waits on it; the runs of a batch are independent, so :func:`run_lanes` takes them :data:`LANES`
 at a time and advances all the rocking ones over each sample interval with one loop over lanes
 (``rocking/_taylor_lanes.h``, generated C: the same arithmetic lane by lane, which the compiler
-turns into SIMD instructions).  Only the common case is done there: a block rocking through a
-whole interval with no turning point, impact or overturning, and with the series converged at
-the chunk's order.  Everything else in an interval (uplift, impacts, Zeno sequences, peaks, a
-higher order, overturning) is handed for that one interval and that one lane to the engine's
-own ``run_core`` (``rocking/_core.pyx``), so the model, its events and its accuracy are exactly
-those of :func:`rocking.engine.run`.  The steps agree with a single run's to rounding (same
-formula, same operations, at the same or a higher order).
+turns into SIMD instructions).  The events of an interval (turning points and their peaks,
+impacts with the restitution and the rest of the interval, the hops of a block coming to rest and
+the Zeno rest that ends them) are taken in the lanes too, for all the lanes with one in a pass
+(``rocking_events_N``): located on the polynomial of the lane's step, as the engine's own
+``run_core`` (``rocking/_core.pyx``) locates them, with the same model, so the answers agree with
+:func:`rocking.engine.run`'s to rounding (the operations differ; near the verge of overturning a
+rounding can change a verdict, as between any two machines).  What the pass cannot settle (an
+uplift from rest, overturning, a Zeno rest followed by an uplift in the same interval, a root or
+a step that needs more than the chunk's order) is handed for that one interval and that one
+lane to ``run_core``; :data:`STATS` counts both.
 
 For records (forcing linear between samples) on a uniform grid with one Taylor step per sample
 (``p dt`` within :data:`rocking.solver.PH_MAX`); :func:`rocking.simulate_many` uses it for those

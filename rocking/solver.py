@@ -16,6 +16,7 @@ integration (unless a longer ``duration`` is asked for, to draw the free rocking
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -136,23 +137,33 @@ def _grid(excitation, p_max: float, linear: bool, duration: float | None,
         return _Grid(engine.NODAL, 1.0 / G, 1.0, 0.0, excitation.acc, empty, excitation.t_start,
                      excitation.dt, n_int, pga / G)
     if isinstance(excitation, Pulse):
-        u_peak = abs(excitation.ap) / G
-        p_eff = p_max * math.sqrt(1.0 + u_peak)
-        if linear:
-            h_max = min(excitation.tp / LINEAR_STEPS_PER_TP, 0.05 / p_eff)
-        else:
-            h_max = min(excitation.tp / STEPS_PER_TP, ph_max / p_eff)
-        t_end = None if duration is None else excitation.support[0] + duration
-        n_int = _pulse_grid_size(excitation, h_max, t_end)
-        if n_int > PART_INTERVALS:
-            a, b, n, _ = _pulse_pieces(excitation, h_max, t_end)
-            return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
-                         empty, float(a[0]), 0.0, n_int, u_peak,
-                         lazy=(excitation, h_max, t_end, float(np.max((b - a) / n))))
-        nodes = _pulse_grid(excitation, h_max, t_end)
-        return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
-                     nodes, nodes[0], 0.0, nodes.size - 1, u_peak)
+        return _pulse_grid_of(excitation, float(p_max), bool(linear), duration, float(ph_max))
     raise TypeError(f"excitation must be a pulses.Pulse or a pulses.Record, got {type(excitation).__name__}")
+
+
+@functools.lru_cache(maxsize=64)
+def _pulse_grid_of(excitation: Pulse, p_max: float, linear: bool, duration: float | None,
+                   ph_max: float) -> _Grid:
+    """The grid of a pulse (:func:`_grid`), kept for the next call with the same pulse and
+    block: a search over slenderness asks for it a dozen times (the nodes are only read)."""
+    empty = np.zeros(0)
+    u_peak = abs(excitation.ap) / G
+    p_eff = p_max * math.sqrt(1.0 + u_peak)
+    if linear:
+        h_max = min(excitation.tp / LINEAR_STEPS_PER_TP, 0.05 / p_eff)
+    else:
+        h_max = min(excitation.tp / STEPS_PER_TP, ph_max / p_eff)
+    t_end = None if duration is None else excitation.support[0] + duration
+    n_int = _pulse_grid_size(excitation, h_max, t_end)
+    if n_int > PART_INTERVALS:
+        a, b, n, _ = _pulse_pieces(excitation, h_max, t_end)
+        return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
+                     empty, float(a[0]), 0.0, n_int, u_peak,
+                     lazy=(excitation, h_max, t_end, float(np.max((b - a) / n))))
+    nodes = _pulse_grid(excitation, h_max, t_end)
+    nodes.setflags(write=False)
+    return _Grid(excitation.kind, excitation.ap / G, excitation.tp, excitation.t0, empty,
+                 nodes, nodes[0], 0.0, nodes.size - 1, u_peak)
 
 
 # --------------------------------------------------------------------------- model choice
