@@ -1330,15 +1330,14 @@ cdef extern from "_taylor_lanes.h":
         I_STATUS, I_NIMP, I_UP, I_RUN, I_WAKE, NI
         LANES  # runs stepped together at most (rocking.lanes.LANES)
         CF_TH2, CF_OM2, CF_S1, CF_C1, CF_OWN, NCF
-        E_NEXT, E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
+        E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_SA, E_CA
         E_TAN, E_P2, E_ETA, E_MX, E_OMZ, E_NIMP, E_REM, E_OK, E_NTH, E_NOM, E_NSIDE, E_NS, E_NC, E_WHY
-        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW
-        N_TH2, N_OM2, N_S1, N_C1, N_OM, N_SIDE, N_H, N_T, N_U0, N_U1, N_Q, N_MX, N_NIMP, N_REM, NE
+        E_NREST, E_NEED, E_XE, E_TE, E_OE, E_LOW, NE
     int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, double duj, double* f,
                                int64_t* bad, double h, double eps, int64_t* n_low,
                                double* cf) noexcept nogil
-    void rocking_events(int64_t order, int64_t m, double* e, double eps) noexcept nogil
-    void rocking_peaks(int64_t order, int64_t m, double* e, double eps) noexcept nogil
+    void rocking_events(int64_t order, int64_t m, double* e, double* nx, double eps) noexcept nogil
+    void rocking_peaks(int64_t order, int64_t m, double* e, double* nx, double eps) noexcept nogil
 
 #: counts a batch in lanes keeps (rocking.lanes.STATS): steps kept in lanes, turning points and
 #: impacts taken in lanes, intervals handed to the engine (rocking lanes, lanes at rest, rocking
@@ -1361,12 +1360,13 @@ cdef enum:
 ctypedef struct Chunk:
     # the state of up to LANES runs stepped together: NF rows of floats, NI rows of integers,
     # why each lane was left by the last step (lanes_N), each lane's polynomial of that step and
-    # its end state (NCF rows), and the events' scratch (NE rows, one column per lane gathered)
+    # its end state (NCF rows), and the events' scratches (NE rows, one column per lane
+    # gathered: the round's and the next round's, in turn)
     double f[NF][LANES]
     long i[NI][LANES]
     int64_t bad[LANES]
     double cf[NCF][LANES]
-    double e[NE][LANES]
+    double e[2][NE][LANES]
 
 
 cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, Chunk* L, double h,
@@ -1382,40 +1382,34 @@ cdef inline (long, long) lanes_step(long order, long n, double uj, double duj, C
     return n_bad - (top - n), n_low
 
 
-#: the E_ row of each N_ row (N_TH2 .. N_REM, the next round's inputs)
-cdef long _E_OF_N[14]
-_E_OF_N[:] = [E_TH2, E_OM2, E_S1, E_C1, E_OM, E_SIDE, E_H, E_T, E_U0, E_U1, E_Q, E_MX, E_NIMP,
-              E_REM]
-
-
-cdef void _gather(long k, long i, long rows, double uj, double duj, Chunk* L, double ta,
-                  double h, double zeno_tol) noexcept nogil:
-    """Lane ``i``'s step into column ``k`` of the events' scratch."""
+cdef void _gather(double* e, long k, long i, long rows, double uj, double duj, Chunk* L,
+                  double ta, double h, double zeno_tol) noexcept nogil:
+    """Lane ``i``'s step into column ``k`` of the events' scratch ``e``."""
     cdef long r
     for r in range(rows):
-        L.e[r][k] = L.cf[r][i]
+        e[r * LANES + k] = L.cf[r][i]
     for r in range(rows, ORDERS_LAST + 1):  # (a round of a higher order reads them)
-        L.e[r][k] = 0.0
-    L.e[E_TH2][k] = L.cf[CF_TH2][i]
-    L.e[E_OM2][k] = L.cf[CF_OM2][i]
-    L.e[E_S1][k] = L.cf[CF_S1][i]
-    L.e[E_C1][k] = L.cf[CF_C1][i]
-    L.e[E_OM][k] = L.f[R_OM][i]
-    L.e[E_SIDE][k] = L.f[R_SIDE][i]
-    L.e[E_H][k] = h
-    L.e[E_T][k] = ta
-    L.e[E_U0][k] = L.f[R_A][i] * uj
-    L.e[E_U1][k] = L.f[R_A][i] * duj
-    L.e[E_Q][k] = L.f[R_Q][i]
-    L.e[E_SA][k] = L.f[R_SA][i]
-    L.e[E_CA][k] = L.f[R_CA][i]
-    L.e[E_TAN][k] = L.f[R_TAN][i]
-    L.e[E_P2][k] = L.f[R_P][i] * L.f[R_P][i]
-    L.e[E_ETA][k] = L.f[R_ETA][i]
-    L.e[E_MX][k] = L.f[R_MX][i]
-    L.e[E_OMZ][k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
-    L.e[E_NIMP][k] = 0.0
-    L.e[E_REM][k] = 0.0
+        e[r * LANES + k] = 0.0
+    e[E_TH2 * LANES + k] = L.cf[CF_TH2][i]
+    e[E_OM2 * LANES + k] = L.cf[CF_OM2][i]
+    e[E_S1 * LANES + k] = L.cf[CF_S1][i]
+    e[E_C1 * LANES + k] = L.cf[CF_C1][i]
+    e[E_OM * LANES + k] = L.f[R_OM][i]
+    e[E_SIDE * LANES + k] = L.f[R_SIDE][i]
+    e[E_H * LANES + k] = h
+    e[E_T * LANES + k] = ta
+    e[E_U0 * LANES + k] = L.f[R_A][i] * uj
+    e[E_U1 * LANES + k] = L.f[R_A][i] * duj
+    e[E_Q * LANES + k] = L.f[R_Q][i]
+    e[E_SA * LANES + k] = L.f[R_SA][i]
+    e[E_CA * LANES + k] = L.f[R_CA][i]
+    e[E_TAN * LANES + k] = L.f[R_TAN][i]
+    e[E_P2 * LANES + k] = L.f[R_P][i] * L.f[R_P][i]
+    e[E_ETA * LANES + k] = L.f[R_ETA][i]
+    e[E_MX * LANES + k] = L.f[R_MX][i]
+    e[E_OMZ * LANES + k] = zeno_tol * L.f[R_P][i] * L.f[R_ALPHA][i]
+    e[E_NIMP * LANES + k] = 0.0
+    e[E_REM * LANES + k] = 0.0
 
 
 cdef inline long n_events(Chunk* L, long n) noexcept nogil:
@@ -1473,47 +1467,39 @@ cdef void _restep(long order, long n, double uj, double duj, Chunk* L, double h)
         m = top
 
 
-cdef void _next_column(long k, long m2, long rows, bint go, Chunk* L) noexcept nogil:
-    """Column ``k`` of the events' scratch to column ``m2`` (``m2 <= k``) for the next round:
-    where ``go``, the next step the round found (its polynomial of ``rows`` terms, the rest of the
-    column's polynomial rows zero, and the N_ rows for the E_ rows); else the round's own inputs
-    (a round again at a higher order)."""
+cdef inline void _column(double* dst, long m2, const double* src, long k) noexcept nogil:
+    """The inputs of a lane (the polynomial and :data:`E_TH2` .. :data:`E_REM`) from column ``k``
+    of ``src`` to column ``m2`` of ``dst``."""
     cdef long r
-    if go:
-        for r in range(rows):
-            L.e[r][m2] = L.e[E_NEXT + r][k]
-        for r in range(rows, ORDERS_LAST + 1):
-            L.e[r][m2] = 0.0
-        for r in range(E_SA, E_OMZ + 1):     # the block's own rows (then the new E_MX)
-            L.e[r][m2] = L.e[r][k]
-        for r in range(N_REM - N_TH2 + 1):   # N_X to E_X (in the order of EV_NEXT)
-            L.e[_E_OF_N[r]][m2] = L.e[N_TH2 + r][k]
-    elif m2 != k:
-        for r in range(NE):
-            L.e[r][m2] = L.e[r][k]
+    for r in range(ORDERS_LAST + 1):
+        dst[r * LANES + m2] = src[r * LANES + k]
+    for r in range(E_TH2, E_REM + 1):
+        dst[r * LANES + m2] = src[r * LANES + k]
 
 
-cdef void _settle(long k, long i, long j, double ok, Chunk* L, int64_t* stats) noexcept nogil:
-    """Lane ``i`` to the end of the interval as column ``k`` of the events' scratch found it."""
-    L.f[R_MX][i] = L.e[N_MX][k]
-    L.i[I_NIMP][i] += <long>L.e[N_NIMP][k]
+cdef void _settle(const double* e, const double* nx, long k, long i, long j, double ok, Chunk* L,
+                  int64_t* stats) noexcept nogil:
+    """Lane ``i`` to the end of the interval as column ``k`` of the events' scratches found it
+    (``e`` the round's, ``nx`` the next round's: the peak and the impacts so far)."""
+    L.f[R_MX][i] = nx[E_MX * LANES + k]
+    L.i[I_NIMP][i] += <long>nx[E_NIMP * LANES + k]
     L.bad[i] = 0
-    stats[ST_IMPACTS] += <long>L.e[N_NIMP][k]
+    stats[ST_IMPACTS] += <long>nx[E_NIMP * LANES + k]
     if ok == 4.0:  # at rest after a Zeno sequence
         L.i[I_STATUS][i] = REST
         L.i[I_WAKE][i] = j + 1
-        L.f[R_REST][i] = L.e[E_NREST][k]
+        L.f[R_REST][i] = e[E_NREST * LANES + k]
         L.f[R_TH][i] = 0.0
         L.f[R_OM][i] = 0.0
         L.f[R_SIDE][i] = 0.0
         L.f[R_SPHI][i] = 0.0
         L.f[R_CPHI][i] = 1.0
         return
-    L.f[R_TH][i] = L.e[E_NTH][k]
-    L.f[R_OM][i] = L.e[E_NOM][k]
-    L.f[R_SIDE][i] = L.e[E_NSIDE][k]
-    L.f[R_SPHI][i] = L.e[E_NS][k]
-    L.f[R_CPHI][i] = L.e[E_NC][k]
+    L.f[R_TH][i] = e[E_NTH * LANES + k]
+    L.f[R_OM][i] = e[E_NOM * LANES + k]
+    L.f[R_SIDE][i] = e[E_NSIDE * LANES + k]
+    L.f[R_SPHI][i] = e[E_NS * LANES + k]
+    L.f[R_CPHI][i] = e[E_NC * LANES + k]
     stats[ST_TURNS] += ok == 1.0
 
 
@@ -1522,52 +1508,62 @@ cdef long _events(long n, long j, double uj, double duj, Chunk* L, double ta, do
     """The lanes the step left with something happening in it (bad 1), in rounds of one pass
     over them all (rocking_events_N, then rocking_peaks_N where a peak may be new; on their
     step's polynomial), each round one event per lane: a turning point, or an impact and the
-    step over the rest of the interval, where the next round looks (at the lowest order its
-    lanes' polynomials need), or a Zeno sequence summed in closed form.  Those settled are
-    written back (bad 0); the engine takes the others through the interval (overturning, a root
-    or a rest of the interval the pass cannot settle, an uplift after a Zeno sequence).  Returns
-    how many lanes came to rest."""
+    step after it (over a hop, or to the end of the interval), where the next round looks, or a
+    Zeno sequence summed in closed form.  Each round reads its scratch and writes the next
+    round's (the two in turn).  Those settled are written back (bad 0); the engine takes the
+    others through the interval (overturning, a root the pass cannot settle, an uplift after a
+    Zeno sequence).  Returns how many lanes came to rest."""
     cdef long idx[LANES]
-    cdef long m = 0, m2, top, k, r, i, rounds, n_rest = 0, own, rows, low
+    cdef long m = 0, m2, top, k, i, rounds, n_rest = 0, own, low
     cdef long order = ORDERS_FIRST  # the first round's: the highest own order of the lanes' steps
     cdef double ok
+    cdef double* e = &L.e[0][0][0]
+    cdef double* nx = &L.e[1][0][0]
+    cdef double* swap
     cdef bint peaks
     for i in range(n):
         if L.bad[i] == 1:
             own = <long>L.cf[CF_OWN][i]
-            _gather(m, i, own + 1, uj, duj, L, ta, h, zeno_tol)
+            _gather(e, m, i, own + 1, uj, duj, L, ta, h, zeno_tol)
             order = max(order, own)
             idx[m] = i
             m += 1
-    rows = order + 1
     for rounds in range(EVENT_ROUNDS):
         if m == 0:
             return n_rest
         top = min(LANES, (m + 3) // 4 * 4)  # whole vectors (the rest of the last one: stale)
-        rocking_events(order, top, &L.e[0][0], TAYLOR_EPS)
+        rocking_events(order, top, e, nx, TAYLOR_EPS)
         peaks = False
         for k in range(m):
-            peaks = peaks or L.e[E_NEED][k] != 0.0
+            peaks = peaks or e[E_NEED * LANES + k] != 0.0
         if peaks:
-            rocking_peaks(order, top, &L.e[0][0], TAYLOR_EPS)
+            rocking_peaks(order, top, e, nx, TAYLOR_EPS)
         m2 = 0
         low = ORDERS_FIRST
         for k in range(m):
-            ok = L.e[E_OK][k]
+            ok = e[E_OK * LANES + k]
             i = idx[k]
             if ok == 0.0:
-                stats[ST_WHY - 1 + <long>L.e[E_WHY][k]] += 1
-            elif ok == 3.0 or ok == 5.0:  # more in the interval: the next round
-                _next_column(k, m2, rows, ok == 3.0, L)
-                low = max(low, <long>L.e[E_LOW][k] if ok == 3.0 else order + 2)
+                stats[ST_WHY - 1 + <long>e[E_WHY * LANES + k]] += 1
+            elif ok == 3.0:  # more in the interval: the next round, from the next step
+                if m2 != k:
+                    _column(nx, m2, nx, k)
+                low = max(low, <long>e[E_LOW * LANES + k])
+                idx[m2] = i
+                m2 += 1
+            elif ok == 5.0:  # the round again, at the next order up
+                _column(nx, m2, e, k)
+                low = max(low, order + 2)
                 idx[m2] = i
                 m2 += 1
             else:
-                _settle(k, i, j, ok, L, stats)
+                _settle(e, nx, k, i, j, ok, L, stats)
                 n_rest += ok == 4.0
         m = m2
         order = low
-        rows = order + 1
+        swap = e
+        e = nx
+        nx = swap
     stats[ST_WHY + 4] += m  # too many events in one interval: the engine takes them
     return n_rest
 
@@ -1664,7 +1660,7 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
         L.bad[i] = 0
     F.kind, F.tp, F.t0, F.uval = NODAL, 1.0, 0.0, uval
     F.vval, F.vamp = NULL, 0.0
-    memset(&L.e[0][0], 0, sizeof(L.e))  # (the events' padding columns compute on what is there)
+    memset(&L.e[0][0][0], 0, sizeof(L.e))  # (the events' padding columns compute on what is there)
     for j in range(n_int):
         if n_live == 0:
             break
@@ -2018,20 +2014,23 @@ def py_lanes_step(long order, long n, double uj, double duj, double[:, ::1] stat
     return res
 
 
-def py_events(long order, long m, double[:, ::1] e, bint peaks):
-    """A round of the lanes' events of order ``order`` on columns ``0 .. m-1`` of ``e`` (the
-    scratch: ``NE`` rows of ``LANES`` columns, rocking._make_lanes.event_rows()), in place,
-    then its peaks where ``peaks``."""
+def py_events(long order, long m, double[:, ::1] e, double[:, ::1] nx, bint peaks):
+    """A round of the lanes' events of order ``order`` on columns ``0 .. m-1`` of the round's
+    scratch ``e``, writing the next round's ``nx`` (each ``NE`` rows of ``LANES`` columns,
+    rocking._make_lanes.event_rows()), in place, then its peaks where ``peaks``."""
     cdef Chunk L
-    cdef long r, k
-    if not (0 <= m <= LANES and e.shape[0] == NE and e.shape[1] == LANES):
-        raise ValueError(f"e must be {NE} x {LANES}")
+    cdef long r, k, b
+    if not (0 <= m <= LANES and e.shape[0] == NE and e.shape[1] == LANES
+            and nx.shape[0] == NE and nx.shape[1] == LANES):
+        raise ValueError(f"e and nx must be {NE} x {LANES}")
     for r in range(NE):
         for k in range(LANES):
-            L.e[r][k] = e[r, k]
-    rocking_events(order, m, &L.e[0][0], TAYLOR_EPS)
+            L.e[0][r][k] = e[r, k]
+            L.e[1][r][k] = nx[r, k]
+    rocking_events(order, m, &L.e[0][0][0], &L.e[1][0][0], TAYLOR_EPS)
     if peaks:
-        rocking_peaks(order, m, &L.e[0][0], TAYLOR_EPS)
+        rocking_peaks(order, m, &L.e[0][0][0], &L.e[1][0][0], TAYLOR_EPS)
     for r in range(NE):
         for k in range(LANES):
-            e[r, k] = L.e[r][k]
+            e[r, k] = L.e[0][r][k]
+            nx[r, k] = L.e[1][r][k]

@@ -166,27 +166,28 @@ def _function(n: int) -> str:
 #: rows of the per-lane polynomial written by the lanes' step: its coefficients c_0 .. c_N (rows
 #: 0 .. N), then the step's end state
 CF_ROWS = ("CF_TH2", "CF_OM2", "CF_S1", "CF_C1", "CF_OWN")
-#: the events' scratch (one column per lane with an event, gathered by rocking._core): the
-#: polynomial of the lane's step (rows 0 .. N), that of the step over the rest of the interval
-#: after an impact (rows E_NEXT + 0 .. N, the next round's), then the rows below
+#: the events' scratch: two of them, the round's and the next round's (one column per lane with
+#: an event, gathered by rocking._core), each the polynomial of the lane's step (rows 0 .. N),
+#: then the rows below
 NCOEF = ORDERS[-1] + 1
 #: the lane's step (of length h from time t, forcing u0s + u1s x, q = (p h)^2, omega and the end
 #: state th2, om2, s1, c1), the block (sin, cos and tan of alpha, p^2, the restitution eta, the
 #: Zeno threshold omz of omega) and what the rounds have found (max|theta|, impacts)
 EV_IN = ("E_TH2", "E_OM2", "E_S1", "E_C1", "E_OM", "E_SIDE", "E_H", "E_T", "E_U0", "E_U1", "E_Q",
          "E_SA", "E_CA", "E_TAN", "E_P2", "E_ETA", "E_MX", "E_OMZ", "E_NIMP", "E_REM")
+#: the block's rows (the next round's as the round's)
+EV_BLOCK = ("E_SA", "E_CA", "E_TAN", "E_P2", "E_ETA", "E_OMZ")
 #: the round's verdict (E_OK, :func:`_events`), the lane's state at the end of the interval, why
 #: the engine must take it, the end of its rest after a Zeno sequence, whether the peak pass is
-#: needed and where it looks (E_XE, E_TE, E_OE), the lowest order the rest's polynomial needs
+#: needed and where it looks (E_XE, E_TE, E_OE), the lowest order the next step needs
 EV_OUT = ("E_OK", "E_NTH", "E_NOM", "E_NSIDE", "E_NS", "E_NC", "E_WHY", "E_NREST", "E_NEED",
           "E_XE", "E_TE", "E_OE", "E_LOW")
-#: what a round writes for the next one (read where the interval goes on after an event):
-#: the row N_X for the input row E_X, its value (and the next step's polynomial, rows E_NEXT +
-#: k); the round's own inputs are left as they were (a round redone at a higher order reads them)
-EV_NEXT = (("TH2", "r_th2"), ("OM2", "r_om2"), ("S1", "r_s1"), ("C1", "r_c1"), ("OM", "omb"),
-           ("SIDE", "sb"), ("H", "hr"), ("T", "ts"), ("U0", "u0"), ("U1", "u1"), ("Q", "qi"),
-           ("MX", "nmx"), ("NIMP", "nimp"), ("REM", "nrem"))
-EV_NX = tuple("N_" + r for r, _ in EV_NEXT)
+#: what a round writes into the next round's scratch (read where the interval goes on after an
+#: event): input row, value (and the next step's polynomial, rows 0 .. N); the round's own are
+#: left as they were (a round redone at a higher order reads them)
+EV_NEXT = (("E_TH2", "r_th2"), ("E_OM2", "r_om2"), ("E_S1", "r_s1"), ("E_C1", "r_c1"),
+           ("E_OM", "omb"), ("E_SIDE", "sb"), ("E_H", "hr"), ("E_T", "ts"), ("E_U0", "u0"),
+           ("E_U1", "u1"), ("E_Q", "qi"), ("E_MX", "nmx"), ("E_NIMP", "nimp"), ("E_REM", "nrem"))
 #: Halley's iterations of the impact on the step's polynomial (see :func:`_events`); a root not
 #: converged to ROOT_TOL (in units of the step) after them is left to the engine
 NEWTON_POLY = 3
@@ -468,27 +469,27 @@ copysign = math.copysign
 
 def _in_name(row: str) -> str:
     """The local name of an input row of :data:`EV_IN` in :func:`_events`."""
-    return {"E_U0": "u0s", "E_U1": "u1s", "E_NIMP": "nimp0", "E_P2": "psq",
-            "N_MX": "mx"}.get(row, row[2:].lower())
+    return {"E_U0": "u0s", "E_U1": "u1s", "E_NIMP": "nimp0", "E_P2": "psq"}.get(row, row[2:].lower())
 
 
-#: the inputs of :func:`_peaks` (rows of the scratch; its polynomial, rows 0 .. N, besides)
-PEAK_IN = ("E_OM", "E_H", "N_MX", "E_XE", "E_TE", "E_OE")
+#: the inputs of :func:`_peaks`: (scratch, row); its polynomial (rows 0 .. N) besides
+PEAK_IN = (("e", "E_OM"), ("e", "E_H"), ("nx", "E_MX"), ("e", "E_XE"), ("e", "E_TE"),
+           ("e", "E_OE"))
 
 
-def _next(n: int) -> list[tuple[str, str]]:
-    """What a round writes (rows and values): :data:`EV_OUT`, :data:`EV_NEXT`, and the rest's
-    polynomial (rows E_NEXT + k)."""
-    return ([(r, r[2:].lower()) for r in EV_OUT] + [("N_" + r, v) for r, v in EV_NEXT]
-            + [(f"E_NEXT + {k}", "th" if k == 0 else ("D_1" if k == 1 else f"r_t_{k}"))
-               for k in range(n + 1)])
+def _next(n: int) -> list[tuple[str, str, str]]:
+    """What a round writes (scratch, row, value): :data:`EV_OUT` into its own, :data:`EV_NEXT`,
+    the block and the next step's polynomial (its rows beyond N zero) into the next round's."""
+    return ([("e", r, r[2:].lower()) for r in EV_OUT] + [("nx", r, v) for r, v in EV_NEXT]
+            + [("nx", r, _in_name(r)) for r in EV_BLOCK]
+            + [("nx", str(k), "th" if k == 0 else ("D_1" if k == 1 else f"r_t_{k}"))
+               for k in range(n + 1)] + [("nx", str(k), "0.0") for k in range(n + 1, NCOEF)])
 
 
 def event_rows() -> dict:
     """``{row name: index}`` of the events' scratch (the enum of the generated header)."""
-    rows = {"E_NEXT": NCOEF}
-    rows.update({r: k for k, r in enumerate(EV_IN + EV_OUT + EV_NX, 2 * NCOEF)})
-    rows["NE"] = 2 * NCOEF + len(EV_IN) + len(EV_OUT) + len(EV_NX)
+    rows = {r: k for k, r in enumerate(EV_IN + EV_OUT, NCOEF)}
+    rows["NE"] = NCOEF + len(EV_IN) + len(EV_OUT)
     return rows
 
 
@@ -500,8 +501,8 @@ def _events_reference(n: int) -> str:
     out = [f"\n\ndef _events_{n}(p, {ins}, eps):"]
     out += [f"    p{k} = p[{k}]" for k in range(n + 1)]
     out += ["    " + line for line in _events(n)]
-    out.append("    return (" + ", ".join(v for _, v in _next(n)) + ")")
-    out += [f"\n\ndef _peaks_{n}(p, {', '.join(_in_name(r) for r in PEAK_IN)}):"]
+    out.append("    return (" + ", ".join(v for _, _, v in _next(n)) + ")")
+    out += [f"\n\ndef _peaks_{n}(p, {', '.join(_in_name(r) for _, r in PEAK_IN)}):"]
     out += [f"    p{k} = p[{k}]" for k in range(n + 1)]
     out += ["    " + line for line in _peaks(n)]
     out.append("    return nmx")
@@ -512,24 +513,28 @@ def _c_expr(expr: str) -> str:
     return re.sub(r"\b(sel|fmax|fmin|fdiv|fsqrt)\(", lambda m: _C_NAMES[m.group(1)] + "(", expr)
 
 
-def _c_loop(name: str, n: int, rows, body: list[str], stores) -> str:
-    lines = [f"\n\nROCKING_LANES_CLONES static void {name}(int64_t m, double *e, double eps) {{",
+def _c_loop(name: str, n: int, loads, body: list[str], stores) -> str:
+    """A loop over lanes ``0 .. m-1``: the polynomial and ``loads`` (scratch, row) read, ``body``
+    computed, ``stores`` (scratch, row, value) written; scratches ``e`` (the round's) and ``nx``
+    (the next round's)."""
+    lines = [f"\n\nROCKING_LANES_CLONES static void {name}(int64_t m, double *ROCKING_RESTRICT e,\n        double *ROCKING_RESTRICT nx, double eps) {{",
              "    (void)eps;",
+             "    (void)nx;",
              "    for (int64_t i = 0; i < m; i++) {"]
     lines += [f"        const double p{k} = e[{k} * LANES + i];" for k in range(n + 1)]
-    lines += [f"        const double {_in_name(r)} = e[{r} * LANES + i];" for r in rows]
+    lines += [f"        const double {_in_name(r)} = {ptr}[{r} * LANES + i];" for ptr, r in loads]
     for line in body:
         var, expr = line.split(" = ", 1)
         kind = "int64_t" if var.startswith("k_") else "double"
         lines.append(f"        const {kind} {var} = {_c_expr(expr)};")
-    lines += [f"        e[({r}) * LANES + i] = {v};" for r, v in stores]
+    lines += [f"        {ptr}[({r}) * LANES + i] = {v};" for ptr, r, v in stores]
     lines += ["    }", "}"]
     return "\n".join(lines) + "\n"
 
 
 def _events_function(n: int) -> str:
-    return (_c_loop(f"rocking_events_{n}", n, EV_IN, _events(n), _next(n))
-            + _c_loop(f"rocking_peaks_{n}", n, PEAK_IN, _peaks(n), [("N_MX", "nmx")]))
+    return (_c_loop(f"rocking_events_{n}", n, [("e", r) for r in EV_IN], _events(n), _next(n))
+            + _c_loop(f"rocking_peaks_{n}", n, PEAK_IN, _peaks(n), [("nx", "E_MX", "nmx")]))
 
 
 PRELUDE = """#ifndef ROCKING_TAYLOR_LANES_H
@@ -547,6 +552,13 @@ PRELUDE = """#ifndef ROCKING_TAYLOR_LANES_H
 #define ROCKING_LANES_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define ROCKING_LANES_CLONES
+#endif
+
+/* the events' two scratches never overlap (without saying so the compiler does not vectorise) */
+#if defined(_MSC_VER)
+#define ROCKING_RESTRICT __restrict
+#else
+#define ROCKING_RESTRICT restrict
 #endif
 
 /* ``k ? a : b`` and Python's ``max(a, b)`` without a branch: the bits of ``a`` or ``b`` chosen by
@@ -572,9 +584,8 @@ def source() -> str:
             f"enum {{ LANES = {LANES} }};",
             f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(CF_ROWS, ORDERS[-1] + 1))},"
             f" NCF = {ORDERS[-1] + 1 + len(CF_ROWS)} }};",
-            f"enum {{ E_NEXT = {NCOEF}, "
-            f"{', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT + EV_NX, 2 * NCOEF))},"
-            f" NE = {2 * NCOEF + len(EV_IN) + len(EV_OUT) + len(EV_NX)} }};"]
+            f"enum {{ {', '.join(f'{r} = {k}' for k, r in enumerate(EV_IN + EV_OUT, NCOEF))},"
+            f" NE = {NCOEF + len(EV_IN) + len(EV_OUT)} }};"]
     args = "n, uj, duj, f, bad, h, eps, n_low, cf"
     dispatch = ["\n\n/* the step of ORDERS order ``order`` (the highest for larger); returns the lanes left,"
                 " and in\n   ``*n_low`` the kept lanes for which a lower order would have done */",
@@ -585,10 +596,11 @@ def source() -> str:
     dispatch.append(f"    return rocking_lanes_{ORDERS[-1]}({args});\n}}")
     for what in ("events", "peaks"):
         dispatch += [f"\n/* the {what} of ORDERS order ``order`` (the highest for larger) on lanes 0 .. m-1 of e */",
-                     f"static inline void rocking_{what}(int64_t order, int64_t m, double *e, double eps) {{"]
+                     f"static inline void rocking_{what}(int64_t order, int64_t m, double *e, double *nx,"
+                     " double eps) {"]
         for n in ORDERS[:-1]:
-            dispatch.append(f"    if (order <= {n}) {{ rocking_{what}_{n}(m, e, eps); return; }}")
-        dispatch.append(f"    rocking_{what}_{ORDERS[-1]}(m, e, eps);\n}}")
+            dispatch.append(f"    if (order <= {n}) {{ rocking_{what}_{n}(m, e, nx, eps); return; }}")
+        dispatch.append(f"    rocking_{what}_{ORDERS[-1]}(m, e, nx, eps);\n}}")
     dispatch.append("#endif")
     return (HEADER + PRELUDE + "\n" + "\n".join(defs) + "\n"
             + "".join(_function(n) + _events_function(n) for n in ORDERS) + "\n".join(dispatch) + "\n")

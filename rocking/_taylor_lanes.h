@@ -38,6 +38,13 @@
 #define ROCKING_LANES_CLONES
 #endif
 
+/* the events' two scratches never overlap (without saying so the compiler does not vectorise) */
+#if defined(_MSC_VER)
+#define ROCKING_RESTRICT __restrict
+#else
+#define ROCKING_RESTRICT restrict
+#endif
+
 /* ``k ? a : b`` and Python's ``max(a, b)`` without a branch: the bits of ``a`` or ``b`` chosen by
    a mask (the same value as the conditional; a branch keeps the loop from being vectorised) */
 static inline double rocking_select(int64_t k, double a, double b) {
@@ -56,7 +63,7 @@ enum { R_A = 0, R_Q = 1, R_SA = 2, R_CA = 3, R_TAN = 4, R_P = 5, R_ALPHA = 6, R_
 enum { I_STATUS = 0, I_NIMP = 1, I_UP = 2, I_RUN = 3, I_WAKE = 4, NI = 5 };
 enum { LANES = 32 };
 enum { CF_TH2 = 17, CF_OM2 = 18, CF_S1 = 19, CF_C1 = 20, CF_OWN = 21, NCF = 22 };
-enum { E_NEXT = 17, E_TH2 = 34, E_OM2 = 35, E_S1 = 36, E_C1 = 37, E_OM = 38, E_SIDE = 39, E_H = 40, E_T = 41, E_U0 = 42, E_U1 = 43, E_Q = 44, E_SA = 45, E_CA = 46, E_TAN = 47, E_P2 = 48, E_ETA = 49, E_MX = 50, E_OMZ = 51, E_NIMP = 52, E_REM = 53, E_OK = 54, E_NTH = 55, E_NOM = 56, E_NSIDE = 57, E_NS = 58, E_NC = 59, E_WHY = 60, E_NREST = 61, E_NEED = 62, E_XE = 63, E_TE = 64, E_OE = 65, E_LOW = 66, N_TH2 = 67, N_OM2 = 68, N_S1 = 69, N_C1 = 70, N_OM = 71, N_SIDE = 72, N_H = 73, N_T = 74, N_U0 = 75, N_U1 = 76, N_Q = 77, N_MX = 78, N_NIMP = 79, N_REM = 80, NE = 81 };
+enum { E_TH2 = 17, E_OM2 = 18, E_S1 = 19, E_C1 = 20, E_OM = 21, E_SIDE = 22, E_H = 23, E_T = 24, E_U0 = 25, E_U1 = 26, E_Q = 27, E_SA = 28, E_CA = 29, E_TAN = 30, E_P2 = 31, E_ETA = 32, E_MX = 33, E_OMZ = 34, E_NIMP = 35, E_REM = 36, E_OK = 37, E_NTH = 38, E_NOM = 39, E_NSIDE = 40, E_NS = 41, E_NC = 42, E_WHY = 43, E_NREST = 44, E_NEED = 45, E_XE = 46, E_TE = 47, E_OE = 48, E_LOW = 49, NE = 50 };
 
 
 ROCKING_LANES_CLONES static int64_t rocking_lanes_4(int64_t n, double uj, double duj, double *f,
@@ -122,8 +129,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_4(int64_t n, double uj, double
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_4(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_4(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -315,31 +324,51 @@ ROCKING_LANES_CLONES static void rocking_events_4(int64_t m, double *e, double e
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = 0.0;
+        nx[(6) * LANES + i] = 0.0;
+        nx[(7) * LANES + i] = 0.0;
+        nx[(8) * LANES + i] = 0.0;
+        nx[(9) * LANES + i] = 0.0;
+        nx[(10) * LANES + i] = 0.0;
+        nx[(11) * LANES + i] = 0.0;
+        nx[(12) * LANES + i] = 0.0;
+        nx[(13) * LANES + i] = 0.0;
+        nx[(14) * LANES + i] = 0.0;
+        nx[(15) * LANES + i] = 0.0;
+        nx[(16) * LANES + i] = 0.0;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_4(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_4(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -348,7 +377,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_4(int64_t m, double *e, double ep
         const double p4 = e[4 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -388,7 +417,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_4(int64_t m, double *e, double ep
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -476,8 +505,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_6(int64_t n, double uj, double
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_6(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_6(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -689,33 +720,51 @@ ROCKING_LANES_CLONES static void rocking_events_6(int64_t m, double *e, double e
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
-        e[(E_NEXT + 5) * LANES + i] = r_t_5;
-        e[(E_NEXT + 6) * LANES + i] = r_t_6;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = r_t_5;
+        nx[(6) * LANES + i] = r_t_6;
+        nx[(7) * LANES + i] = 0.0;
+        nx[(8) * LANES + i] = 0.0;
+        nx[(9) * LANES + i] = 0.0;
+        nx[(10) * LANES + i] = 0.0;
+        nx[(11) * LANES + i] = 0.0;
+        nx[(12) * LANES + i] = 0.0;
+        nx[(13) * LANES + i] = 0.0;
+        nx[(14) * LANES + i] = 0.0;
+        nx[(15) * LANES + i] = 0.0;
+        nx[(16) * LANES + i] = 0.0;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_6(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_6(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -726,7 +775,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_6(int64_t m, double *e, double ep
         const double p6 = e[6 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -766,7 +815,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_6(int64_t m, double *e, double ep
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -874,8 +923,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_8(int64_t n, double uj, double
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_8(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_8(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -1107,35 +1158,51 @@ ROCKING_LANES_CLONES static void rocking_events_8(int64_t m, double *e, double e
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
-        e[(E_NEXT + 5) * LANES + i] = r_t_5;
-        e[(E_NEXT + 6) * LANES + i] = r_t_6;
-        e[(E_NEXT + 7) * LANES + i] = r_t_7;
-        e[(E_NEXT + 8) * LANES + i] = r_t_8;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = r_t_5;
+        nx[(6) * LANES + i] = r_t_6;
+        nx[(7) * LANES + i] = r_t_7;
+        nx[(8) * LANES + i] = r_t_8;
+        nx[(9) * LANES + i] = 0.0;
+        nx[(10) * LANES + i] = 0.0;
+        nx[(11) * LANES + i] = 0.0;
+        nx[(12) * LANES + i] = 0.0;
+        nx[(13) * LANES + i] = 0.0;
+        nx[(14) * LANES + i] = 0.0;
+        nx[(15) * LANES + i] = 0.0;
+        nx[(16) * LANES + i] = 0.0;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_8(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_8(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -1148,7 +1215,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_8(int64_t m, double *e, double ep
         const double p8 = e[8 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -1188,7 +1255,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_8(int64_t m, double *e, double ep
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -1316,8 +1383,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_10(int64_t n, double uj, doubl
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_10(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_10(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -1569,37 +1638,51 @@ ROCKING_LANES_CLONES static void rocking_events_10(int64_t m, double *e, double 
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
-        e[(E_NEXT + 5) * LANES + i] = r_t_5;
-        e[(E_NEXT + 6) * LANES + i] = r_t_6;
-        e[(E_NEXT + 7) * LANES + i] = r_t_7;
-        e[(E_NEXT + 8) * LANES + i] = r_t_8;
-        e[(E_NEXT + 9) * LANES + i] = r_t_9;
-        e[(E_NEXT + 10) * LANES + i] = r_t_10;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = r_t_5;
+        nx[(6) * LANES + i] = r_t_6;
+        nx[(7) * LANES + i] = r_t_7;
+        nx[(8) * LANES + i] = r_t_8;
+        nx[(9) * LANES + i] = r_t_9;
+        nx[(10) * LANES + i] = r_t_10;
+        nx[(11) * LANES + i] = 0.0;
+        nx[(12) * LANES + i] = 0.0;
+        nx[(13) * LANES + i] = 0.0;
+        nx[(14) * LANES + i] = 0.0;
+        nx[(15) * LANES + i] = 0.0;
+        nx[(16) * LANES + i] = 0.0;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_10(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_10(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -1614,7 +1697,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_10(int64_t m, double *e, double e
         const double p10 = e[10 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -1654,7 +1737,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_10(int64_t m, double *e, double e
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -1802,8 +1885,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_12(int64_t n, double uj, doubl
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_12(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_12(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -2075,39 +2160,51 @@ ROCKING_LANES_CLONES static void rocking_events_12(int64_t m, double *e, double 
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
-        e[(E_NEXT + 5) * LANES + i] = r_t_5;
-        e[(E_NEXT + 6) * LANES + i] = r_t_6;
-        e[(E_NEXT + 7) * LANES + i] = r_t_7;
-        e[(E_NEXT + 8) * LANES + i] = r_t_8;
-        e[(E_NEXT + 9) * LANES + i] = r_t_9;
-        e[(E_NEXT + 10) * LANES + i] = r_t_10;
-        e[(E_NEXT + 11) * LANES + i] = r_t_11;
-        e[(E_NEXT + 12) * LANES + i] = r_t_12;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = r_t_5;
+        nx[(6) * LANES + i] = r_t_6;
+        nx[(7) * LANES + i] = r_t_7;
+        nx[(8) * LANES + i] = r_t_8;
+        nx[(9) * LANES + i] = r_t_9;
+        nx[(10) * LANES + i] = r_t_10;
+        nx[(11) * LANES + i] = r_t_11;
+        nx[(12) * LANES + i] = r_t_12;
+        nx[(13) * LANES + i] = 0.0;
+        nx[(14) * LANES + i] = 0.0;
+        nx[(15) * LANES + i] = 0.0;
+        nx[(16) * LANES + i] = 0.0;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_12(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_12(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -2124,7 +2221,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_12(int64_t m, double *e, double e
         const double p12 = e[12 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -2164,7 +2261,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_12(int64_t m, double *e, double e
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -2332,8 +2429,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_14(int64_t n, double uj, doubl
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_14(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_14(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -2625,41 +2724,51 @@ ROCKING_LANES_CLONES static void rocking_events_14(int64_t m, double *e, double 
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
-        e[(E_NEXT + 5) * LANES + i] = r_t_5;
-        e[(E_NEXT + 6) * LANES + i] = r_t_6;
-        e[(E_NEXT + 7) * LANES + i] = r_t_7;
-        e[(E_NEXT + 8) * LANES + i] = r_t_8;
-        e[(E_NEXT + 9) * LANES + i] = r_t_9;
-        e[(E_NEXT + 10) * LANES + i] = r_t_10;
-        e[(E_NEXT + 11) * LANES + i] = r_t_11;
-        e[(E_NEXT + 12) * LANES + i] = r_t_12;
-        e[(E_NEXT + 13) * LANES + i] = r_t_13;
-        e[(E_NEXT + 14) * LANES + i] = r_t_14;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = r_t_5;
+        nx[(6) * LANES + i] = r_t_6;
+        nx[(7) * LANES + i] = r_t_7;
+        nx[(8) * LANES + i] = r_t_8;
+        nx[(9) * LANES + i] = r_t_9;
+        nx[(10) * LANES + i] = r_t_10;
+        nx[(11) * LANES + i] = r_t_11;
+        nx[(12) * LANES + i] = r_t_12;
+        nx[(13) * LANES + i] = r_t_13;
+        nx[(14) * LANES + i] = r_t_14;
+        nx[(15) * LANES + i] = 0.0;
+        nx[(16) * LANES + i] = 0.0;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_14(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_14(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -2678,7 +2787,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_14(int64_t m, double *e, double e
         const double p14 = e[14 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -2718,7 +2827,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_14(int64_t m, double *e, double e
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -2906,8 +3015,10 @@ ROCKING_LANES_CLONES static int64_t rocking_lanes_16(int64_t n, double uj, doubl
 }
 
 
-ROCKING_LANES_CLONES static void rocking_events_16(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_events_16(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -3219,43 +3330,51 @@ ROCKING_LANES_CLONES static void rocking_events_16(int64_t m, double *e, double 
         e[(E_TE) * LANES + i] = te;
         e[(E_OE) * LANES + i] = oe;
         e[(E_LOW) * LANES + i] = low;
-        e[(N_TH2) * LANES + i] = r_th2;
-        e[(N_OM2) * LANES + i] = r_om2;
-        e[(N_S1) * LANES + i] = r_s1;
-        e[(N_C1) * LANES + i] = r_c1;
-        e[(N_OM) * LANES + i] = omb;
-        e[(N_SIDE) * LANES + i] = sb;
-        e[(N_H) * LANES + i] = hr;
-        e[(N_T) * LANES + i] = ts;
-        e[(N_U0) * LANES + i] = u0;
-        e[(N_U1) * LANES + i] = u1;
-        e[(N_Q) * LANES + i] = qi;
-        e[(N_MX) * LANES + i] = nmx;
-        e[(N_NIMP) * LANES + i] = nimp;
-        e[(N_REM) * LANES + i] = nrem;
-        e[(E_NEXT + 0) * LANES + i] = th;
-        e[(E_NEXT + 1) * LANES + i] = D_1;
-        e[(E_NEXT + 2) * LANES + i] = r_t_2;
-        e[(E_NEXT + 3) * LANES + i] = r_t_3;
-        e[(E_NEXT + 4) * LANES + i] = r_t_4;
-        e[(E_NEXT + 5) * LANES + i] = r_t_5;
-        e[(E_NEXT + 6) * LANES + i] = r_t_6;
-        e[(E_NEXT + 7) * LANES + i] = r_t_7;
-        e[(E_NEXT + 8) * LANES + i] = r_t_8;
-        e[(E_NEXT + 9) * LANES + i] = r_t_9;
-        e[(E_NEXT + 10) * LANES + i] = r_t_10;
-        e[(E_NEXT + 11) * LANES + i] = r_t_11;
-        e[(E_NEXT + 12) * LANES + i] = r_t_12;
-        e[(E_NEXT + 13) * LANES + i] = r_t_13;
-        e[(E_NEXT + 14) * LANES + i] = r_t_14;
-        e[(E_NEXT + 15) * LANES + i] = r_t_15;
-        e[(E_NEXT + 16) * LANES + i] = r_t_16;
+        nx[(E_TH2) * LANES + i] = r_th2;
+        nx[(E_OM2) * LANES + i] = r_om2;
+        nx[(E_S1) * LANES + i] = r_s1;
+        nx[(E_C1) * LANES + i] = r_c1;
+        nx[(E_OM) * LANES + i] = omb;
+        nx[(E_SIDE) * LANES + i] = sb;
+        nx[(E_H) * LANES + i] = hr;
+        nx[(E_T) * LANES + i] = ts;
+        nx[(E_U0) * LANES + i] = u0;
+        nx[(E_U1) * LANES + i] = u1;
+        nx[(E_Q) * LANES + i] = qi;
+        nx[(E_MX) * LANES + i] = nmx;
+        nx[(E_NIMP) * LANES + i] = nimp;
+        nx[(E_REM) * LANES + i] = nrem;
+        nx[(E_SA) * LANES + i] = sa;
+        nx[(E_CA) * LANES + i] = ca;
+        nx[(E_TAN) * LANES + i] = tan;
+        nx[(E_P2) * LANES + i] = psq;
+        nx[(E_ETA) * LANES + i] = eta;
+        nx[(E_OMZ) * LANES + i] = omz;
+        nx[(0) * LANES + i] = th;
+        nx[(1) * LANES + i] = D_1;
+        nx[(2) * LANES + i] = r_t_2;
+        nx[(3) * LANES + i] = r_t_3;
+        nx[(4) * LANES + i] = r_t_4;
+        nx[(5) * LANES + i] = r_t_5;
+        nx[(6) * LANES + i] = r_t_6;
+        nx[(7) * LANES + i] = r_t_7;
+        nx[(8) * LANES + i] = r_t_8;
+        nx[(9) * LANES + i] = r_t_9;
+        nx[(10) * LANES + i] = r_t_10;
+        nx[(11) * LANES + i] = r_t_11;
+        nx[(12) * LANES + i] = r_t_12;
+        nx[(13) * LANES + i] = r_t_13;
+        nx[(14) * LANES + i] = r_t_14;
+        nx[(15) * LANES + i] = r_t_15;
+        nx[(16) * LANES + i] = r_t_16;
     }
 }
 
 
-ROCKING_LANES_CLONES static void rocking_peaks_16(int64_t m, double *e, double eps) {
+ROCKING_LANES_CLONES static void rocking_peaks_16(int64_t m, double *ROCKING_RESTRICT e,
+        double *ROCKING_RESTRICT nx, double eps) {
     (void)eps;
+    (void)nx;
     for (int64_t i = 0; i < m; i++) {
         const double p0 = e[0 * LANES + i];
         const double p1 = e[1 * LANES + i];
@@ -3276,7 +3395,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_16(int64_t m, double *e, double e
         const double p16 = e[16 * LANES + i];
         const double om = e[E_OM * LANES + i];
         const double h = e[E_H * LANES + i];
-        const double mx = e[N_MX * LANES + i];
+        const double mx = nx[E_MX * LANES + i];
         const double xe = e[E_XE * LANES + i];
         const double te = e[E_TE * LANES + i];
         const double oe = e[E_OE * LANES + i];
@@ -3316,7 +3435,7 @@ ROCKING_LANES_CLONES static void rocking_peaks_16(int64_t m, double *e, double e
         const double w2 = rocking_select(C2 != 0.0, A2 - rocking_div(0.5 * B2 * B2, C2), A2);
         const double pk2 = rocking_select(k_gs_e2, fabs(w2), 0.0);
         const double nmx = rocking_fmax(mx, rocking_fmax(pk1, pk2));
-        e[(N_MX) * LANES + i] = nmx;
+        nx[(E_MX) * LANES + i] = nmx;
     }
 }
 
@@ -3335,24 +3454,24 @@ static inline int64_t rocking_lanes_step(int64_t order, int64_t n, double uj, do
 }
 
 /* the events of ORDERS order ``order`` (the highest for larger) on lanes 0 .. m-1 of e */
-static inline void rocking_events(int64_t order, int64_t m, double *e, double eps) {
-    if (order <= 4) { rocking_events_4(m, e, eps); return; }
-    if (order <= 6) { rocking_events_6(m, e, eps); return; }
-    if (order <= 8) { rocking_events_8(m, e, eps); return; }
-    if (order <= 10) { rocking_events_10(m, e, eps); return; }
-    if (order <= 12) { rocking_events_12(m, e, eps); return; }
-    if (order <= 14) { rocking_events_14(m, e, eps); return; }
-    rocking_events_16(m, e, eps);
+static inline void rocking_events(int64_t order, int64_t m, double *e, double *nx, double eps) {
+    if (order <= 4) { rocking_events_4(m, e, nx, eps); return; }
+    if (order <= 6) { rocking_events_6(m, e, nx, eps); return; }
+    if (order <= 8) { rocking_events_8(m, e, nx, eps); return; }
+    if (order <= 10) { rocking_events_10(m, e, nx, eps); return; }
+    if (order <= 12) { rocking_events_12(m, e, nx, eps); return; }
+    if (order <= 14) { rocking_events_14(m, e, nx, eps); return; }
+    rocking_events_16(m, e, nx, eps);
 }
 
 /* the peaks of ORDERS order ``order`` (the highest for larger) on lanes 0 .. m-1 of e */
-static inline void rocking_peaks(int64_t order, int64_t m, double *e, double eps) {
-    if (order <= 4) { rocking_peaks_4(m, e, eps); return; }
-    if (order <= 6) { rocking_peaks_6(m, e, eps); return; }
-    if (order <= 8) { rocking_peaks_8(m, e, eps); return; }
-    if (order <= 10) { rocking_peaks_10(m, e, eps); return; }
-    if (order <= 12) { rocking_peaks_12(m, e, eps); return; }
-    if (order <= 14) { rocking_peaks_14(m, e, eps); return; }
-    rocking_peaks_16(m, e, eps);
+static inline void rocking_peaks(int64_t order, int64_t m, double *e, double *nx, double eps) {
+    if (order <= 4) { rocking_peaks_4(m, e, nx, eps); return; }
+    if (order <= 6) { rocking_peaks_6(m, e, nx, eps); return; }
+    if (order <= 8) { rocking_peaks_8(m, e, nx, eps); return; }
+    if (order <= 10) { rocking_peaks_10(m, e, nx, eps); return; }
+    if (order <= 12) { rocking_peaks_12(m, e, nx, eps); return; }
+    if (order <= 14) { rocking_peaks_14(m, e, nx, eps); return; }
+    rocking_peaks_16(m, e, nx, eps);
 }
 #endif
