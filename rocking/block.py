@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from pulses import G
 
 from .frame import check_cap_mass_ratio, eta_frame, frame_p
+from .restitution import Restitution
 
 #: slenderness at which Eq. 5 gives a perfectly plastic impact (eta = 0): asin(sqrt(2/3))
 ALPHA_PLASTIC = math.asin(math.sqrt(2.0 / 3.0))
@@ -34,8 +35,14 @@ def _p_alpha(height: float, width: float, gamma: float) -> tuple[float, float]:
 
 def _restitution(eta, alpha: float, gamma: float, who: str) -> float:
     """``eta`` checked to lie in [0, 1], or where None Eq. 5 at ``alpha`` (the frame's with
-    ``gamma``, :func:`rocking.frame.eta_frame`; Housner's at ``gamma = 0``)."""
-    value = eta_frame(alpha, gamma) if eta is None else float(eta)
+    ``gamma``, :func:`rocking.frame.eta_frame`; Housner's at ``gamma = 0``); a single
+    :class:`rocking.restitution.Restitution` gives its ``eta`` at ``alpha``."""
+    if eta is None:
+        value = eta_frame(alpha, gamma)
+    elif isinstance(eta, Restitution):
+        value = eta.eta_at(alpha, gamma)
+    else:
+        value = float(eta)
     if not (math.isfinite(value) and 0.0 <= value <= 1.0):
         raise ValueError(f"{who}: eta must lie in [0, 1], got {eta!r}")
     return value
@@ -51,9 +58,10 @@ class Block:
         Frequency parameter ``sqrt(3 g / (4 R))``, rad/s.
     alpha : float
         Slenderness angle ``atan(b/h)``, rad, in (0, pi/2).
-    eta : float, optional
+    eta : float or Restitution, optional
         Coefficient of restitution of the angular velocity at impact; default Eq. 5 (for a frame,
-        :func:`rocking.frame.eta_frame`).
+        :func:`rocking.frame.eta_frame`).  A single :class:`rocking.restitution.Restitution`
+        (a factor of Eq. 5, an ``eta`` or an ``r``) is turned into its ``eta`` at ``alpha``.
     height, width : float, optional
         Full dimensions in m, when known (set by :meth:`from_dimensions`).
     cap_mass_ratio : float, optional
@@ -159,9 +167,9 @@ class Blocks:
     p, alpha : array_like
         Frequency parameters (rad/s) and slenderness angles (rad), as :class:`Block`'s (not
         checked again: they come from checked dimensions or a search's own values).
-    eta : float, optional
+    eta : float or Restitution, optional
         Coefficient of restitution of all; default Eq. 5 (the frame's with ``cap_mass_ratio``)
-        at each ``alpha``.
+        at each ``alpha``; a single :class:`rocking.restitution.Restitution` at each ``alpha``.
     cap_mass_ratio : float, optional
         As :class:`Block`'s.
 
@@ -182,8 +190,9 @@ class Blocks:
         gamma = check_cap_mass_ratio(cap_mass_ratio)
         self.p = np.ascontiguousarray(p, dtype=float).ravel()
         self.alpha = np.ascontiguousarray(alpha, dtype=float).ravel()
-        if eta is None:
-            self.eta = np.array([eta_frame(a, gamma) for a in self.alpha.tolist()], dtype=float)
+        if eta is None or isinstance(eta, Restitution):
+            self.eta = np.array([_restitution(eta, a, gamma, "Blocks") for a in self.alpha.tolist()],
+                                dtype=float)
         else:
             self.eta = np.full(self.p.size, _restitution(eta, 0.0, gamma, "Blocks"))
         self.cap_mass_ratio, self.height = gamma, height
