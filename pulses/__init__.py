@@ -9,7 +9,7 @@ from .lazy import lazy_names
 #: public name -> the module of this package that defines it
 _WHERE = {
     "RecordError": "errors", "UnitsWarning": "errors",
-    "G": "record", "Record": "record",
+    "G": "units", "Record": "record",
     "VP_TO_AP": "scenario", "design_pulse": "scenario", "pulse_period": "scenario",
     "read_record": "io",
     "write_sac": "sac",

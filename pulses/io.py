@@ -29,8 +29,9 @@ import numpy as np
 from . import at2, formats, knet, obspyformat, sac, textfile  # noqa: F401  (each registers its format)
 from .errors import RecordError
 from .formats import MAX_SAMPLES, ReadOptions
-from .record import G, Record
+from .record import Record
 from .units import (
+    G,
     PLAUSIBLE_MAX_G,
     PLAUSIBLE_MIN_G,
     WARN_PEAK_G,

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-G = 9.81  #: standard gravity used throughout the package, m/s^2
+from .units import G
 
 
 class Record:

@@ -8,7 +8,8 @@ from __future__ import annotations
 import math
 
 from .errors import RecordError
-from .record import G
+
+G = 9.81  #: standard gravity used throughout the package, m/s^2
 
 #: accepted spellings -> factor to m/s^2
 ACCELERATION_UNITS = {

@@ -31,10 +31,10 @@ def test_every_public_name_is_its_modules_object(package):
 
 
 def test_a_name_is_looked_up_once_and_kept():
-    getattr_, dir_ = lazy_names("pulses", {"G": "record"})
+    getattr_, dir_ = lazy_names("pulses", {"G": "units"})
     vars(pulses).pop("G", None)
     assert "G" not in vars(pulses) and "G" in dir_()
-    from pulses.record import G
+    from pulses.units import G
 
     assert getattr_("G") == G and vars(pulses)["G"] == G
     with pytest.raises(AttributeError):
