@@ -12,7 +12,7 @@ _WHERE = {
     "G": "units", "Record": "record",
     "VP_TO_AP": "scenario", "design_pulse": "scenario", "pulse_period": "scenario",
     "read_record": "io",
-    "write_sac": "sac",
+    "write_sac": "formats.sac",
     "Candidate": "fit", "FitError": "fit", "PulseFit": "fit", "fit_pulse": "fit",
     "BETA": "shapes", "SHAPES": "shapes", "AntisymmetricRicker": "shapes", "OneSine": "shapes",
     "Pulse": "shapes", "Rectangular": "shapes", "SymmetricRicker": "shapes", "make_pulse": "shapes",
@@ -20,12 +20,12 @@ _WHERE = {
     "PulseCandidate": "velocity", "PulseClassification": "velocity", "classify_pulse": "velocity",
     "Pairing": "pairs", "check_pair": "pairs", "component": "pairs", "pair_files": "pairs",
     "read_pair": "pairs", "rotate_pair": "pairs",
-    "PeerDownload": "peer",
+    "PeerDownload": "io.peer",
     "check_triplet": "triplets",
-    "to_frame": "export", "from_stream": "traces",
+    "to_frame": "export", "from_stream": "formats.traces",
 }
-#: submodules that are part of the public namespace
-_MODULES = ("peer",)
+#: submodules that are part of the public namespace: public name -> the module
+_MODULES = {"peer": "io.peer"}
 
 __all__ = sorted(_WHERE) + list(_MODULES)
 

@@ -107,7 +107,7 @@ class Record:
         >>> round(pulses.Record.from_trace(tr, units="g").pga / pulses.G, 3)
         0.874
         """
-        from .traces import from_trace
+        from .formats.traces import from_trace
 
         return from_trace(trace, units, name=name)
 
@@ -125,7 +125,7 @@ class Record:
         >>> tr.stats.delta, list(tr.data) == list(rec.acc), pulses.Record.from_trace(tr).name
         (0.01, True, 'demo')
         """
-        from .traces import to_trace
+        from .formats.traces import to_trace
 
         return to_trace(self)
 

@@ -1,11 +1,10 @@
-"""The registry of record formats that :func:`pulses.read_record` reads.
+"""The registry of record formats that :func:`pulses.read_record` reads, and what a format's
+reader returns.
 
-A format is one module and one registration, as obspy's waveform plugins are (``obspy.io.sac``:
-``_is_sac`` detects, ``_read_sac`` reads, one entry point registers them).  Here a module builds
-one :class:`RecordFormat` (how to detect the file, how to read it) and passes it to
-:func:`register`; its reader returns a :class:`Reading` that says what the file states about its
-units (``units``, ``units_rule``).  :func:`pulses.read_record` then only dispatches and
-checks; it knows no format by name.
+A format module builds one :class:`RecordFormat` (how to detect the file, how to read it) and
+passes it to :func:`register`; its reader returns a :class:`Reading` that says what the file
+states about its units (``units``, ``units_rule``).  :func:`pulses.read_record` only asks the
+registry and checks; it knows no format by name.  How to add one: :mod:`pulses.formats`.
 
 Formats read by obspy (SAC, K-NET, MiniSEED, ...) are detected by obspy: the ``obspy`` format
 reads the file with :func:`obspy.read` and hands the trace to the format registered for obspy's

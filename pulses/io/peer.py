@@ -21,8 +21,8 @@ part is never read, and a member larger than :data:`MAX_MEMBER_BYTES` (or a repo
 
 Verticals: PEER names a vertical's positive direction in its file name and in the second header
 line, ``UP`` (positive upwards) or ``DWN`` (positive downwards); see docs/theory.md section 10.
-:func:`vertical_polarity` reads both and refuses a vertical where neither says it or they
-disagree: a polarity is never guessed.
+:func:`pulses.triplets.vertical_polarity` reads both and refuses a vertical where neither says
+it or they disagree: a polarity is never guessed.
 """
 from __future__ import annotations
 
@@ -37,9 +37,10 @@ import zipfile
 import zlib
 from dataclasses import dataclass, field
 
-from .errors import RecordError
-from .formats import MAX_SAMPLES
-from .record import Record
+from ..errors import RecordError
+from ..formats import MAX_SAMPLES, at2
+from ..record import Record
+from .read import record_from_reading, special_kind
 
 #: the search report's file name in a PEER download
 SEARCH_RESULTS = "_SearchResults.csv"
@@ -433,9 +434,6 @@ class PeerDownload:
         :func:`pulses.read_record`; ``metadata["source"]`` is :meth:`display`.  The file is
         streamed (a zip member is unpacked as it is parsed, never held whole in memory), and a
         damaged member fails with a message naming it."""
-        from . import at2
-        from .io import record_from_reading
-
         found, fh = self._open_member(name, MAX_MEMBER_BYTES)
         label = self.display(found)
         with fh:
@@ -500,8 +498,6 @@ class _Bounded(io.RawIOBase):
 def _open_regular(path):
     """``path`` opened for reading if it is a regular file; a FIFO, a device or a socket (which
     would block or never end) is refused before anything opens it."""
-    from .io import special_kind
-
     st = os.stat(path)
     if not stat.S_ISREG(st.st_mode):
         raise RecordError(f"{path}: {special_kind(st.st_mode)}, not a record file: not opened")
@@ -538,43 +534,3 @@ def is_peer_download(path) -> bool:
     if os.path.isdir(path):
         return os.path.isfile(os.path.join(path, SEARCH_RESULTS))
     return is_peer_zip(path)
-
-
-# -- verticals ---------------------------------------------------------------------------------------
-#: PEER writes the polarity at the end of a vertical's name: ``TAF-UP``, ``ORRDWN``
-_NAME_POLARITY = re.compile(r"(UP|DWN)$", re.IGNORECASE)
-
-
-def vertical_polarity(record: Record, file_name: str | None = None) -> int:
-    """+1 for a vertical whose samples are positive upwards (``UP``), -1 for positive downwards
-    (``DWN``), from the file name and the header's component (docs/theory.md section 10).
-
-    Raises
-    ------
-    RecordError
-        When neither says ``UP`` or ``DWN``, or they disagree: a polarity is never guessed.
-    """
-    name = file_name or str(record.metadata.get("source") or record.name)
-    stem = os.path.splitext(os.path.basename(name))[0]
-    said = {}
-    m = _NAME_POLARITY.search(stem)
-    if m:
-        said["file name"] = m.group(1).upper()
-    comp = str(record.metadata.get("component") or "").strip().upper()
-    m = _NAME_POLARITY.search(comp)
-    if m:
-        said["header"] = m.group(1)
-    if not said:
-        raise RecordError(f"{name}: the polarity of this vertical is not stated (neither its name nor "
-                          f"its header component {comp!r} says UP or DWN); it is not used")
-    if len(set(said.values())) > 1:
-        raise RecordError(f"{name}: the file name says {said['file name']} but the header says "
-                          f"{said['header']}: polarity unknown, not used")
-    return 1 if next(iter(said.values())) == "UP" else -1
-
-
-def upward(record: Record, file_name: str | None = None) -> Record:
-    """The vertical as upward ground acceleration ``uv''`` (m/s^2): multiplied by -1 for ``DWN``."""
-    sign = vertical_polarity(record, file_name)
-    meta = dict(record.metadata, polarity="UP" if sign > 0 else "DWN", vertical=True)
-    return Record(record.acc * sign, record.dt, record.name, record.t_start, meta)

@@ -1,20 +1,29 @@
 """Every format obspy reads (MiniSEED, GSE2, ...), and the route SAC and K-NET take through obspy.
 
 :func:`obspy.read` detects and reads the file; the trace is then interpreted by the format
-registered for obspy's name of it (:mod:`pulses.sac`, :mod:`pulses.knet`), or as a format that
-states no units (MiniSEED and the rest: the user gives ``units``).  The channel code is read as a
-SEED code for ``metadata["vertical"]``.
+registered for obspy's name of it (:mod:`pulses.formats.sac`, :mod:`pulses.formats.knet`), or as
+a format that states no units (MiniSEED and the rest: the user gives ``units``).  The channel
+code is read as a SEED code for ``metadata["vertical"]``.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from . import formats
-from .errors import RecordError
-from .orientation import seed_orientation
+from ..errors import RecordError
+from ..orientation import seed_orientation
+from .registry import (
+    FALLBACK,
+    UNITS_NONE,
+    Reading,
+    ReadOptions,
+    RecordFormat,
+    by_obspy_name,
+    register,
+    too_long,
+)
 
 
-def read_trace(path: str, options: formats.ReadOptions, obspy_name: str | None = None):
+def read_trace(path: str, options: ReadOptions, obspy_name: str | None = None):
     """The one trace of ``path`` that obspy reads (``obspy_name`` = obspy's format, or detected).
 
     Raises
@@ -39,7 +48,7 @@ def read_trace(path: str, options: formats.ReadOptions, obspy_name: str | None =
         raise RecordError(f"{path}: the file holds no traces")
     tr = _pick_trace(path, stream, options.trace)
     if tr.stats.npts > options.max_samples:
-        raise RecordError(formats.too_long(path, options.max_samples, tr.stats.npts))
+        raise RecordError(too_long(path, options.max_samples, tr.stats.npts))
     return tr
 
 
@@ -51,24 +60,24 @@ def trace_metadata(tr) -> dict:
             "starttime": str(st.starttime), "t_start": 0.0}
 
 
-def read(path: str, options: formats.ReadOptions, obspy_name: str | None = None) -> formats.Reading:
+def read(path: str, options: ReadOptions, obspy_name: str | None = None) -> Reading:
     """Read ``path`` through obspy and interpret its trace by the format registered for it."""
     if obspy_name is None and options.format is not None:
         obspy_name = str(options.format).strip().upper()
     tr = read_trace(path, options, obspy_name)
     file_format = str(tr.stats.get("_format", obspy_name or "")).upper()
-    fmt = formats.by_obspy_name(file_format)
+    fmt = by_obspy_name(file_format)
     if fmt is not None and fmt.from_trace is not None:
         return fmt.from_trace(tr, path, options)
-    return _unitless(tr, file_format)
+    return unitless(tr, file_format)
 
 
-def _unitless(tr, file_format: str) -> formats.Reading:
+def unitless(tr, file_format: str) -> Reading:
     """A trace of a format that states no units (MiniSEED, GSE2, ...)."""
     meta = trace_metadata(tr)
     meta.update(seed_orientation(tr.stats.channel))
-    return formats.Reading(np.asarray(tr.data, dtype=float), float(tr.stats.delta), meta,
-                           units_rule=formats.UNITS_NONE, no_units=f"{file_format} data carry no units")
+    return Reading(np.asarray(tr.data, dtype=float), float(tr.stats.delta), meta,
+                   units_rule=UNITS_NONE, no_units=f"{file_format} data carry no units")
 
 
 def _pick_trace(path, stream, trace):
@@ -94,6 +103,6 @@ def _pick_trace(path, stream, trace):
 
 
 #: read by name only (obspy detects them): the fallback for every file, and MiniSEED's names
-FORMAT = formats.register(formats.RecordFormat(name=formats.FALLBACK, read=read))
-MSEED = formats.register(formats.RecordFormat(
+FORMAT = register(RecordFormat(name=FALLBACK, read=read))
+MSEED = register(RecordFormat(
     name="mseed", aliases=("miniseed",), read=lambda path, options: read(path, options, "MSEED")))

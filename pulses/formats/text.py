@@ -20,9 +20,17 @@ import re
 
 import numpy as np
 
-from . import formats
-from .errors import RecordError
-from .formats import MAX_SAMPLES, join_blocks, too_long
+from ..errors import RecordError
+from .registry import (
+    MAX_SAMPLES,
+    UNITS_NONE,
+    Reading,
+    ReadOptions,
+    RecordFormat,
+    join_blocks,
+    register,
+    too_long,
+)
 
 _SPLIT = re.compile(r"[\s,;]+")
 _COMMENT = ("%", "#", "!", "//")
@@ -272,16 +280,16 @@ def hint_from_comments(comments) -> str:
     return f" (its comments say: {text[:120]!r})"
 
 
-def read(path: str, options: formats.ReadOptions) -> formats.Reading:
+def read(path: str, options: ReadOptions) -> Reading:
     """The text format's reader: the chosen column; units and ``dt`` come from the user."""
     values, dt_time, info = read_text_file(path, column=options.column, max_samples=options.max_samples)
     meta = {"format": "text", "comments": info["comments"], "columns": info["columns"],
             "column": info["column"], "time_column": info["time_column"],
             "component": f"column {info['column']}" if info["columns"] > 1 else ""}
     hint = hint_from_comments(info["comments"])
-    return formats.Reading(values, dt_time, meta, units_rule=formats.UNITS_NONE, hint=hint,
-                           no_units=f"the file does not state its units{hint}")
+    return Reading(values, dt_time, meta, units_rule=UNITS_NONE, hint=hint,
+                   no_units=f"the file does not state its units{hint}")
 
 
-FORMAT = formats.register(formats.RecordFormat(
+FORMAT = register(RecordFormat(
     name="text", aliases=("txt", "csv", "ascii"), detect=sniff_text, read=read, sniff_order=20))

@@ -18,7 +18,7 @@ The sample count is checked against ``NPTS``: sample ``k`` (0-based) is at ``t =
 record lasts ``(NPTS - 1) DT``.
 
 Once the package is installed, ``obspy.read("x.AT2")`` works through the entry points
-``pulses.at2:_is_at2`` and ``pulses.at2:_read_at2`` declared in ``pyproject.toml``.
+``pulses.formats.at2:_is_at2`` and ``pulses.formats.at2:_read_at2`` declared in ``pyproject.toml``.
 """
 from __future__ import annotations
 
@@ -28,11 +28,19 @@ import warnings
 
 import numpy as np
 
-from . import formats
-from .errors import RecordError
-from .formats import MAX_SAMPLES, join_blocks, too_long
-from .orientation import orientation, seed_orientation
-from .units import canonical_units
+from ..errors import RecordError
+from ..orientation import orientation, seed_orientation
+from ..units import canonical_units
+from .registry import (
+    MAX_SAMPLES,
+    UNITS_STATED,
+    Reading,
+    ReadOptions,
+    RecordFormat,
+    join_blocks,
+    register,
+    too_long,
+)
 
 #: one Fortran real: optional sign, digits with optional point (or a point and digits),
 #: optional exponent with E or D
@@ -273,7 +281,7 @@ def _parse_block(path: str, lines: list, lineno: int) -> np.ndarray:
     return np.array([_float(v) for v in tokens], dtype=float)
 
 
-def read(path: str, options: formats.ReadOptions) -> formats.Reading:
+def read(path: str, options: ReadOptions) -> Reading:
     """The AT2 format's reader: acceleration only, in the units the header states.
 
     Raises
@@ -286,7 +294,7 @@ def read(path: str, options: formats.ReadOptions) -> formats.Reading:
     return reading_of(path, values, dt, header)
 
 
-def reading_of(path: str, values, dt: float, header: dict) -> formats.Reading:
+def reading_of(path: str, values, dt: float, header: dict) -> Reading:
     """The :class:`pulses.formats.Reading` of AT2 samples and header (see :func:`read`)."""
     if header["quantity"] in ("velocity", "displacement"):
         raise RecordError(f"{path}: this is a {header['quantity']} record ({header['lines'][2].strip()}); "
@@ -302,7 +310,7 @@ def reading_of(path: str, values, dt: float, header: dict) -> formats.Reading:
     meta = {k: header[k] for k in ("event", "date", "station", "component", "title", "header_style",
                                    "azimuth", "vertical") if k in header}
     meta.update(format="at2", npts_header=header["npts"], units_stated=header["units"])
-    return formats.Reading(values, dt, meta, units=stated, units_rule=formats.UNITS_STATED)
+    return Reading(values, dt, meta, units=stated, units_rule=UNITS_STATED)
 
 
 def detect(path: str) -> bool:
@@ -343,5 +351,4 @@ def _read_at2(filename, headonly=False, **kwargs):
     return Stream([tr])
 
 
-FORMAT = formats.register(formats.RecordFormat(name="at2", aliases=("peer",), detect=detect, read=read,
-                                               sniff_order=10))
+FORMAT = register(RecordFormat(name="at2", aliases=("peer",), detect=detect, read=read, sniff_order=10))

@@ -6,10 +6,10 @@ it and applies the checks every record gets.  Formats (``format=``):
 ``"at2"``
     PEER NGA ``.AT2`` (both header styles); units from the header ("UNITS OF G").
 ``"text"``
-    Plain text or CSV columns (see :mod:`pulses.textfile`); the user gives ``units`` and ``dt``
+    Plain text or CSV columns (see :mod:`pulses.formats.text`); the user gives ``units`` and ``dt``
     (``dt`` may come from a time column instead).
-``"sac"`` (:mod:`pulses.sac`), ``"knet"`` (:mod:`pulses.knet`), every other obspy format (``"mseed"``, ...)
-    Through :func:`obspy.read` (:mod:`pulses.obspyformat`).  SAC: ``idep`` states the quantity;
+``"sac"`` (:mod:`pulses.formats.sac`), ``"knet"`` (:mod:`pulses.formats.knet`), every other obspy format (``"mseed"``, ...)
+    Through :func:`obspy.read` (:mod:`pulses.formats.obspy`).  SAC: ``idep`` states the quantity;
     ``iacc`` means nm/s^2 by the SAC standard, honoured unless the user passes ``units``.  K-NET: obspy leaves the samples in
     counts and puts the header's scale factor, converted from gal to m/s^2, into
     ``stats.calib``; the reader multiplies by it and removes the mean (the K-NET convention), so
@@ -26,11 +26,11 @@ import pathlib
 
 import numpy as np
 
-from . import at2, formats, knet, obspyformat, sac, textfile  # noqa: F401  (each registers its format)
-from .errors import RecordError
-from .formats import MAX_SAMPLES, ReadOptions
-from .record import Record
-from .units import (
+from .. import formats
+from ..errors import RecordError
+from ..formats import MAX_SAMPLES, ReadOptions
+from ..record import Record
+from ..units import (
     G,
     PLAUSIBLE_MAX_G,
     PLAUSIBLE_MIN_G,
@@ -183,7 +183,7 @@ def record_from_reading(path: str, reading, units=None, dt=None, name=None, *,
     """The checks every record gets, on what a format's reader found (``reading``, a
     :class:`pulses.formats.Reading`): units (never guessed), time step, finite samples, plausible
     peak.  ``path`` names the source in messages and in ``metadata["source"]``; it need not be a
-    file (a member of a zip read in memory, :mod:`pulses.peer`)."""
+    file (a member of a zip read in memory, :mod:`pulses.io.peer`)."""
     if units is not None:
         unit_factor(units)
     meta = reading.metadata

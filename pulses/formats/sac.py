@@ -12,10 +12,11 @@ import os
 
 import numpy as np
 
-from . import formats, obspyformat
-from .errors import RecordError
-from .orientation import orientation, seed_orientation
-from .record import Record
+from ..errors import RecordError
+from ..orientation import orientation, seed_orientation
+from .obspy import read as read_by_obspy
+from .obspy import trace_metadata
+from .registry import UNITS_STANDARD, Reading, ReadOptions, RecordFormat, register
 
 #: SAC ``idep`` enumeration values (as obspy stores them) -> quantity
 IDEP_QUANTITY = {8: "acceleration", 7: "velocity", 6: "displacement", 5: "unknown", 50: "volts"}
@@ -75,7 +76,7 @@ def shortest_float32(value: float) -> float:
     return float(np.format_float_positional(np.float32(value), unique=True, trim="-"))
 
 
-def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
+def from_trace(tr, path: str, options: ReadOptions) -> Reading:
     """Interpret a SAC trace obspy read: ``delta`` as written, ``b``, ``kevnm``, ``idep``'s units.
 
     Raises
@@ -85,7 +86,7 @@ def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
         is not a time series (``iftype`` other than ``itime``: a spectrum, x-y data).
     """
     sac = tr.stats.sac
-    meta = obspyformat.trace_metadata(tr)
+    meta = trace_metadata(tr)
     meta["t_start"] = float(sac.get("b", 0.0) or 0.0)
     meta["event"] = str(sac.get("kevnm", "") or "").strip()
     if sac.get("kuser0"):
@@ -101,9 +102,8 @@ def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
         kind = IFTYPE_KIND.get(int(iftype), f"code {int(iftype)}")
         raise RecordError(f"{path}: SAC iftype says this file is not a time series but {kind}; "
                           "records must be time series (iftype = itime)")
-    reading = formats.Reading(np.asarray(tr.data, dtype=float),
-                              shortest_float32(sac.get("delta", tr.stats.delta)), meta,
-                              units_rule=formats.UNITS_STANDARD)
+    reading = Reading(np.asarray(tr.data, dtype=float), shortest_float32(sac.get("delta", tr.stats.delta)),
+                      meta, units_rule=UNITS_STANDARD)
     if quantity == "acceleration":
         reading.units = standard  # nm/s2 by the SAC standard; the user may override with units=
     else:
@@ -111,7 +111,7 @@ def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
     return reading
 
 
-def write_sac(record: Record, path) -> str:
+def write_sac(record, path) -> str:
     """Write ``record`` as a binary SAC file of ground acceleration in nm/s^2 (``idep = iacc``).
 
     This is the SAC standard, so :func:`pulses.read_record` reads the file back without being
@@ -169,6 +169,6 @@ def write_sac(record: Record, path) -> str:
     return path
 
 
-FORMAT = formats.register(formats.RecordFormat(
+FORMAT = register(RecordFormat(
     name="sac", obspy_name="SAC", from_trace=from_trace,
-    read=lambda path, options: obspyformat.read(path, options, "SAC")))
+    read=lambda path, options: read_by_obspy(path, options, "SAC")))

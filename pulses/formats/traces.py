@@ -2,7 +2,7 @@
 reader put in ``trace.stats``, or given: never guessed), a record as a trace, and a
 :class:`obspy.Stream` of two or three components as a pair or a triplet.
 
-A trace is interpreted as the file it came from would be (:mod:`pulses.sac`, :mod:`pulses.knet`,
+A trace is interpreted as the file it came from would be (:mod:`pulses.formats.sac`, :mod:`pulses.formats.knet`,
 the AT2 plugin's ``stats.at2``), then gets every check :func:`pulses.read_record` makes
 (:func:`pulses.io.record_from_reading`).
 """
@@ -12,9 +12,9 @@ import os
 
 import numpy as np
 
-from . import formats
-from .errors import RecordError
-from .record import Record
+from ..errors import RecordError
+from ..record import Record
+from . import registry as formats
 
 #: ``trace.stats`` key under which :func:`to_trace` keeps what a trace does not hold otherwise
 STATS_KEY = "pulses"
@@ -29,18 +29,18 @@ def _source(tr, name) -> str:
 
 def _reading(tr, path: str) -> formats.Reading:
     """What the trace says, as the format it was read from states it."""
-    from . import obspyformat
+    from . import obspy as obspyformat
 
     fmt_name = str(tr.stats.get("_format", "")).upper()
     fmt = formats.by_obspy_name(fmt_name) if fmt_name else None
     if fmt is not None and fmt.from_trace is not None:
         return fmt.from_trace(tr, path, formats.ReadOptions())
-    if "at2" in tr.stats:  # the AT2 plugin's header (pulses.at2._read_at2)
+    if "at2" in tr.stats:  # the AT2 plugin's header (pulses.formats.at2._read_at2)
         from .at2 import reading_of
 
         header = {"lines": ["", "", ""], **dict(tr.stats.at2)}
         return reading_of(path, np.asarray(tr.data, dtype=float), float(tr.stats.delta), header)
-    return obspyformat._unitless(tr, fmt_name or "this trace's")
+    return obspyformat.unitless(tr, fmt_name or "this trace's")
 
 
 def from_trace(tr, units=None, *, name=None) -> Record:
@@ -48,7 +48,7 @@ def from_trace(tr, units=None, *, name=None) -> Record:
     kept = tr.stats.get(STATS_KEY)
     if kept is not None:  # a record's own trace (to_trace): m/s^2, its name, start and metadata
         return _own(tr, kept, units)
-    from .io import record_from_reading
+    from ..io.read import record_from_reading
 
     path = _source(tr, name)
     shown = name if name is not None else os.path.basename(path)
@@ -57,7 +57,7 @@ def from_trace(tr, units=None, *, name=None) -> Record:
 
 def _own(tr, kept, units) -> Record:
     if units is not None and units != "m/s2":
-        from .units import unit_factor
+        from ..units import unit_factor
 
         if unit_factor(units) != 1.0:
             raise RecordError(f"{kept.name}: the trace was made by Record.to_trace and holds m/s2, "
@@ -122,8 +122,8 @@ def from_stream(stream, units=None):
     >>> round(first.pga / pulses.G, 2), second.npts
     (0.19, 1000)
     """
-    from .pairs import check_pair
-    from .triplets import check_triplet
+    from ..pairs import check_pair
+    from ..triplets import check_triplet
 
     records = [from_trace(tr, units) for tr in stream]
     if len(records) == 2:

@@ -6,8 +6,10 @@ convention), so the file states its units (m/s^2) and a user's units are not app
 """
 from __future__ import annotations
 
-from . import formats, obspyformat
-from .orientation import orientation
+from ..orientation import orientation
+from .obspy import read as read_by_obspy
+from .obspy import trace_metadata
+from .registry import UNITS_STATED, Reading, ReadOptions, RecordFormat, register
 
 #: K-NET ``Dir.`` (obspy's channel, KiK-net's 1-6 mapped to NS1 ... UD2) -> orientation
 _DIRECTIONS = {"NS": orientation(azimuth=0.0), "EW": orientation(azimuth=90.0),
@@ -19,21 +21,21 @@ def knet_orientation(channel) -> dict:
     return dict(_DIRECTIONS.get(str(channel or "").strip().upper()[:2], {}))
 
 
-def from_trace(tr, path: str, options: formats.ReadOptions) -> formats.Reading:
+def from_trace(tr, path: str, options: ReadOptions) -> Reading:
     """Interpret a K-NET trace obspy read: counts times the scale factor, mean removed, in m/s^2."""
     st = tr.stats
     values = tr.data.astype(float)
     values -= values.mean()
     values *= float(st.calib)
-    meta = obspyformat.trace_metadata(tr)
+    meta = trace_metadata(tr)
     knet = st.get("knet", {})
     meta["event"] = f"M{knet.get('mag', '')} {knet.get('evot', '')}".strip()
     meta["knet_accmax_gal"] = knet.get("accmax")
     meta.update(knet_orientation(st.channel))
     meta["notes"] = ["K-NET: samples times the header scale factor, mean removed"]
-    return formats.Reading(values, float(st.delta), meta, units="m/s2", units_rule=formats.UNITS_STATED)
+    return Reading(values, float(st.delta), meta, units="m/s2", units_rule=UNITS_STATED)
 
 
-FORMAT = formats.register(formats.RecordFormat(
+FORMAT = register(RecordFormat(
     name="knet", obspy_name="KNET", from_trace=from_trace,
-    read=lambda path, options: obspyformat.read(path, options, "KNET")))
+    read=lambda path, options: read_by_obspy(path, options, "KNET")))
