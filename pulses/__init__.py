@@ -11,7 +11,7 @@ _WHERE = {
     "RecordError": "errors", "UnitsWarning": "errors",
     "G": "units", "Record": "record",
     "VP_TO_AP": "scenario", "design_pulse": "scenario", "pulse_period": "scenario",
-    "read_record": "io",
+    "read_record": "io", "read_pair": "io", "from_stream": "io",
     "write_sac": "formats.sac",
     "Candidate": "fit", "FitError": "fit", "PulseFit": "fit", "fit_pulse": "fit",
     "BETA": "shapes", "SHAPES": "shapes", "AntisymmetricRicker": "shapes", "OneSine": "shapes",
@@ -19,10 +19,10 @@ _WHERE = {
     "shape_class": "shapes",
     "PulseCandidate": "velocity", "PulseClassification": "velocity", "classify_pulse": "velocity",
     "Pairing": "pairs", "check_pair": "pairs", "component": "pairs", "pair_files": "pairs",
-    "read_pair": "pairs", "rotate_pair": "pairs",
+    "rotate_pair": "pairs",
     "PeerDownload": "io.peer",
     "check_triplet": "triplets",
-    "to_frame": "export", "from_stream": "formats.traces",
+    "to_frame": "export",
 }
 #: submodules that are part of the public namespace: public name -> the module
 _MODULES = {"peer": "io.peer"}

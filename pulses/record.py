@@ -107,9 +107,9 @@ class Record:
         >>> round(pulses.Record.from_trace(tr, units="g").pga / pulses.G, 3)
         0.874
         """
-        from .formats.traces import from_trace
+        from .formats.traces import trace_fields  # the formats load when a trace is first converted
 
-        return from_trace(trace, units, name=name)
+        return cls(**trace_fields(trace, units, name=name))
 
     def to_trace(self):
         """This record as an :class:`obspy.Trace`: ``data`` in m/s^2, ``delta`` = ``dt``,
@@ -125,9 +125,9 @@ class Record:
         >>> tr.stats.delta, list(tr.data) == list(rec.acc), pulses.Record.from_trace(tr).name
         (0.01, True, 'demo')
         """
-        from .formats.traces import to_trace
+        from .formats.traces import record_trace
 
-        return to_trace(self)
+        return record_trace(self)
 
     # -- basic facts -------------------------------------------------------------------
     @property

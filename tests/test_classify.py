@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import pulses
-from pulses.pairs import check_pair, component, pair_files, read_pair, rotate_pair
+from pulses.io import read_pair
+from pulses.pairs import check_pair, component, pair_files, rotate_pair
 from pulses.velocity import (
     FC,
     _cwt_at,
