@@ -1,7 +1,7 @@
 """The pulse fitter: scale-to-Tp conversion, the FFT wavelet transform, and accuracy.
 
-Accuracy is measured on synthetic records (:mod:`pulses.synthetic`) against the noise limit of
-any least-squares pulse fit (:func:`pulses.synthetic.least_squares_limit`): with band-limited
+Accuracy is measured on synthetic records (:mod:`pulses.fit.synthetic`) against the noise limit of
+any least-squares pulse fit (:func:`pulses.fit.synthetic.least_squares_limit`): with band-limited
 background motion (0.5-10 Hz) a short pulse sits inside the noise band, and no fit recovers it
 better than that limit.  The issue's percentage floors are asserted where the limit allows them;
 everywhere the scatter must stay at the limit and every miss must be a pulse that explains the
@@ -19,7 +19,7 @@ import pytest
 
 import pulses
 from pulses import G, PulseFit, Record, fit_pulse, make_pulse
-from pulses.cwt import (
+from pulses.fit.matching import (
     GAUS3_TP_PER_SCALE,
     MEXH_TP_PER_SCALE,
     Matcher,
@@ -28,7 +28,7 @@ from pulses.cwt import (
     unit_energy,
     unit_spectrum,
 )
-from pulses.synthetic import least_squares_limit, sampled_pulse, synthetic_record
+from pulses.fit.synthetic import least_squares_limit, sampled_pulse, synthetic_record
 
 from .conftest import SHARED_RECORDS, shared_record
 
@@ -346,8 +346,8 @@ def test_noise_free_recovery_weighted(shape):
 
 
 def test_background_spectrum_leaves_out_the_pulse():
-    from pulses.fit import Background
-    from pulses.synthetic import band_noise
+    from pulses.fit.fitter import Background
+    from pulses.fit.synthetic import band_noise
 
     # 15 % background (0.5-10 Hz) plus the error of a plain fit of a 0.5 s one-sine at 8 s (ap 5 %
     # and Tp 3 % off): its corners put power at 15-30 Hz, where the background has little.  From
@@ -376,7 +376,7 @@ def test_segment_periodograms_are_scipys_spectrogram(nseg):
     round-off itself); asserted at 1e-13 and 1e-11."""
     from scipy import signal
 
-    from pulses.fit import segment_periodograms
+    from pulses.fit.fitter import segment_periodograms
 
     rng = np.random.default_rng(7)
     records = [rng.standard_normal(n) for n in (nseg, nseg + 1, 1001, 4000)]
@@ -427,13 +427,13 @@ def test_weighted_score_of_long_pulses():
             assert fit.best.shape == shape and fit.best.score > 0.9, (shape, fit)
     x = rec.acc
     # the share of the record's weighted energy that the record itself explains is all of it
-    from pulses.fit import Background
+    from pulses.fit.fitter import Background
 
     assert Background(x - fit.best.pulse(np.arange(x.size) * DT), DT).explained(x, {"x": x})["x"] == 1.0
 
 
 def test_weighted_limit_is_below_the_plain_one():
-    from pulses.synthetic import weighted_least_squares_limit
+    from pulses.fit.synthetic import weighted_least_squares_limit
 
     for shape in SHAPES:
         for tp in (0.5, 2.0):
@@ -571,8 +571,8 @@ def test_shape_slope_and_extrema(shape):
 
 
 def test_unknown_shape_fails_loudly():
-    from pulses.cwt import unit_spectrum as spectrum
-    from pulses.fit import unit_samples
+    from pulses.fit.matching import unit_spectrum as spectrum
+    from pulses.fit.fitter import unit_samples
 
     for call in (lambda: pulses.make_pulse("triangle", 1.0, 1.0), lambda: pulses.shape_class("triangle"),
                  lambda: unit_samples("triangle", 1.0, 0.0, np.zeros(3), 0.01),

@@ -22,8 +22,8 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
-from .cwt import BLAS_PRODUCT, _products
 from .lsq import levenberg_marquardt
+from .matching import BLAS_PRODUCT, _products
 
 #: periods scanned by the weighted search of a shape with corners before its descent, within a
 #: factor GLS_SCAN_RANGE of the starting period; shifts within GLS_SHIFT Tp

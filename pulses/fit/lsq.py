@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .cwt import _dot, _products
+from .matching import _dot, _products
 
 #: :func:`pulse_normal_equations` takes the sum of squares of the residual from its products with
 #: the record, ``xp'xp - 2 ap m'P xp + ap^2 m'P m``, which loses ``xp'xp / r'r`` of its relative

@@ -46,13 +46,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import fft as sfft
 
+from ..record import Record
+from ..shapes import SHAPES, Pulse, make_pulse, shape_class
+from ..units import G
 from .baseline import pgv as _pgv
 from .baseline import significant_duration
-from .cwt import Matcher, _dot, unit_energy
 from .lsq import baseline_projector, levenberg_marquardt, pulse_normal_equations
-from .record import Record
-from .shapes import SHAPES, Pulse, make_pulse, shape_class
-from .units import G
+from .matching import Matcher, _dot, unit_energy
 from .weighted import WeightedWindow
 
 #: shapes fitted by default (every registered shape), in the order they are reported on ties

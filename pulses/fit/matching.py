@@ -35,7 +35,7 @@ import math
 import numpy as np
 from scipy import fft as sfft
 
-from .shapes import SHAPES, AntisymmetricRicker, SymmetricRicker, shape_class
+from ..shapes import SHAPES, AntisymmetricRicker, SymmetricRicker, shape_class
 
 #: Tp = MEXH_TP_PER_SCALE * s for PyWavelets' ``mexh`` at scale s (docs/theory.md section 3)
 MEXH_TP_PER_SCALE = SymmetricRicker.pywt[1]

@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal
 
-from .record import Record
-from .shapes import make_pulse, shape_class
+from ..record import Record
+from ..shapes import make_pulse, shape_class
 
 #: default band of the background motion, Hz
 NOISE_BAND = (0.5, 10.0)
@@ -115,7 +115,7 @@ def least_squares_limit(shape: str, ap: float, tp: float, t0: float, duration: f
     dict
         ``ap``, ``tp`` (relative standard deviations) and ``t0`` (standard deviation in Tp).
     """
-    from .fit import _fit_window, unit_samples_and_derivatives
+    from .fitter import _fit_window, unit_samples_and_derivatives
 
     n = int(round(duration / dt)) + 1
     t = np.arange(n) * dt
@@ -156,7 +156,7 @@ def weighted_least_squares_limit(shape: str, ap: float, tp: float, t0: float, du
     """
     from scipy import fft as sfft
 
-    from .fit import GLS_MARGIN, LOADING
+    from .fitter import GLS_MARGIN, LOADING
 
     cls = shape_class(shape)
     n = int(round(duration / dt)) + 1
