@@ -89,7 +89,7 @@ def test_a_list_of_results_is_one_frame():
 
 
 @pytest.mark.parametrize("module", ["pulses.export", "pulses.io.streams", "pulses.record", "pulses.shapes",
-                                    "pulses.velocity", "pulses.scenario", "pulses.fit.fitter", "pulses.pairs",
+                                    "pulses.velocity", "pulses.scenario", "pulses.fit.fitter", "pulses.fit.results", "pulses.pairs",
                                     "pulses.formats.sac", "pulses.io.read", "rocking.governing", "rocking.widths", "rocking._common",
                                     "rocking.slenderness", "rocking.block", "rocking.closed_forms", "rocking.frame",
                                     "rocking.solver", "rocking.fragility", "rocking.spectrum",

@@ -346,7 +346,7 @@ def test_noise_free_recovery_weighted(shape):
 
 
 def test_background_spectrum_leaves_out_the_pulse():
-    from pulses.fit.fitter import Background
+    from pulses.fit.background import Background
     from pulses.fit.synthetic import band_noise
 
     # 15 % background (0.5-10 Hz) plus the error of a plain fit of a 0.5 s one-sine at 8 s (ap 5 %
@@ -376,7 +376,7 @@ def test_segment_periodograms_are_scipys_spectrogram(nseg):
     round-off itself); asserted at 1e-13 and 1e-11."""
     from scipy import signal
 
-    from pulses.fit.fitter import segment_periodograms
+    from pulses.fit.background import segment_periodograms
 
     rng = np.random.default_rng(7)
     records = [rng.standard_normal(n) for n in (nseg, nseg + 1, 1001, 4000)]
@@ -427,7 +427,7 @@ def test_weighted_score_of_long_pulses():
             assert fit.best.shape == shape and fit.best.score > 0.9, (shape, fit)
     x = rec.acc
     # the share of the record's weighted energy that the record itself explains is all of it
-    from pulses.fit.fitter import Background
+    from pulses.fit.background import Background
 
     assert Background(x - fit.best.pulse(np.arange(x.size) * DT), DT).explained(x, {"x": x})["x"] == 1.0
 
@@ -572,7 +572,7 @@ def test_shape_slope_and_extrema(shape):
 
 def test_unknown_shape_fails_loudly():
     from pulses.fit.matching import unit_spectrum as spectrum
-    from pulses.fit.fitter import unit_samples
+    from pulses.fit.windows import unit_samples
 
     for call in (lambda: pulses.make_pulse("triangle", 1.0, 1.0), lambda: pulses.shape_class("triangle"),
                  lambda: unit_samples("triangle", 1.0, 0.0, np.zeros(3), 0.01),

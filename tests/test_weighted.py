@@ -22,7 +22,7 @@ from scipy import fft as sfft
 from scipy import linalg, optimize
 
 from pulses import shape_class
-from pulses.fit.fitter import Background
+from pulses.fit.background import Background
 from pulses.fit.lsq import baseline_projector, levenberg_marquardt, normal_equations
 from pulses.fit.weighted import WeightedWindow, difference_covariance, gram
 
@@ -38,7 +38,7 @@ def spectrum(nfft):
 
 
 def weights(nfft):
-    """The bins' weights for :func:`spectrum`, as :meth:`pulses.fit.Background.weights` makes them:
+    """The bins' weights for :func:`spectrum`, as :meth:`pulses.fit.background.Background.weights` makes them:
     interior bins stand for two bins of the full FFT."""
     w = 2.0 / (nfft * spectrum(nfft))
     w[0] *= 0.5

@@ -1,4 +1,4 @@
-"""Small dense least squares for the pulse fitter (:mod:`pulses.fit`, :mod:`pulses.weighted`).
+"""Small dense least squares for the pulse fitter (:mod:`pulses.fit.plain`, :mod:`pulses.fit.weighted`).
 
 - :func:`levenberg_marquardt`: minimise a sum of squares of a few unknowns (three: ``ap``, ``Tp``,
   ``t0``) inside a box, from the normal equations the caller computes;
@@ -163,7 +163,7 @@ def levenberg_marquardt(normal, p, scale, lower, upper, xtol=1e-10, ftol=1e-9, m
     normal : callable
         ``p -> (sum of squares, J'J, J'r)`` (arrays or nested lists) with ``J = dr/dp``
         (:func:`normal_equations`; :func:`pulse_normal_equations`; for weighted least squares the
-        weighted products, :meth:`pulses.weighted.WeightedWindow.normal`).
+        weighted products, :meth:`pulses.fit.weighted.WeightedWindow.normal`).
     p : ndarray, shape (k,)
         Start, inside the box.
     scale : ndarray, shape (k,)

@@ -25,7 +25,7 @@ The two Ricker shapes are PyWavelets' ``mexh`` (second derivative of a Gaussian)
 The transform is computed in the frequency domain with the closed-form Fourier transforms of the
 four shapes (one FFT of the record, one inverse FFT per period), keeping only the band the
 shortest period needs, so the output is on a coarser time grid than the record.  This is the
-coarse search; :mod:`pulses.fit` refines the best match by least squares on the samples.
+coarse search; :mod:`pulses.fit.plain` refines the best match by least squares on the samples.
 """
 from __future__ import annotations
 

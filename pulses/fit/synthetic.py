@@ -115,11 +115,11 @@ def least_squares_limit(shape: str, ap: float, tp: float, t0: float, duration: f
     dict
         ``ap``, ``tp`` (relative standard deviations) and ``t0`` (standard deviation in Tp).
     """
-    from .fitter import _fit_window, unit_samples_and_derivatives
+    from .windows import fit_window, unit_samples_and_derivatives
 
     n = int(round(duration / dt)) + 1
     t = np.arange(n) * dt
-    lo, hi = _fit_window(shape, tp, t0)
+    lo, hi = fit_window(shape, tp, t0)
     idx = slice(max(0, int(np.floor(lo / dt))), min(n, int(np.ceil(hi / dt)) + 1))
     tw = t[idx]
     m, d_tp, d_t0 = unit_samples_and_derivatives(shape, tp, t0, tw, dt)
@@ -143,9 +143,9 @@ def weighted_least_squares_limit(shape: str, ap: float, tp: float, t0: float, du
     squares of :func:`pulses.fit_pulse` have under band-limited background motion, when the
     background's spectrum is known: the noise limit of ``weighting="background"``.
 
-    As the fitter does, over the pulse and ``pulses.fit.GLS_MARGIN`` s each side, with the
+    As the fitter does, over the pulse and ``pulses.fit.weighted.GLS_MARGIN`` s each side, with the
     covariance of the background taken as the circulant of its spectrum ``S`` and the weights
-    ``1 / (S + c mean(S))`` (``c = pulses.fit.LOADING``).  Linearised about the true pulse, the
+    ``1 / (S + c mean(S))`` (``c = pulses.fit.background.LOADING``).  Linearised about the true pulse, the
     estimate has covariance ``(J'WJ)^-1 J'WSWJ (J'WJ)^-1``; without the loading (``c = 0``) it is
     ``(J'S^-1 J)^-1``, the Cramer-Rao bound, which no unbiased estimator beats.
 
@@ -156,7 +156,8 @@ def weighted_least_squares_limit(shape: str, ap: float, tp: float, t0: float, du
     """
     from scipy import fft as sfft
 
-    from .fitter import GLS_MARGIN, LOADING
+    from .background import LOADING
+    from .weighted import GLS_MARGIN
 
     cls = shape_class(shape)
     n = int(round(duration / dt)) + 1
