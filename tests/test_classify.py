@@ -11,15 +11,8 @@ import pytest
 import pulses
 from pulses.io import read_pair
 from pulses.pairs import check_pair, component, pair_files, rotate_pair
-from pulses.velocity import (
-    FC,
-    _cwt_at,
-    _pulse_wavelet,
-    classify_pulse,
-    coarse_scales,
-    db4_cwt,
-    db4_cwt_direct,
-)
+from pulses.db4 import FC, _pulse_wavelet, cwt_at, db4_cwt, db4_cwt_direct
+from pulses.velocity import classify_pulse, coarse_scales
 
 from .conftest import SHARED_RECORDS, shared_record
 
@@ -81,7 +74,7 @@ def test_transform_on_windows_equals_full_transform():
     for a in (20.0, 300.0):
         full = db4_cwt_direct(x, [a])[0]
         for start, stop in [(0, 1), (1500, 1501), (2999, 3000), (0, 400), (1200, 1900), (2700, 3000)]:
-            part = _cwt_at(x, a, start, stop)
+            part = cwt_at(x, a, start, stop)
             np.testing.assert_allclose(part, full[start:stop], rtol=0, atol=1e-11 * np.max(np.abs(full)))
 
 
