@@ -95,6 +95,25 @@ def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPL
         column that is not uniformly sampled, or more than ``max_samples`` rows.
     """
     path = os.fspath(path)
+    parsed = _parse(path, column, max_samples)
+    ncols = parsed.ncols
+    first = join_blocks(parsed.first)
+    kept = join_blocks(parsed.kept) if parsed.kept_index else first
+    names = parsed.names
+    named_time = bool(names) and names[0].lower().startswith(("t", "time", "sec"))
+    time_column = ncols >= 2 and first.size >= 2 and (named_time or _increasing(first))
+    column = _chosen_column(path, column, ncols, time_column)
+    if time_column and column == 1:
+        time_column = False  # the user says column 1 is acceleration
+    dt_from_time = _time_step(path, first) if time_column else None
+    info = {"comments": parsed.comments, "columns": ncols, "column": column, "time_column": time_column,
+            "names": names}
+    # the chosen column was kept while reading: the first, or the one named (or the second)
+    return (first if column == 1 else kept), dt_from_time, info
+
+
+def _parse(path: str, column, max_samples) -> "_Rows":
+    """The rows of the file, read block by block; refused if missing, not text, empty or ragged."""
     try:
         with open(path, "r", encoding="utf-8-sig") as fh:
             parsed = _Rows(path, column, max_samples)
@@ -111,17 +130,16 @@ def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPL
         raise RecordError(f"{path}: cannot read: {exc.strerror or exc}") from None
     if not parsed.nrows:
         raise RecordError(f"{path}: the file holds no samples (empty or only comments)")
-    ncols = parsed.ncols
     if parsed.ragged is not None:
         lineno, count = parsed.ragged
         last = " (truncated last line?)" if lineno == parsed.last_row else ""
         raise RecordError(f"{path}: line {lineno} has {count} value(s), the first data line "
-                          f"has {ncols}{last}")
-    first = join_blocks(parsed.first)
-    kept = join_blocks(parsed.kept) if parsed.kept_index else first
-    names = parsed.names
-    named_time = bool(names) and names[0].lower().startswith(("t", "time", "sec"))
-    time_column = ncols >= 2 and first.size >= 2 and (named_time or _increasing(first))
+                          f"has {parsed.ncols}{last}")
+    return parsed
+
+
+def _chosen_column(path: str, column, ncols: int, time_column: bool) -> int:
+    """The acceleration column (from 1): the one asked for, or the only one there can be."""
     if column is None:
         if ncols == 1:
             column = 1
@@ -134,24 +152,19 @@ def read_text_file(path, column: int | None = None, max_samples: int = MAX_SAMPL
     column = int(column)
     if not 1 <= column <= ncols:
         raise RecordError(f"{path}: column {column} asked for, the file has {ncols} column(s) (counted from 1)")
-    if time_column and column == 1:
-        time_column = False  # the user says column 1 is acceleration
+    return column
 
-    dt_from_time = None
-    if time_column:
-        steps = np.diff(first)
-        dt_mean = (first[-1] - first[0]) / (first.size - 1)
-        shortest, longest = steps.min(), steps.max()
-        steps -= dt_mean  # in place: no more arrays the record's length
-        if not np.all(np.abs(steps, out=steps) <= UNIFORM_TOLERANCE * dt_mean + 1e-12):
-            raise RecordError(f"{path}: non-uniform sampling: time steps range from {shortest:.6g} "
-                              f"to {longest:.6g} s; resample to a uniform step first")
-        del steps
-        dt_from_time = float(dt_mean)
-    info = {"comments": parsed.comments, "columns": ncols, "column": column, "time_column": time_column,
-            "names": names}
-    # the chosen column was kept while reading: the first, or the one named (or the second)
-    return (first if column == 1 else kept), dt_from_time, info
+
+def _time_step(path: str, first: np.ndarray) -> float:
+    """The time step (s) of the time column ``first``; refused unless uniform."""
+    steps = np.diff(first)
+    dt_mean = (first[-1] - first[0]) / (first.size - 1)
+    shortest, longest = steps.min(), steps.max()
+    steps -= dt_mean  # in place: no more arrays the record's length
+    if not np.all(np.abs(steps, out=steps) <= UNIFORM_TOLERANCE * dt_mean + 1e-12):
+        raise RecordError(f"{path}: non-uniform sampling: time steps range from {shortest:.6g} "
+                          f"to {longest:.6g} s; resample to a uniform step first")
+    return float(dt_mean)
 
 
 def _increasing(values: np.ndarray) -> bool:
