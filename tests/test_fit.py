@@ -32,7 +32,8 @@ from pulses.fit.synthetic import least_squares_limit, sampled_pulse, synthetic_r
 
 from .conftest import SHARED_RECORDS, shared_record
 
-SHAPES = ("sine", "ricker-sym", "ricker-anti", "rect")
+#: every registered shape, the realisable ones first (the order the random cases below are drawn in)
+SHAPES = tuple(sorted(pulses.SHAPES, key=lambda shape: not pulses.SHAPES[shape].realisable))
 TPS = (0.2, 0.5, 1.0, 2.0, 5.0)
 DT = 0.005
 
@@ -669,3 +670,35 @@ def test_a_shapes_fit_is_the_same_whichever_shapes_are_asked(name):
         assert whole["sine"].ap_g == pytest.approx(0.676, abs=5e-4) and whole["sine"].tp == pytest.approx(0.82, abs=5e-3)
     pair = fit_pulse(record, shapes=["rect", "sine"])
     assert [c.shape for c in pair.candidates] == sorted(["rect", "sine"], key=lambda s: -whole[s].score)
+
+
+def test_shapes_are_named_only_by_their_registry():
+    # a new shape is one class in pulses (pulses.Pulse's notes): outside pulses/shapes.py no
+    # module of pulses or pipeline compares a value with a shape's name or writes a list of
+    # shapes by hand (a tuple, list, set or dict of two or more of their names or classes)
+    import ast
+    import pathlib
+
+    names = set(pulses.SHAPES)
+    classes = {cls.__name__ for cls in pulses.SHAPES.values()}
+
+    def named(node):
+        if isinstance(node, ast.Constant):
+            return node.value in names
+        return isinstance(node, (ast.Name, ast.Attribute)) and \
+            (getattr(node, "id", None) or getattr(node, "attr", None)) in classes
+
+    root = pathlib.Path(__file__).resolve().parents[1]
+    found = []
+    for package in ("pulses", "pipeline"):
+        for path in sorted((root / package).rglob("*.py")):
+            if path.relative_to(root).as_posix() in ("pulses/shapes.py", "pulses/__init__.py"):
+                continue  # the registry, and the lazy table naming the public classes
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Compare) and any(named(n) for n in (node.left, *node.comparators)):
+                    found.append(f"{path.name}:{node.lineno} compares with a shape")
+                items = node.elts if isinstance(node, (ast.Tuple, ast.List, ast.Set)) else \
+                    node.keys if isinstance(node, ast.Dict) else []
+                if sum(named(n) for n in items if n is not None) >= 2:
+                    found.append(f"{path.name}:{node.lineno} lists shapes by hand")
+    assert len(names) == 4 and not found, found

@@ -13,11 +13,9 @@ import math
 import threading
 import time
 
-from pulses.shapes import AntisymmetricRicker
-
 from . import memo, peer_inputs, site, vertical
 from ..reports.design_table import check_bin_words, check_reach_words
-from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
+from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key, shape_list
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
 class StageError(Exception):
@@ -165,9 +163,7 @@ RECORD_COLUMNS = Columns(
     ("pga_g", "g", "Peak absolute ground acceleration."),
     ("pgv_m_s", "m/s", "Peak absolute ground velocity (from the fitter, after its baseline correction)."),
     ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated."),
-    ("pulse_shape", "-", "Best-fitting pulse shape: `sine` (one-sine, Eq. 9), `ricker-sym` (symmetric "
-                         "Ricker, Eq. 7), `" + AntisymmetricRicker.shape + "` (antisymmetric Ricker, Eq. 8) or `rect` "
-                         "(rectangular)."),
+    ("pulse_shape", "-", f"Best-fitting pulse shape: {shape_list()}."),
     ("pulse_ap_g", "g", "Amplitude ap of the best-fitting pulse, signed by its polarity."),
     ("pulse_tp_s", "s", "Period Tp of the best-fitting pulse (for the Rickers, the period at the peak "
                         "of the Fourier amplitude)."),

@@ -60,7 +60,10 @@ def _your_pulse(args):
     if args.ap is None or args.tp is None:
         raise ArgumentError("--ap and --tp go together (your pulse's amplitude and period)")
     if args.pulse == "all":
-        raise ArgumentError("--ap/--tp need one pulse shape: --pulse sine, rect, ricker-sym or ricker-anti")
+        from pulses import SHAPES
+
+        names = list(SHAPES)
+        raise ArgumentError(f"--ap/--tp need one pulse shape: --pulse {', '.join(names[:-1])} or {names[-1]}")
     return args.pulse, parse_acceleration(args.ap, signed=False), parse_positive(args.tp, "--tp")
 
 

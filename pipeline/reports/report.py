@@ -20,11 +20,22 @@ import pathlib
 import stat
 import tempfile
 
-from pulses.shapes import AntisymmetricRicker, OneSine, Rectangular, SymmetricRicker
+from pulses.shapes import SHAPES
 from rocking.governing import FIT_TOLERANCE  # a shape "fits" a record: rocking.governing_pulse's rule
 
-#: shapes that get their own group of columns, in this order (``pulses.SHAPES`` names)
-SHAPE_NAMES = tuple(cls.shape for cls in (OneSine, SymmetricRicker, AntisymmetricRicker, Rectangular))
+#: shapes that get their own group of columns, in this order: every shape of ``pulses.SHAPES``, the
+#: realisable ones first (the registry's order kept within each group)
+SHAPE_NAMES = tuple(sorted(SHAPES, key=lambda shape: not SHAPES[shape].realisable))
+
+
+def shape_list() -> str:
+    """The shapes of :data:`SHAPE_NAMES` in words, for the columns' descriptions:
+    ``"`sine` (one-sine, Eq. 9), ... or `rect` (rectangular)"``."""
+    words = []
+    for name in SHAPE_NAMES:
+        cls = SHAPES[name]
+        words.append(f"`{name}` ({cls.label}{', ' + cls.equation if cls.equation else ''})")
+    return ", ".join(words[:-1]) + " or " + words[-1] if len(words) > 1 else words[0]
 
 
 GOVERNING_RULE = (
