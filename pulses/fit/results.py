@@ -92,7 +92,7 @@ class PulseFit:
     pga : float
         Peak ground acceleration of the record, m/s^2.
     pgv : float
-        Peak ground velocity, m/s, after the baseline correction of :mod:`pulses.baseline`.
+        Peak ground velocity, m/s, after the baseline correction of :mod:`pulses.fit.baseline`.
     duration : float
         Length of the record, s.
     significant_duration : float
