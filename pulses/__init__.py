@@ -1,5 +1,11 @@
 """Pulse shapes, accelerogram reading and pulse fitting (no dependency on ``rocking``).
 
+The rooms, from the ground up: units and errors; :mod:`pulses.formats` (what a file or a trace
+states, one module a format, registered once); the record type (:mod:`pulses.record`); the pulse
+shapes (:mod:`pulses.shapes`, one class a shape), pairs and triplets of components; and on them
+:mod:`pulses.io` (records from files and PEER downloads), :mod:`pulses.fit` (pulse fitting) and
+:mod:`pulses.velocity` (Shahi & Baker's classification).  No module imports one above it.
+
 Names are loaded from their modules on first use (PEP 562, :mod:`pulses.lazy`), so that
 ``import pulses`` costs almost nothing and a program pays for scipy, PyWavelets or obspy only
 when it reads records, fits pulses or classifies them.
