@@ -170,7 +170,8 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     # per record, so that memory stays flat over a long batch
     tasks, held = passes.first_pass(tasks, options)
     plan = passes.Plan(options, held)
-    texts, keys, todo = _reusable(tasks, journal, force, options, plan, held)
+    by_pair = pairs_in_passes(tasks, options)
+    texts, keys, todo = _reusable(tasks, journal, force, options, plan, by_pair)
     plan.sent(todo)
     failures: list[dict | None] = [None] * len(tasks)
     computed = set()  # the tasks computed (in any pass); the others were reused
@@ -195,7 +196,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     header = report.csv_text(FIELDS, [])
     stream = _serial([])
 
-    more = _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar)
+    more = _passes(plan, tasks, journal, keys, texts, options, by_pair, force, bar)
     try:
         staged = any(passes.staged(t, options) for t in tasks)
         todo = todo or (more() if staged else [])
@@ -232,7 +233,8 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
             say(f"pipeline run: note: {exc}")
     with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
         design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options, render)
-    journal.finish([t.record_id for t in tasks])
+    journal.finish([t.record_id for t in tasks],
+                   {p: [tasks[i].record_id for i in ix] for p, ix in by_pair.items()})
     n_failed = len(failures)
     n_reused = len(tasks) - len(computed)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
@@ -267,59 +269,84 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
         journal.drop(task.record_id)
     else:
         journal.add(task.record_id, keys[i], (header + texts[i]).encode("utf-8"),
-                    figure if options.plots and task.plot else None)
+                    figure if options.plots and task.plot else None,
+                    resume.form_text(task) if passes.staged(task, options) else None)
     if res["failure"]:
         f = res["failure"]
         say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
 
 
-def _variants(task, options):
-    """The forms of ``task`` whose kept report may stand for it: itself, and for a pair's
-    direction computed in passes, its checked forms (a later pass of an earlier run)."""
-    if not passes.staged(task, options):
-        return [task]
-    return [task] + [dataclasses.replace(task, check=True, plot=p) for p in (False, True) if p or not task.plot]
-
-
-def _reuse(t, journal, force, options, version):
-    """``(task form, key, rows text)`` of ``t``'s kept report, or ``(t, key, "")``."""
+def _reuse(t, journal, force, version):
+    """``(key, rows text)`` of ``t``'s kept report (made by this very form of ``t``), or ``(key, "")``."""
     key = resume.task_key(t, version)
-    if not force:
-        for v in _variants(t, options):
-            k = key if v is t else resume.task_key(v, version)
-            kept = journal.reusable(v, k, options.plots and v.plot)
-            if kept is not None:
-                return v, k, kept
-    return t, key, ""
+    kept = None if force else journal.reusable(t, key, t.options.plots and t.plot)
+    return key, kept or ""
 
 
-def _reusable(tasks, journal, force: bool, options, plan, held=()):
+def pairs_in_passes(tasks, options) -> dict:
+    """``{pair: [indices]}`` of the pairs computed in passes (pipeline.batch.passes)."""
+    out: dict = {}
+    for t in tasks:
+        if passes.staged(t, options):
+            out.setdefault(site.pair_of(t), []).append(t.index)
+    return out
+
+
+def _settled_pair(tasks, indices, journal, version):
+    """``{index: (task form, key, rows text)}`` of a pair whose passes an earlier run finished
+    (pipeline.batch.resume.Journal.settle), every direction's report kept in the form it was
+    made in; empty where any is not."""
+    pair = site.pair_of(tasks[indices[0]])
+    if journal.settled(pair) is None:
+        return {}
+    out = {}
+    for i in indices:
+        form = resume.with_form(tasks[i], journal.forms.get(tasks[i].record_id))
+        if form is None:
+            return {}
+        key, text = _reuse(form, journal, False, version)
+        if not text:
+            return {}
+        out[i] = (form, key, text)
+    if journal.pair_digest([tasks[i].record_id for i in indices]) != journal.settled(pair):
+        return {}
+    return out
+
+
+def _reusable(tasks, journal, force: bool, options, plan, by_pair):
     """``(texts, keys, todo)``: each task's rows as its kept report holds them ("" where it must be
     computed), its resume key, and the tasks to compute (their journal entries dropped).
-    ``tasks`` is updated with the form of each task that was kept; the ``held`` ones (indices)
-    are left to a later pass."""
+    ``tasks`` is updated with the form of each task that was kept: a pair whose passes an earlier
+    run finished is kept whole; the held directions of the others (``plan.held``, indices) are
+    left to a later pass."""
     texts: list[str] = [""] * len(tasks)
     version = resume.package_version()
     keys: list = [None] * len(tasks)
     todo = []
+    for indices in by_pair.values():
+        kept = {} if force else _settled_pair(tasks, indices, journal, version)
+        for i, (form, keys[i], texts[i]) in kept.items():
+            tasks[i] = form
+            plan.note(form, resume.rows_from_text(texts[i]))
+        plan.held -= set(kept)
     for t in list(tasks):
-        if t.index in held:
+        if t.index in plan.held or texts[t.index]:
             continue
-        v, keys[t.index], texts[t.index] = _reuse(t, journal, force, options, version)
+        keys[t.index], texts[t.index] = _reuse(t, journal, force, version)
         if texts[t.index]:
-            tasks[t.index] = v
-            plan.note(v, resume.rows_from_text(texts[t.index]))
+            plan.note(t, resume.rows_from_text(texts[t.index]))
         else:
             journal.drop(t.record_id)
             todo.append(t)
     return texts, keys, todo
 
 
-def _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar):
+def _passes(plan, tasks, journal, keys, texts, options, by_pair, force, bar):
     """The executor's ``more``: the tasks of the next pass (pipeline.batch.passes: a pair's
     directions, then its governing one checked, ...), counted on the progress bar."""
     def more():
-        later = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
+        later = _later_pass(plan, tasks, journal, keys, texts, options, force)
+        _settle(plan, tasks, journal, by_pair)
         if later and bar is not None:
             bar.total += len(later)
             bar.refresh()
@@ -327,7 +354,14 @@ def _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar):
     return more
 
 
-def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
+def _settle(plan, tasks, journal, by_pair) -> None:
+    """Note in the journal the pairs whose passes are done (a later run keeps them whole)."""
+    while plan.done:
+        pair = plan.done.pop()
+        journal.settle(pair, [tasks[i].record_id for i in by_pair.get(pair, ())])
+
+
+def _later_pass(plan, tasks, journal, keys, texts, options, force):
     """The tasks of the next pass (pipeline.batch.passes) that must be computed; those an earlier run
     kept are taken as they are."""
     version = resume.package_version()
