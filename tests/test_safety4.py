@@ -44,3 +44,58 @@ def test_reruns_and_resumes_of_a_pair_in_many_directions_give_the_same_files(tmp
         (out / resume.RESUME).write_text("".join(lines[:keep]))
         assert main(args) == 0
         assert tree(out) == first, keep
+
+
+# -- the resume key: the code, not only the version ---------------------------------------------------
+@pytest.mark.slow
+def test_a_change_of_the_code_or_its_settings_computes_the_records_again(tmp_path):
+    """An editable install whose search settings changed kept its earlier reports ("3 reused, 0
+    computed"): the key held only the version.  Here the packages are copied, run, a default of
+    the search changed in the copy's source, and run again: nothing is kept."""
+    import pathlib
+    import re
+    import shutil
+    import subprocess
+    import sys
+
+    import rocking
+
+    from .test_pipeline_run import BATCH_ARGS, write_good
+
+    root = pathlib.Path(rocking.__file__).resolve().parents[1]
+    code = tmp_path / "code"
+    for name in resume.CODE_PACKAGES:
+        shutil.copytree(root / name, code / name, ignore=shutil.ignore_patterns("__pycache__", "*.c"))
+    records = [str(write_good(tmp_path, k, duration=4.0)) for k in range(2)]
+    env = {**__import__("os").environ, "PYTHONPATH": str(code)}
+    cmd = [sys.executable, "-m", "pipeline", "run", *records, *[a for a in BATCH_ARGS if a != "--quiet"],
+           "--out", str(tmp_path / "out")]
+
+    def counts():
+        proc = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr
+        return re.search(r"\((\d+) reused from an earlier run, (\d+) computed\)", proc.stdout).groups()
+
+    assert counts() == ("0", "2")
+    assert counts() == ("2", "0")
+    search = code / "rocking" / "search.py"
+    text = search.read_text()
+    assert "\nDEFAULT_SETTINGS = SearchSettings()" in text
+    search.write_text(text.replace("\nDEFAULT_SETTINGS = SearchSettings()",
+                                   "\nDEFAULT_SETTINGS = SearchSettings()  # changed"))
+    assert counts() == ("0", "2")
+
+
+def test_the_code_digest_follows_every_code_file(tmp_path):
+    pkg = tmp_path / "pkg"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "a.py").write_text("x = 1\n")
+    (pkg / "sub" / "b.pyx").write_text("y = 2\n")
+    (pkg / "__pycache__").mkdir()
+    before = resume.source_digest([pkg])
+    (pkg / "__pycache__" / "a.pyc").write_bytes(b"cache")  # not code
+    (pkg / "notes.txt").write_text("not code")
+    assert resume.source_digest([pkg]) == before
+    (pkg / "sub" / "b.pyx").write_text("y = 3\n")
+    assert resume.source_digest([pkg]) != before
+    assert resume.code_version().startswith(resume.package_version() + "+")

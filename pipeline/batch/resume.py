@@ -2,7 +2,8 @@
 
 A record's report is kept when it was made from the same file content (sha256 of the bytes; both
 files of a pair), the same task (record id, path, columns, options, direction, scale ...) and the
-same package version.  These make the record's *key*.  After each record's report is written, a line
+same code: the package's version, a digest of its installed code files and its solver settings
+(:func:`code_version`).  These make the record's *key*.  After each record's report is written, a line
 ``<key>  <sha256 of the report>  <record id>`` is appended to :data:`RESUME` in the output folder;
 a later run keeps the record only if that line is there and the report (and its figure, with plots)
 still has the content recorded, so a report edited, removed or half-written by a killed run is
@@ -51,6 +52,50 @@ def package_version() -> str:
         if m:
             return m.group(1)
     return "unknown"
+
+
+#: the files of the package whose content is its code (what a record's result depends on): its
+#: sources, the compiled solver and data read at run time; caches and build products are not
+CODE_SUFFIXES = (".py", ".pyx", ".pxd", ".pxi", ".h", ".so", ".pyd", ".json", ".csv")
+#: the packages whose code computes a record
+CODE_PACKAGES = ("pulses", "rocking", "pipeline")
+
+
+def source_digest(roots) -> str:
+    """sha256 of every code file (:data:`CODE_SUFFIXES`) under the folders ``roots``, by path
+    relative to its root and content, in sorted order."""
+    h = hashlib.sha256()
+    for root in map(pathlib.Path, roots):
+        files = sorted(p for p in root.rglob("*") if p.suffix in CODE_SUFFIXES
+                       and "__pycache__" not in p.parts and p.is_file())
+        for p in files:
+            h.update(f"{root.name}/{p.relative_to(root).as_posix()}\0".encode("utf-8", "surrogateescape"))
+            with contextlib.suppress(OSError):
+                h.update(hashlib.sha256(p.read_bytes()).digest())
+    return h.hexdigest()
+
+
+@functools.lru_cache(maxsize=1)
+def _code_digest() -> str:
+    """:func:`source_digest` of the packages as imported (computed once a process: 10 ms)."""
+    import importlib.util
+
+    roots = []
+    for name in CODE_PACKAGES:
+        spec = importlib.util.find_spec(name)
+        if spec is not None and spec.submodule_search_locations:
+            roots += list(spec.submodule_search_locations)
+    return source_digest(roots)
+
+
+def code_version() -> str:
+    """What a record's result depends on besides its task and files: the package's version, its
+    code (:func:`source_digest` of the installed files: an editable install whose code or
+    defaults changed keeps no earlier report) and the solver's settings in this process."""
+    from rocking.search import DEFAULT_SETTINGS
+
+    settings = hashlib.sha256(repr(DEFAULT_SETTINGS).encode("utf-8")).hexdigest()[:16]
+    return f"{package_version()}+{_code_digest()[:32]}+{settings}"
 
 
 def file_digest(path) -> str | None:

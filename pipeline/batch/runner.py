@@ -320,7 +320,7 @@ def _reusable(tasks, journal, force: bool, options, plan, by_pair):
     run finished is kept whole; the held directions of the others (``plan.held``, indices) are
     left to a later pass."""
     texts: list[str] = [""] * len(tasks)
-    version = resume.package_version()
+    version = resume.code_version()
     keys: list = [None] * len(tasks)
     todo = []
     for indices in by_pair.values():
@@ -364,7 +364,7 @@ def _settle(plan, tasks, journal, by_pair) -> None:
 def _later_pass(plan, tasks, journal, keys, texts, options, force):
     """The tasks of the next pass (pipeline.batch.passes) that must be computed; those an earlier run
     kept are taken as they are."""
-    version = resume.package_version()
+    version = resume.code_version()
     todo = []
     while True:
         wanted = plan.next_pass(tasks)
