@@ -447,6 +447,8 @@ def run_plan(plan) -> DesignRun:
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
     from .batch.peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
+    if plan.dask:
+        _check_dask(plan.dask)
     paths, tasks, absent = _tasks(plan, say)
     # with no folder of the caller's, the runner's messages would name the private one: the table
     # is printed here instead
@@ -462,6 +464,22 @@ def run_plan(plan) -> DesignRun:
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
                      summary.n_failed, None if plan.out is None else summary.out)
+
+
+def _check_dask(address) -> None:
+    """``--dask``: dask.distributed installed and, for a scheduler's address, a scheduler there
+    (:func:`pipeline.batch.scheduler.check_address`): an argument error before any work."""
+    import importlib.util
+
+    if not isinstance(address, str):
+        raise TypeError(f"dask: expected 'local' or a scheduler address such as 'tcp://HOST:8786', "
+                        f"got {type(address).__name__}")
+    if importlib.util.find_spec("distributed") is None:
+        raise ArgumentError("--dask needs dask.distributed: pip install 'rocking-columns[dask]'")
+    if address != "local":
+        from .batch.scheduler import check_address
+
+        check_address(address)
 
 
 @contextlib.contextmanager

@@ -99,3 +99,131 @@ def test_the_code_digest_follows_every_code_file(tmp_path):
     (pkg / "sub" / "b.pyx").write_text("y = 3\n")
     assert resume.source_digest([pkg]) != before
     assert resume.code_version().startswith(resume.package_version() + "+")
+
+
+# -- --dask at something that is no scheduler, or a scheduler that dies -------------------------------
+@pytest.fixture
+def not_schedulers():
+    """``(banner port, HTTP port, refused port)`` on this host: a server that greets first (as SSH
+    does), an HTTP server (the dashboard's port given by mistake), and a port nothing listens on."""
+    import http.server
+    import socket
+    import threading
+
+    def banner(sock):
+        while True:
+            try:
+                conn, _ = sock.accept()
+            except OSError:
+                return
+            conn.sendall(b"SSH-2.0-OpenSSH_9.6\r\n")
+            threading.Timer(10.0, conn.close).start()
+
+    ssh = socket.socket()
+    ssh.bind(("127.0.0.1", 0))
+    ssh.listen()
+    threading.Thread(target=banner, args=(ssh,), daemon=True).start()
+    web = http.server.HTTPServer(("127.0.0.1", 0), http.server.BaseHTTPRequestHandler)
+    threading.Thread(target=web.serve_forever, daemon=True).start()
+    free = socket.socket()
+    free.bind(("127.0.0.1", 0))
+    refused = free.getsockname()[1]
+    free.close()
+    yield ssh.getsockname()[1], web.server_address[1], refused
+    web.shutdown()
+    ssh.close()
+
+
+def test_dask_at_what_is_no_scheduler_is_one_line_and_status_2_at_once(not_schedulers, tmp_path, capsys,
+                                                                         monkeypatch):
+    """A banner gave numpy's "Unable to allocate 2.82 EiB" traceback (status 1), an HTTP server
+    hung for more than 120 s, a refused port took 20 s: each is now one line, exit status 2, before
+    anything is read or written."""
+    import time
+
+    pytest.importorskip("dask.distributed")
+    from pipeline.batch import scheduler
+
+    monkeypatch.setattr(scheduler, "PROBE_S", 1.0)  # how long a silent server is given
+    ssh, web, refused = not_schedulers
+    from .test_pipeline_run import write_good
+
+    record = write_good(tmp_path, 0, duration=2.0)  # never read: the error comes first
+    for port, words in ((ssh, "it greeted with b'SSH-2.0-'"), (web, "it sent nothing within 1 s"),
+                        (refused, "nothing listens there (connection refused)")):
+        start = time.monotonic()
+        code = main(["run", str(record), "--block", "7.5x1.8", "--out", str(tmp_path / "out"),
+                     "--dask", f"tcp://127.0.0.1:{port}"])
+        err = capsys.readouterr().err
+        assert code == 2 and time.monotonic() - start < 3.0
+        assert len(err.strip().splitlines()) == 1 and words in err, err
+        assert not (tmp_path / "out").exists()
+    with pytest.raises(ValueError, match="nothing listens there"):
+        import pipeline
+
+        pipeline.design([record], blocks="7.5x1.8", dask=f"tcp://127.0.0.1:{refused}")
+
+
+@pytest.mark.slow
+def test_a_scheduler_killed_mid_run_ends_it_with_its_reports_and_a_resume_finishes(tmp_path, capsys,
+                                                                                     monkeypatch):
+    """Six pairs on a cluster killed ten seconds in: the client gave up after 20 s, then the run
+    sat idle until killed, with no design.csv, failures.csv or report.  Now it ends once the
+    client gives up (its reconnection timeout, shortened here), with every report written and the
+    tasks not computed in failures.csv (stage `cluster`, exit status 1); run again without dask, the
+    batch is finished and every file is a clean run's."""
+    import re
+    import signal
+    import subprocess
+    import sys
+    import threading
+    import time
+
+    pytest.importorskip("dask.distributed")
+    from pipeline.batch import scheduler
+
+    from .test_pipeline_run import read_csv
+    from .test_site import _pair
+
+    pair = _pair(tmp_path, "STK", 0.45, 0.3, 1)
+    args = ["run", "--pair", *map(str, pair), "--directions", "18", "--block", "2x0.35", "--no-plots"]
+    assert main([*args, "--out", str(tmp_path / "clean")]) == 0
+    sched = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                              "--port", "0", "--no-dashboard"], stderr=subprocess.PIPE, text=True)
+    workers = None
+    try:
+        for line in sched.stderr:
+            m = re.search(r"Scheduler at:\s+(tcp://\S+)", line)
+            if m:
+                break
+        address = m.group(1)
+        workers = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
+                                    "--nthreads", "1", "--no-dashboard"],
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        out = tmp_path / "out"
+        killed = []
+
+        def kill_when_some_are_done():
+            while len(list(out.glob("*deg.csv"))) < 4:
+                time.sleep(0.02)
+            sched.send_signal(signal.SIGKILL)
+            killed.append(time.monotonic())
+
+        threading.Thread(target=kill_when_some_are_done, daemon=True).start()
+        monkeypatch.setattr(scheduler, "CONNECT_TIMEOUT", "3s")
+        capsys.readouterr()
+        code = main([*args, "--out", str(out), "--dask", address])
+        ended = time.monotonic()
+    finally:
+        for proc in (workers, sched):
+            if proc is not None:
+                proc.kill()
+                proc.wait(timeout=30)
+    assert killed and code == 1
+    assert ended - killed[0] < 30.0  # the client's 3 s, and the reports
+    assert "not computed, listed in failures.csv" in capsys.readouterr().err
+    fails = read_csv(out / "failures.csv")
+    assert fails and {f["stage"] for f in fails} == {"cluster"}
+    assert (out / "design.csv").is_file() and (out / "report.html").is_file()
+    assert main([*args, "--out", str(out)]) == 0
+    assert tree(out) == tree(tmp_path / "clean")

@@ -242,21 +242,35 @@ def dask_client(address: str, jobs: int | None):
             cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1,
                                    processes=True, dashboard_address=None, silence_logs=logging.ERROR)
         return Client(cluster), cluster
+    from .scheduler import CONNECT_TIMEOUT
+
+    # what is no scheduler was refused before the run (pipeline.batch.scheduler.check_address)
     try:
-        return Client(address, timeout="20s"), None
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise ArgumentError(f"--dask: cannot connect to the scheduler at {address!r}: {exc}") from None
+        return Client(address, timeout=CONNECT_TIMEOUT), None
+    except Exception as exc:  # what a client raises for a scheduler it cannot talk to varies
+        raise ArgumentError(f"--dask {address}: cannot connect to the scheduler: "
+                            f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
 
 
 def _dask(tasks, address, jobs, more=None):
     from .remote import run_dask
+    from .scheduler import ClusterLost, Watch
 
-    client, cluster = dask_client(address, jobs)
     try:
-        client.run(init_worker)
-        workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
+        client, cluster = dask_client(address, jobs)
+    except ArgumentError as exc:  # checked before the run: the scheduler went away since
+        if address == "local":
+            raise
+        raise ClusterLost(str(exc)) from None
+    watch = Watch(client, address, cluster is not None)
+    try:
+        try:
+            client.run(init_worker)
+            workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
+        except Exception as exc:
+            raise watch.lost() from exc
         while tasks:
-            yield from run_dask(tasks, client, workers, more)
+            yield from run_dask(tasks, client, workers, more, watch)
             tasks = more() if more is not None else []
     finally:
         client.close()

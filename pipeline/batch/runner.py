@@ -22,6 +22,7 @@ from ..args import ArgumentError, output_folder
 from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from . import executors
 from .executors import _serial, execute
+from .scheduler import ClusterLost
 from .worker import TEST_KILL_ENV, TEXT  # noqa: F401 (tests set TEST_KILL_ENV through the runner)
 from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
 
@@ -202,12 +203,15 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         todo = todo or (more() if staged else [])
         # one executor for every pass: its workers started once
         stream = execute(todo, jobs=jobs, dask=dask, more=more if staged else None)
-        for res in stream:
-            computed.add(res["index"])
-            _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
-            log.record(res, tasks[res["index"]].record_id)
-            if bar is not None:
-                bar.update(1)
+        try:
+            for res in stream:
+                computed.add(res["index"])
+                _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
+                log.record(res, tasks[res["index"]].record_id)
+                if bar is not None:
+                    bar.update(1)
+        except ClusterLost as exc:  # the reports are written all the same, the rest listed
+            _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, say)
         stream.close()
     finally:
         with interrupts.deferred():
@@ -253,6 +257,25 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         print(design_table.table_text(design, failures, rows), end="")
         print(f"{msg}; reports in {report.display(out)}")
     return summary
+
+
+def _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, say) -> None:
+    """Every task without a result when the dask cluster was lost (``exc``): a failure of stage
+    ``cluster``, its report of an earlier run removed; a later run computes them."""
+    reason = ClusterLost(f"{exc}; not computed: run the same command again to finish the batch")
+    left = [t for t in tasks if not texts[t.index] and failures[t.index] is None]
+    for t in left:
+        computed.add(t.index)
+        failures[t.index] = failure(t, "cluster", reason)
+        journal.drop(t.record_id)
+        for name in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id),
+                     report.record_widths_plot_name(t.record_id)):
+            with contextlib.suppress(OSError, report.NotOurs):
+                if outputs.owned(name):
+                    outputs.remove(name)
+        log.record({"failure": failures[t.index]}, t.record_id)
+    say(f"pipeline run: {exc}: {len(left)} task(s) not computed, listed in failures.csv; run the "
+        "same command again to finish the batch")
 
 
 def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say) -> None:
