@@ -227,3 +227,69 @@ def test_a_scheduler_killed_mid_run_ends_it_with_its_reports_and_a_resume_finish
     assert (out / "design.csv").is_file() and (out / "report.html").is_file()
     assert main([*args, "--out", str(out)]) == 0
     assert tree(out) == tree(tmp_path / "clean")
+
+
+# -- workers end with the main process ----------------------------------------------------------------
+def _descendants(pid) -> set:
+    """The processes below ``pid`` (Linux /proc), children of children included."""
+    import glob
+
+    out, todo = set(), [pid]
+    while todo:
+        p = todo.pop()
+        for path in glob.glob(f"/proc/{p}/task/*/children"):
+            try:
+                with open(path) as fh:
+                    kids = {int(k) for k in fh.read().split()}
+            except OSError:
+                continue
+            todo += list(kids - out)
+            out |= kids
+    return out
+
+
+def _alive(pid) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] not in (b"Z", b"X")
+    except (OSError, IndexError):
+        return False
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not __import__("os").path.isdir("/proc/self/task"), reason="needs Linux's /proc")
+@pytest.mark.parametrize("how", [["--jobs", "2"], ["--dask", "local", "--jobs", "2"]], ids=["pool", "dask"])
+def test_workers_fork_server_and_resource_tracker_end_when_the_main_process_is_killed(how, tmp_path):
+    """SIGKILL of `pipeline run --jobs 2` (as an out-of-memory killer does) left the fork server,
+    the resource tracker and both workers alive and idle 300 s later (about 500 MB)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from .test_pipeline_run import BATCH_ARGS, write_good
+
+    if "--dask" in how:
+        pytest.importorskip("dask.distributed")
+    records = [str(write_good(tmp_path, k, duration=30.0)) for k in range(8)]
+    proc = subprocess.Popen([sys.executable, "-m", "pipeline", "run", *records, *BATCH_ARGS, *how,
+                             "--out", str(tmp_path / "out")],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    below = set()
+    while time.monotonic() < deadline and proc.poll() is None:
+        below |= _descendants(proc.pid)
+        if len(below) >= 3 and list((tmp_path / "out").glob("good*.csv")):  # workers at work
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the batch ended before it could be killed"
+    below |= _descendants(proc.pid)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and any(map(_alive, below)):
+        time.sleep(0.1)
+    left = [p for p in below if _alive(p)]
+    for p in left:  # not to leave them behind whatever the outcome
+        __import__("os").kill(p, signal.SIGKILL)
+    assert not left

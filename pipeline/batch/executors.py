@@ -12,6 +12,7 @@ import os
 from .. import interrupts
 from ..args import ArgumentError
 from . import memo, worker
+from .lifeline import lifeline
 from ..reports.figures import draw
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, work_many, worker_failure
 
@@ -70,7 +71,7 @@ def _pool(tasks, jobs, more=None):
     finished = False
     def new_pool():
         return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
-                                   initargs=(os.environ.get(TEST_KILL_ENV),))
+                                   initargs=(os.environ.get(TEST_KILL_ENV), lifeline()))
 
     try:
         while queue or suspects or _refill(queue, more):
@@ -313,7 +314,7 @@ def renderer(away: bool):
             methods = multiprocessing.get_all_start_methods()
             ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
             pool = ProcessPoolExecutor(1, mp_context=ctx, initializer=_init_pool_worker,
-                                       initargs=(None,))
+                                       initargs=(None, lifeline()))
         fut = pool.submit(draw, name, *args)
         while True:  # a short wait, so that Ctrl-C stops the run
             try:

@@ -243,15 +243,23 @@ def _map_pairs(args, jobs):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
+    from .lifeline import lifeline
+
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_ignore_interrupts) as pool:
+    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_ignore_interrupts,
+                             initargs=(lifeline(),)) as pool:
         return list(pool.map(_prepare_packed, args, chunksize=max(1, len(args) // (4 * jobs))))
 
 
-def _ignore_interrupts() -> None:
-    """Ctrl-C left to the main process (a worker interrupted on its own would print a traceback)."""
+def _ignore_interrupts(line=None) -> None:
+    """Ctrl-C left to the main process (a worker interrupted on its own would print a traceback);
+    the worker ends when the main process does (``line``, :mod:`pipeline.batch.lifeline`)."""
     import signal
+
+    from .lifeline import hold
+
+    hold(line)
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 

@@ -20,12 +20,17 @@ def init_worker() -> None:
     lanes.set_threads(1)
 
 
-def _init_pool_worker(kill_at: str | None = None) -> None:
+def _init_pool_worker(kill_at: str | None = None, line=None) -> None:
     """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
     the workers itself (a worker interrupted on its own would only print a traceback).
     ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
-    the workers may have been started before it was set)."""
+    the workers may have been started before it was set).  ``line``: the main process's
+    :func:`pipeline.batch.lifeline.lifeline`; the worker ends when the main process does."""
     import signal
+
+    from .lifeline import hold
+
+    hold(line)
 
     if kill_at is None:
         os.environ.pop(TEST_KILL_ENV, None)
