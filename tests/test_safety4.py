@@ -293,3 +293,18 @@ def test_workers_fork_server_and_resource_tracker_end_when_the_main_process_is_k
     for p in left:  # not to leave them behind whatever the outcome
         __import__("os").kill(p, signal.SIGKILL)
     assert not left
+
+
+# -- pulses.Record: one component ----------------------------------------------------------------------
+@pytest.mark.parametrize("shape", [(2, 500), (500, 2), (500, 1), ()])
+def test_a_record_of_an_array_not_one_dimensional_is_refused(shape):
+    """(2, N) became the two components end to end (twice the duration) and (N, 2) interleaved,
+    each designed as one record."""
+    import numpy as np
+
+    import pulses
+
+    acc = np.ones(shape) if shape else np.float64(1.0)
+    with pytest.raises(ValueError, match=r"one-dimensional.*shape"):
+        pulses.Record(acc, 0.01)
+    assert pulses.Record(np.ones(500), 0.01).duration == pytest.approx(4.99)
