@@ -309,7 +309,25 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     TypeError
         An argument of a type not accepted (the message names the accepted forms).
     ValueError
-        A value out of range (a negative height, an unknown shape ...).
+        A value out of range (a negative height, an unknown shape ...), refused with the words
+        ``pipeline run`` uses for it.
+    RuntimeError
+        ``jobs > 1`` (or ``dask="local"``) called at the top level of a script without the
+        ``if __name__ == "__main__":`` guard: the worker processes import the script again,
+        and would run the call again (see Notes).
+
+    Notes
+    -----
+    With ``jobs > 1`` the records go to worker processes that import the calling script again;
+    a script's work belongs under the guard::
+
+        import pipeline
+
+        if __name__ == "__main__":
+            run = pipeline.design("records/", blocks="7.5x1.8", jobs=2)
+            print(run.design)
+
+    In a notebook or an interactive session nothing is needed.
 
     Examples
     --------
@@ -449,6 +467,10 @@ def run_plan(plan) -> DesignRun:
 
     if plan.dask:
         _check_dask(plan.dask)
+    if plan.jobs > 1 or plan.dask == "local":  # worker processes, which import the script again
+        from .batch import mainguard
+
+        mainguard.check("dask='local'" if plan.dask == "local" else f"jobs={plan.jobs}")
     paths, tasks, absent = _tasks(plan, say)
     # with no folder of the caller's, the runner's messages would name the private one: the table
     # is printed here instead

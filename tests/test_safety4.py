@@ -308,3 +308,49 @@ def test_a_record_of_an_array_not_one_dimensional_is_refused(shape):
     with pytest.raises(ValueError, match=r"one-dimensional.*shape"):
         pulses.Record(acc, 0.01)
     assert pulses.Record(np.ones(500), 0.01).duration == pytest.approx(4.99)
+
+
+# -- jobs > 1 from a script: the guard -------------------------------------------------------------------
+_SCRIPT = """\
+import sys
+print("top level", flush=True)
+import pipeline
+
+def work():
+    run = pipeline.design(sys.argv[1:], blocks="7.5x1.8", shapes="sine", jobs=2)
+    print("failed", len(run.failures), flush=True)
+
+{call}
+"""
+
+
+@pytest.mark.slow
+def test_jobs_from_a_script_without_the_guard_fails_at_once_naming_it(tmp_path):
+    """Every record failed with "A process in the process pool was terminated abruptly", and each
+    worker ran the script's top level again.  Now the call fails before any process starts, with
+    the guard in the message; under the guard (or in a function it calls) the batch runs."""
+    import subprocess
+    import sys
+
+    from .test_pipeline_run import write_good
+
+    records = [str(write_good(tmp_path, k, duration=3.0)) for k in range(2)]
+    for call, guarded in (("work()", False), ('if __name__ == "__main__":\n    work()', True)):
+        script = tmp_path / "batch.py"
+        script.write_text(_SCRIPT.format(call=call))
+        proc = subprocess.run([sys.executable, str(script), *records], capture_output=True, text=True,
+                              cwd=tmp_path, timeout=300)
+        if guarded:  # (the workers import the script, so its first line runs in each)
+            assert proc.returncode == 0 and "failed 0" in proc.stdout, proc.stderr
+        else:
+            assert proc.stdout.count("top level") == 1, proc.stdout  # no worker was started
+            assert proc.returncode == 1 and "failed" not in proc.stdout
+            assert 'RuntimeError: jobs=2 starts worker processes' in proc.stderr
+            assert 'if __name__ == "__main__":' in proc.stderr and "line 9" in proc.stderr
+
+
+def test_the_guard_is_found_in_either_spelling():
+    from pipeline.batch.mainguard import guarded_lines
+
+    source = "a = 1\nif '__main__' == __name__:\n    b = 2\n    c = 3\nif __name__ == 'x':\n    d = 4\n"
+    assert guarded_lines(source) == [(3, 4)]
