@@ -459,7 +459,15 @@ def _tasks(plan, say):
 
 
 def run_plan(plan) -> DesignRun:
-    """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments)."""
+    """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments);
+    with ``quiet``, no warning is printed meanwhile, here or in the workers."""
+    from .batch.worker import quieted
+
+    with quieted(plan.quiet):
+        return _run_plan(plan)
+
+
+def _run_plan(plan) -> DesignRun:
     from .batch.runner import run
 
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
@@ -467,7 +475,7 @@ def run_plan(plan) -> DesignRun:
 
     if plan.dask:
         _check_dask(plan.dask)
-    if plan.jobs > 1 or plan.dask == "local":  # worker processes, which import the script again
+    if (plan.jobs or 1) > 1 or plan.dask == "local":  # worker processes, which import the script again
         from .batch import mainguard
 
         mainguard.check("dask='local'" if plan.dask == "local" else f"jobs={plan.jobs}")

@@ -354,3 +354,28 @@ def test_the_guard_is_found_in_either_spelling():
 
     source = "a = 1\nif '__main__' == __name__:\n    b = 2\n    c = 3\nif __name__ == 'x':\n    d = 4\n"
     assert guarded_lines(source) == [(3, 4)]
+
+
+# -- the smaller items ----------------------------------------------------------------------------------
+@pytest.mark.slow
+@pytest.mark.parametrize("extra", [[], ["--jobs", "2"]], ids=["one", "pool"])
+def test_quiet_silences_warnings_here_and_in_the_workers(extra, tmp_path):
+    """-q printed obspy's warning on a SAC file's sample spacing and numpy's overflow for
+    --limit 1e-320 (what a record's reading warns of that matters is in its rows)."""
+    import subprocess
+    import sys
+
+    import pulses
+    from pulses.synthetic import synthetic_record
+
+    paths = []
+    for k in range(2):  # sampled at 300 Hz: obspy warns that it rounds the spacing
+        r = synthetic_record("sine", 0.5 * pulses.G, 1.0, 2.0, 4.0, dt=1 / 300, noise=0.1, seed=k)
+        paths.append(str(tmp_path / f"odd{k}.sac"))
+        pulses.write_sac(pulses.Record(r.acc, 1 / 300, f"odd{k}"), paths[-1])
+    cmd = [sys.executable, "-m", "pipeline", "run", *paths, "--block", "7.5x1.8", "--shapes", "sine",
+           "--no-plots", "--limit", "1e-320", *extra, "--out", str(tmp_path / "out")]
+    loud = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path)
+    assert loud.returncode == 0 and "Warning" in loud.stderr  # the warnings this is about
+    quiet = subprocess.run([*cmd, "-q", "--force"], capture_output=True, text=True, cwd=tmp_path)
+    assert quiet.returncode == 0 and quiet.stderr == "" and quiet.stdout == ""

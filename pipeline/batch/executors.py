@@ -71,7 +71,7 @@ def _pool(tasks, jobs, more=None):
     finished = False
     def new_pool():
         return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
-                                   initargs=(os.environ.get(TEST_KILL_ENV), lifeline()))
+                                   initargs=(os.environ.get(TEST_KILL_ENV), lifeline(), worker.quiet_now()))
 
     try:
         while queue or suspects or _refill(queue, more):
@@ -266,7 +266,7 @@ def _dask(tasks, address, jobs, more=None):
     watch = Watch(client, address, cluster is not None)
     try:
         try:
-            client.run(init_worker)
+            client.run(init_worker, cluster is not None and worker.quiet_now())
             workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
         except Exception as exc:
             raise watch.lost() from exc
@@ -314,7 +314,7 @@ def renderer(away: bool):
             methods = multiprocessing.get_all_start_methods()
             ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
             pool = ProcessPoolExecutor(1, mp_context=ctx, initializer=_init_pool_worker,
-                                       initargs=(None, lifeline()))
+                                       initargs=(None, lifeline(), worker.quiet_now()))
         fut = pool.submit(draw, name, *args)
         while True:  # a short wait, so that Ctrl-C stops the run
             try:

@@ -42,6 +42,9 @@ def unguarded_call() -> tuple[str, int] | None:
 
     main = sys.modules.get("__main__")
     path = getattr(main, "__file__", None)
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    if name is not None and (name == "__main__" or name.endswith(".__main__")):
+        return None  # a package's __main__ (python -m pipeline): multiprocessing leaves it out
     if not path or not str(path).endswith(".py"):
         return None
     frame, top = inspect.currentframe(), None

@@ -244,22 +244,27 @@ def _map_pairs(args, jobs):
     from concurrent.futures import ProcessPoolExecutor
 
     from .lifeline import lifeline
+    from .worker import quiet_now
 
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_ignore_interrupts,
-                             initargs=(lifeline(),)) as pool:
+                             initargs=(lifeline(), quiet_now())) as pool:
         return list(pool.map(_prepare_packed, args, chunksize=max(1, len(args) // (4 * jobs))))
 
 
-def _ignore_interrupts(line=None) -> None:
+def _ignore_interrupts(line=None, quiet: bool = False) -> None:
     """Ctrl-C left to the main process (a worker interrupted on its own would print a traceback);
-    the worker ends when the main process does (``line``, :mod:`pipeline.batch.lifeline`)."""
+    the worker ends when the main process does (``line``, :mod:`pipeline.batch.lifeline`);
+    ``quiet``: no warning printed (pipeline.batch.worker.quieted)."""
     import signal
+    import warnings
 
     from .lifeline import hold
 
     hold(line)
+    if quiet:
+        warnings.simplefilter("ignore")
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 

@@ -3,6 +3,7 @@ process, a pool's process or a dask worker) runs it, with the time it took and w
 """
 from __future__ import annotations
 
+import contextlib
 import os
 
 from . import joblog, memo
@@ -10,22 +11,65 @@ from .record import FIELDS, failure, process_record
 from .tasks import Task
 
 
-def init_worker() -> None:
+def init_worker(quiet: bool = False) -> None:
     """Set up a worker process: one solver thread (the processes share the CPUs; the solver's
-    batches then run on one thread, with the same runs and the same results)."""
+    batches then run on one thread, with the same runs and the same results); ``quiet``: no
+    warning printed (``--quiet``: what a record's reading warns of is in its rows)."""
     global _in_worker
     _in_worker = True
     from rocking import lanes
 
     lanes.set_threads(1)
+    if quiet:
+        import warnings
+
+        warnings.simplefilter("ignore")
 
 
-def _init_pool_worker(kill_at: str | None = None, line=None) -> None:
+#: whether this process runs a quiet batch now (:func:`quieted`): the workers it starts are quiet too
+_quiet = False
+
+
+@contextlib.contextmanager
+def quieted(quiet: bool):
+    """A batch with ``--quiet`` (``pipeline.design(quiet=True)``): no warning printed in this
+    process while it runs (obspy's, numpy's; a record's own are in its rows' ``warnings``), nor
+    in the worker processes it starts (:func:`quiet_now`, their initializers' argument), nor the
+    log lines of a local dask cluster's client."""
+    global _quiet
+    if not quiet:
+        yield
+        return
+    import logging
+    import warnings
+
+    before, _quiet = _quiet, True
+    loggers = [logging.getLogger(n) for n in ("distributed", "distributed.client")]
+    levels = [lg.level for lg in loggers]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for lg in loggers:
+                lg.setLevel(logging.CRITICAL + 1)
+            yield
+    finally:
+        _quiet = before
+        for lg, level in zip(loggers, levels):
+            lg.setLevel(level)
+
+
+def quiet_now() -> bool:
+    """Whether the workers started now should print no warning (:func:`quieted`)."""
+    return _quiet
+
+
+def _init_pool_worker(kill_at: str | None = None, line=None, quiet: bool = False) -> None:
     """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
     the workers itself (a worker interrupted on its own would only print a traceback).
     ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
     the workers may have been started before it was set).  ``line``: the main process's
-    :func:`pipeline.batch.lifeline.lifeline`; the worker ends when the main process does."""
+    :func:`pipeline.batch.lifeline.lifeline`; the worker ends when the main process does.
+    ``quiet``: :func:`quiet_now` in the main process."""
     import signal
 
     from .lifeline import hold
@@ -38,7 +82,7 @@ def _init_pool_worker(kill_at: str | None = None, line=None) -> None:
         os.environ[TEST_KILL_ENV] = kill_at
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    init_worker()
+    init_worker(quiet)
 
 
 #: test-only: a record id at which a worker process (never the main one) kills itself with SIGKILL,
