@@ -379,3 +379,82 @@ def test_quiet_silences_warnings_here_and_in_the_workers(extra, tmp_path):
     assert loud.returncode == 0 and "Warning" in loud.stderr  # the warnings this is about
     quiet = subprocess.run([*cmd, "-q", "--force"], capture_output=True, text=True, cwd=tmp_path)
     assert quiet.returncode == 0 and quiet.stderr == "" and quiet.stdout == ""
+
+
+# -- pipeline.design() follows pipeline run's rules ------------------------------------------------------
+@pytest.mark.parametrize("kw, argv, words", [
+    (dict(up_to=0.5), ["--up-to", "0.5"], "must lie between 1 and 1000"),
+    (dict(up_to=5000), ["--up-to", "5000"], "must lie between 1 and 1000"),
+    (dict(up_to=-2.0), ["--up-to=-2"], "must lie between 1 and 1000"),
+    (dict(cap_mass_ratio=5000), ["--cap-mass-ratio", "5000"], "must be a number between 0 and 1000"),
+    (dict(cap_mass_ratio=-1), ["--cap-mass-ratio=-1"], "must be a number between 0 and 1000"),
+    (dict(dt=-0.01), ["--dt=-0.01"], "(s) must be a positive finite number"),
+    (dict(dt=5), ["--dt", "5"], "(s) must lie between 1e-05 s and 1 s"),
+    (dict(limit=1.5), ["--limit", "1.5"], "(max|theta|/alpha) must be a number in (0, 1]"),
+    (dict(limit=0.0), ["--limit", "0"], "(max|theta|/alpha) must be a number in (0, 1]"),
+    # argparse took -inf for an option: "expected one argument"
+    (dict(limit=float("-inf")), ["--limit", "-inf"], "(max|theta|/alpha) must be a number in (0, 1]"),
+    (dict(up_to=-1e5), ["--up-to", "-1e5"], "must lie between 1 and 1000"),
+    (dict(directions=-1), ["--directions=-1"], "must be 0 to 180"),
+    (dict(directions=500), ["--directions", "500"], "must be 0 to 180"),
+    (dict(scale=1e6), ["--scale", "1e6"], "must lie between 0.001 and 1000"),
+    (dict(jobs=-1), ["--jobs=-1"], "must be 0 (one per CPU) to 256"),
+    (dict(column=0), ["--column", "0"], "counts from 1"),
+])
+def test_design_refuses_what_pipeline_run_refuses_in_the_same_words(kw, argv, words, tmp_path, capsys):
+    """up_to 0.5 or 5000 and cap_mass_ratio 5000 passed where the command line refuses them;
+    negative up_to, cap_mass_ratio or dt became failed rows instead of a ValueError."""
+    import pipeline
+
+    from .test_pipeline_run import write_good
+
+    record = write_good(tmp_path, 0, duration=2.0)
+    with pytest.raises(ValueError) as info:
+        pipeline.design([record], blocks="7.5x1.8", out=tmp_path / "py", **kw)
+    assert words in str(info.value) and str(info.value).startswith(next(iter(kw)))
+    assert main(["run", str(record), "--block", "7.5x1.8", "--out", str(tmp_path / "cli"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "py").exists() and not (tmp_path / "cli").exists()
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(force="no"), "force: expected True or False"), (dict(fragility="no"), "fragility: expected True or False"),
+    (dict(quiet="no"), "quiet: expected True or False"), (dict(thorough=1), "thorough: expected True or False"),
+    (dict(plots=1), "plots: expected True, False, None or one of"), (dict(glob=5), "glob: expected text"),
+    (dict(directions=2.0), "directions: expected a whole number"), (dict(jobs=True), "jobs: expected a whole number"),
+])
+def test_design_takes_booleans_only_as_booleans(kw, words, tmp_path):
+    """plots="none", force="no", fragility="no" and quiet="no" all meant True; glob=5 raised a raw
+    TypeError."""
+    import pipeline
+
+    with pytest.raises(TypeError, match=__import__("re").escape(words)):
+        pipeline.design([tmp_path / "a.sac"], blocks="7.5x1.8", **kw)
+    with pytest.raises(ValueError, match="'governing', 'all', 'none'"):
+        pipeline.design([tmp_path / "a.sac"], blocks="7.5x1.8", plots="no")
+
+
+def test_design_takes_thorough_plots_all_or_none_and_numpy_integers(tmp_path):
+    """design() had no thorough and no plots="all", and refused np.int64 for directions and jobs."""
+    import numpy as np
+
+    import pipeline
+    from pipeline import api
+    from pipeline.cli import build_parser
+    from pipeline.commands import run as run_command
+
+    from .test_pipeline_run import write_good
+
+    for plots, cli in (("all", ["--plots", "all"]), ("none", ["--no-plots"]), ("governing", []), (False, ["--no-plots"])):
+        plan = api._plan([tmp_path / "a.sac"], blocks="7.5x1.8", heights=None, pairs=None, directions=np.int64(3),
+                         vertical="auto", limit=None, jobs=np.int64(1), out=None, shapes=None,
+                         weighting="background", units=None, dt=None, scale=None, plots=plots, force=False,
+                         quiet=True, thorough=True)
+        args = build_parser().parse_args(["run", "a.sac", "--block", "7.5x1.8", "--thorough", *cli])
+        assert plan.options == run_command.options_from(args, **{k: getattr(plan.options, k) for k in (
+            "shapes", "weighting", "vertical", "cap_mass_ratio", "fragility", "up_to", "limit")})
+        assert plan.directions == "3" and plan.jobs == 1
+    record = write_good(tmp_path, 0, duration=2.0)
+    run = pipeline.design([record], blocks="7.5x1.8", shapes="sine", directions=np.int64(0), jobs=np.int64(1))
+    assert run.exit_code == 0 and len(run.design) == 1

@@ -20,13 +20,11 @@ import sys
 from . import peer_inputs
 
 from ..reports import pulse_row
-from ..args import ArgumentError, pair_files, parse_scale
+from ..args import MAX_DIRECTIONS, ArgumentError, pair_files, parse_directions, parse_scale  # noqa: F401 (MAX_DIRECTIONS: also here)
 from .tasks import Task, make_tasks, record_ids
 
 #: directions closer than this (deg, modulo 180) are one direction
 ANGLE_TOL_DEG = 1e-6
-#: most evenly spaced directions accepted (``--directions``): 1 deg apart
-MAX_DIRECTIONS = 180
 
 
 
@@ -65,12 +63,7 @@ def _file_tasks(args, paths, columns, options):
 
 def settings_from_args(args):
     """``(directions N, --scale factor, --scales table or None)``, checked."""
-    try:
-        n = int(str(args.directions))
-    except ValueError:
-        raise SiteError(f"--directions expects a whole number, got {args.directions!r}") from None
-    if not 0 <= n <= MAX_DIRECTIONS:
-        raise SiteError(f"--directions must be 0 to {MAX_DIRECTIONS}, got {n}")
+    n = parse_directions(args.directions)
     if args.scale is not None and args.scales is not None:
         raise SiteError("give --scale or --scales, not both")
     scale = 1.0 if args.scale is None else parse_scale(args.scale, "--scale")

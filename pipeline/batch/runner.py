@@ -240,23 +240,36 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     journal.finish([t.record_id for t in tasks],
                    {p: [tasks[i].record_id for i in ix] for p, ix in by_pair.items()})
     n_failed = len(failures)
-    n_reused = len(tasks) - len(computed)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, len(tasks) - len(computed),
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": site.suite_rows(rows) if rows else []})
+                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else [])})
     if not quiet:
-        msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
-        if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
-            groups = {site.pair_of(t) for t in tasks}
-            msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
-                   f"records or pairs processed in every direction ({summary.n_ok} of "
-                   f"{summary.n_records} tasks)")
-        msg += f" ({n_reused} reused from an earlier run, {len(computed)} computed)"
-        if n_failed:
-            msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
-        print(design_table.table_text(design, failures, rows), end="")
-        print(f"{msg}; reports in {report.display(out)}")
+        _print_end(summary, tasks, failed, len(computed), design, failures, rows)
     return summary
+
+
+def _as_written(fields, rows) -> list[dict]:
+    """``rows`` as their CSV file holds them (6 significant digits), read back."""
+    import csv
+    import io
+
+    text = report.csv_text(fields, rows)
+    return [{f: resume.typed(c) for f, c in zip(fields, cells)} for cells in list(csv.reader(io.StringIO(text)))[1:]]
+
+
+def _print_end(summary, tasks, failed, n_computed, design, failures, rows) -> None:
+    """The table of the answer and the run's last line."""
+    msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
+    if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
+        groups = {site.pair_of(t) for t in tasks}
+        msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
+               f"records or pairs processed in every direction ({summary.n_ok} of "
+               f"{summary.n_records} tasks)")
+    msg += f" ({summary.n_reused} reused from an earlier run, {n_computed} computed)"
+    if summary.n_failed:
+        msg += f", {summary.n_failed} failed (see {report.display(summary.out / report.FAILURES)})"
+    print(design_table.table_text(design, failures, rows), end="")
+    print(f"{msg}; reports in {report.display(summary.out)}")
 
 
 def _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, say) -> None:
