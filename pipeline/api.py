@@ -218,6 +218,9 @@ class DesignRun:
         Tasks run (a pair's directions count one each) and tasks that failed.
     out : pathlib.Path or None
         The folder the reports were written to (None: nothing was written).
+    n_unwritten : int
+        The run's own figures that could not be written (a full disk): left out, the tables and
+        ``report.html`` written all the same.
 
     Examples
     --------
@@ -236,11 +239,14 @@ class DesignRun:
     n_records: int = 0
     n_failed: int = 0
     out: pathlib.Path | None = None
+    #: the run's own figures that could not be written (a full disk ...), left out
+    n_unwritten: int = 0
 
     @property
     def exit_code(self) -> int:
-        """``pipeline run``'s exit status: 0 when every record was processed, 1 when some failed."""
-        return 0 if self.n_failed == 0 else 1
+        """``pipeline run``'s exit status: 0 when every record was processed, 1 when some failed
+        (or a figure of the run's could not be written)."""
+        return 0 if self.n_failed == 0 and not self.n_unwritten else 1
 
     @property
     def design(self):
@@ -551,7 +557,7 @@ def _run_plan(plan) -> DesignRun:
 
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
-                     summary.n_failed, None if plan.out is None else summary.out)
+                     summary.n_failed, None if plan.out is None else summary.out, summary.n_unwritten)
 
 
 def _check_dask(address) -> None:

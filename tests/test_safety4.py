@@ -458,3 +458,71 @@ def test_design_takes_thorough_plots_all_or_none_and_numpy_integers(tmp_path):
     record = write_good(tmp_path, 0, duration=2.0)
     run = pipeline.design([record], blocks="7.5x1.8", shapes="sine", directions=np.int64(0), jobs=np.int64(1))
     assert run.exit_code == 0 and len(run.design) == 1
+
+
+def test_a_record_sampled_too_coarsely_is_said_so_not_too_short():
+    import numpy as np
+
+    import pulses
+
+    rec = pulses.Record(np.random.default_rng(1).normal(size=200), 10.0, "coarse")  # 1990 s long
+    with pytest.raises(pulses.FitError, match="sampled every 10 s, too coarsely"):
+        pulses.fit_pulse(rec)
+
+
+def test_a_full_disk_at_a_figure_still_writes_design_csv_and_report_html(tmp_path, capsys, monkeypatch):
+    """When the disk filled at a figure, design.csv and report.html were never written."""
+    import errno
+
+    from pipeline.reports import report
+
+    from .test_pipeline_run import write_good
+
+    records = [str(write_good(tmp_path, k, duration=2.0)) for k in range(2)]
+    real = report.Outputs.write
+
+    def full_at_figures(self, rel, data):
+        if str(rel) == report.SUMMARY_PLOT:
+            raise OSError(errno.ENOSPC, f"No space left on device: '{rel}'")
+        return real(self, rel, data)
+
+    monkeypatch.setattr(report.Outputs, "write", full_at_figures)
+    out = tmp_path / "out"
+    assert main(["run", *records, "--block", "7.5x1.8", "--shapes", "sine", "--out", str(out)]) == 1
+    assert "No space left on device" in capsys.readouterr().err
+    assert (out / "design.csv").is_file() and (out / "report.html").is_file()
+    assert not (out / report.SUMMARY_PLOT).exists()
+    monkeypatch.undo()
+    assert main(["run", *records, "--block", "7.5x1.8", "--shapes", "sine", "--out", str(out), "-q"]) == 0
+    assert (out / report.SUMMARY_PLOT).is_file()
+
+
+def test_a_batch_whose_every_record_failed_draws_no_empty_figure(tmp_path):
+    from pipeline.reports import report
+
+    bad = tmp_path / "bad.sac"
+    bad.write_bytes(b"not a record")
+    out = tmp_path / "out"
+    assert main(["run", str(bad), "--block", "7.5x1.8", "--out", str(out), "-q"]) == 1
+    assert (out / "design.csv").is_file() and (out / "report.html").is_file()
+    assert not list(out.rglob("*.png"))
+    assert not (out / report.SUMMARY_PLOT).exists()
+
+
+def test_the_suite_table_is_rounded_as_suite_csv(tmp_path):
+    """DesignRun.suite carried unrounded floats while suite.csv holds 6 significant digits."""
+    import csv
+
+    import pipeline
+
+    from .test_pipeline_run import write_good
+
+    records = [write_good(tmp_path, k, duration=2.0) for k in range(3)]
+    run = pipeline.design(records, blocks="7.5x1.8", shapes="sine", out=tmp_path / "out", plots=False)
+    with open(tmp_path / "out" / "suite.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert list(run.suite.columns) == rows[0]
+    for got, want in zip(run.suite.itertuples(index=False), rows[1:]):
+        for value, cell in zip(got, want):
+            if isinstance(value, float) and cell:
+                assert value == float(cell), (value, cell)  # the file's number, not a finer one

@@ -37,10 +37,12 @@ class RunSummary:
     #: the run's tables as row dicts (``design``, ``summary``, ``failures``, ``suite``): the rows the
     #: CSV reports were written from (pipeline.api.DesignRun makes DataFrames of them)
     tables: dict | None = dataclasses.field(default=None, repr=False)
+    #: the run's own figures that could not be written (a full disk): left out, exit status 1
+    n_unwritten: int = 0
 
     @property
     def exit_code(self) -> int:
-        return 0 if self.n_failed == 0 else 1
+        return 0 if self.n_failed == 0 and not self.n_unwritten else 1
 
 
 # -- the output folder -------------------------------------------------------------------------------
@@ -236,13 +238,15 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         except report.NotOurs as exc:
             say(f"pipeline run: note: {exc}")
     with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
-        design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options, render)
+        design, rows, problems = _write_tables(outputs, out, tasks, header, text, failures, failed, options,
+                                               render, say)
     journal.finish([t.record_id for t in tasks],
                    {p: [tasks[i].record_id for i in ix] for p, ix in by_pair.items()})
     n_failed = len(failures)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, len(tasks) - len(computed),
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else [])})
+                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else [])},
+                         problems)
     if not quiet:
         _print_end(summary, tasks, failed, len(computed), design, failures, rows)
     return summary
@@ -442,9 +446,40 @@ def _progress_bar(n_todo: int, quiet: bool, progress: bool | None):
                 ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
 
 
-def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None):
+class _Figures:
+    """``outputs`` for the run's own files, where a figure that cannot be written (a full disk)
+    is said and counted (``problems``) and the run goes on to ``design.csv`` and ``report.html``;
+    a figure with no rows to draw is not drawn, and an earlier run's is removed."""
+
+    def __init__(self, outputs, say):
+        self.outputs, self.say, self.problems = outputs, say, 0
+
+    def __getattr__(self, name):
+        return getattr(self.outputs, name)
+
+    def write(self, rel, data):
+        if not str(rel).endswith(".png"):
+            return self.outputs.write(rel, data)
+        try:
+            return self.outputs.write(rel, data)
+        except OSError as exc:
+            self.problems += 1
+            self.say(f"pipeline run: {report.display(exc)}; the figure is left out")
+            self.drop(rel)  # not an earlier run's in its place
+            return None
+
+    def drop(self, rel) -> None:
+        """No figure at ``rel`` this run: an earlier run's is removed (where it is the tool's)."""
+        with contextlib.suppress(OSError, report.NotOurs):
+            if self.outputs.owned(rel):
+                self.outputs.remove(rel)
+
+
+def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None, say=print):
     """Write the run's own files from every record's rows (``text``: summary.csv's rows as the records'
-    reports hold them, below ``header``); return the design rows and the rows of summary.csv."""
+    reports hold them, below ``header``); return the design rows, the rows of summary.csv and how
+    many figures could not be written."""
+    outputs = _Figures(outputs, say)
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
@@ -452,11 +487,14 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed, render)
-    if options.plots:
+    if options.plots and rows:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
+    elif options.plots:  # every record failed: no empty figures
+        for rel in (report.SUMMARY_PLOT, report.SUITE_PLOT, report.FRAGILITY_PLOT):
+            outputs.drop(rel)
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
     outputs.finish()
-    return design, rows
+    return design, rows, outputs.problems
 
 
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------
