@@ -526,3 +526,41 @@ def test_the_suite_table_is_rounded_as_suite_csv(tmp_path):
         for value, cell in zip(got, want):
             if isinstance(value, float) and cell:
                 assert value == float(cell), (value, cell)  # the file's number, not a finer one
+
+
+# -- the report's words -----------------------------------------------------------------------------------
+def test_the_report_names_its_pgvs_and_says_why_the_governing_pulse_is_not_the_best_fit(tmp_path):
+    """The demo's report gave "PGV 0.241 m/s" and a line below "PGV 25 cm/s" (two definitions, two
+    units, unnamed), "its design overturns under 0", and no word on why a symmetric Ricker governed
+    a record made with an antisymmetric one."""
+    import html
+    import re
+
+    import pipeline
+    from pipeline.commands.demo import bundled_records
+
+    with bundled_records() as paths:
+        pipeline.design(paths[:2], blocks="7.5x1.8", out=tmp_path / "out", plots=False)
+    page = html.unescape(re.sub(r"<[^>]+>", " ", (tmp_path / "out" / "report.html").read_text()))
+    assert "cm/s" not in page
+    assert "velocity after the fitter's baseline correction" in page
+    assert "the indicator's PGV, in the pulse's direction and without baseline correction" in page
+    assert "its design overturns" not in page and "a column of Eq. 31's width overturns under none" in page
+    # the antisymmetric Ricker record is governed by a symmetric Ricker, and the page says why
+    assert "so it is not always the best fit" in page and "fits ricker-anti best" in page
+    # g = 9.81 is the paper's value, not standard gravity (9.80665), and columns.md says so
+    columns = (tmp_path / "out" / "columns.md").read_text()
+    assert "g = 9.81 m/s^2, the value of the paper" in columns and "standard gravity is 9.80665" in columns
+
+
+def test_a_levels_overturning_width_says_whether_it_is_whole():
+    """Under --limit, overturning_width_m carried a less refined number than without it (1.85944
+    against 1.8608) under the same words: where the level's own width governs, it is only what was
+    established, and the report says so."""
+    from pipeline.reports.html_report import _overturning_words
+
+    assert "set by the overturning design width 1.861 m" in _overturning_words(
+        {"overturning_width_m": 1.8608, "design_width_m": 1.8608})
+    words = _overturning_words({"overturning_width_m": 1.85944, "design_width_m": 2.1})
+    assert "at least 1.859 m: refined only as far as it could change the design width" in words
+    assert _overturning_words({"design_width_m": 2.1}) == ""
