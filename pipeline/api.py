@@ -525,7 +525,7 @@ def _tasks(plan, say):
 def run_plan(plan) -> DesignRun:
     """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments);
     with ``quiet``, no warning is printed meanwhile, here or in the workers."""
-    from .batch.worker import quieted
+    from .batch.quiet import quieted
 
     with quieted(plan.quiet):
         return _run_plan(plan)

@@ -237,7 +237,7 @@ def _map_pairs(args, jobs):
     from concurrent.futures import ProcessPoolExecutor
 
     from .lifeline import lifeline
-    from .worker import quiet_now
+    from .quiet import quiet_now
 
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
