@@ -127,10 +127,58 @@ def _choice(value, what, choices):
     return value
 
 
+def _is_whole(x) -> bool:
+    """A whole number, numpy's included, not a boolean."""
+    import numbers
+
+    return isinstance(x, numbers.Integral) and not _is_flag(x)
+
+
+def _is_flag(x) -> bool:
+    """``True``/``False``, numpy's included."""
+    return isinstance(x, bool) or (type(x).__module__ == "numpy" and type(x).__name__ in ("bool", "bool_"))
+
+
 def _jobs(jobs) -> int:
-    if not isinstance(jobs, int) or isinstance(jobs, bool):
+    if not _is_whole(jobs):
         raise TypeError(f"jobs: expected a whole number of processes (0: one per CPU), got {type(jobs).__name__}")
-    return jobs_count(jobs, "jobs")
+    return jobs_count(int(jobs), "jobs")
+
+
+def _flag(value, what) -> bool:
+    """A boolean argument: True or False only (``"no"`` is not False)."""
+    if not _is_flag(value):
+        raise TypeError(f"{what}: expected True or False, got {type(value).__name__} {value!r:.60}")
+    return bool(value)
+
+
+#: what ``plots`` takes, as ``pipeline run``'s ``--plots [governing|all]`` and ``--no-plots``
+_PLOTS = ("governing", "all", "none")
+
+
+def _plots(plots, out) -> dict:
+    """``plots`` and ``plots_all`` of the options from ``plots`` (None: figures when ``out``)."""
+    if plots is None:
+        plots = out is not None
+    if not _is_flag(plots) and not isinstance(plots, str):
+        raise TypeError(f"plots: expected True, False, None or one of {', '.join(map(repr, _PLOTS))}, "
+                        f"got {type(plots).__name__}")
+    scope = ("governing" if plots else "none") if _is_flag(plots) else _choice(plots, "plots", _PLOTS)
+    return {"plots": scope != "none", "plots_all": scope == "all"}
+
+
+def _text_option(value, what, *, whole=False):
+    """A text argument (or None); ``whole``: a whole number is taken as its text too."""
+    if value is None or isinstance(value, str) or (whole and _is_whole(value)):
+        return None if value is None else str(value)
+    raise TypeError(f"{what}: expected {'a whole number or ' if whole else ''}text, got "
+                    f"{type(value).__name__} {value!r:.60}")
+
+
+def _path_option(value, what):
+    if value is not None and not _is_path(value):
+        raise TypeError(f"{what}: expected a file path (str or os.PathLike) or None, got {type(value).__name__}")
+    return value
 
 
 def _shapes(shapes):
@@ -170,6 +218,9 @@ class DesignRun:
         Tasks run (a pair's directions count one each) and tasks that failed.
     out : pathlib.Path or None
         The folder the reports were written to (None: nothing was written).
+    n_unwritten : int
+        The run's own figures that could not be written (a full disk): left out, the tables and
+        ``report.html`` written all the same.
 
     Examples
     --------
@@ -188,11 +239,14 @@ class DesignRun:
     n_records: int = 0
     n_failed: int = 0
     out: pathlib.Path | None = None
+    #: the run's own figures that could not be written (a full disk ...), left out
+    n_unwritten: int = 0
 
     @property
     def exit_code(self) -> int:
-        """``pipeline run``'s exit status: 0 when every record was processed, 1 when some failed."""
-        return 0 if self.n_failed == 0 else 1
+        """``pipeline run``'s exit status: 0 when every record was processed, 1 when some failed
+        (or a figure of the run's could not be written)."""
+        return 0 if self.n_failed == 0 and not self.n_unwritten else 1
 
     @property
     def design(self):
@@ -251,7 +305,8 @@ def _frame(rows, columns):
 
 def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 0, vertical: str = "auto",
            limit=None, jobs: int = 1, out=None, shapes=None, weighting: str = "background", units=None,
-           dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True, **more) -> DesignRun:
+           dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True, thorough: bool = False,
+           **more) -> DesignRun:
     """Design columns for a batch of records, as ``pipeline run`` does, and return the tables.
 
     Parameters
@@ -288,12 +343,18 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         What a file does not say (``--units``, ``--dt``).
     scale : float, optional
         A factor on every record (``--scale``).
-    plots : bool, optional
-        Draw the figures (default: when ``out`` is given).
+    plots : bool or {"governing", "all", "none"}, optional
+        Draw the figures (default: when ``out`` is given): True or ``"governing"`` (for a pair in
+        several directions, its governing direction's), ``"all"`` (every direction's), False or
+        ``"none"``.  ``--plots [all]``, ``--no-plots``.
     force : bool
         Compute every record again instead of keeping an earlier run's reports in ``out``.
     quiet : bool
-        No messages and no table on stderr/stdout (default); False prints what ``pipeline run`` prints.
+        No messages, no warnings and no table on stderr/stdout (default); False prints what
+        ``pipeline run`` prints.
+    thorough : bool
+        For pairs: the check above the search width (and the figures) in every direction
+        (``--thorough``); the same pair design width.
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
@@ -309,7 +370,17 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     TypeError
         An argument of a type not accepted (the message names the accepted forms).
     ValueError
-        A value out of range (a negative height, an unknown shape ...).
+        A value out of range (a negative height, an unknown shape ...), refused with the words
+        ``pipeline run`` uses for it.
+    RuntimeError
+        ``jobs > 1`` (or ``dask="local"``) called at the top level of a script without the
+        ``if __name__ == "__main__":`` guard: the worker processes import the script again,
+        and would run the call again (see Notes).
+
+    Notes
+    -----
+    With ``jobs > 1`` the workers import the calling script again: in a script, call
+    :func:`design` under ``if __name__ == "__main__":`` (docs/notebook.md); a notebook needs nothing.
 
     Examples
     --------
@@ -326,7 +397,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     """
     plan = _plan(records, blocks=blocks, heights=heights, pairs=pairs, directions=directions,
                  vertical=vertical, limit=limit, jobs=jobs, out=out, shapes=shapes, weighting=weighting,
-                 units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet, **more)
+                 units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet, thorough=thorough,
+                 **more)
     return run_plan(plan)
 
 
@@ -335,9 +407,11 @@ _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_sc
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
-          units, dt, scale, plots, force, quiet, **more) -> Plan:
-    """Every argument of :func:`design` checked and in the forms the runner takes."""
-    from .args import parse_units
+          units, dt, scale, plots, force, quiet, thorough, **more) -> Plan:
+    """Every argument of :func:`design` checked and in the forms the runner takes: each value by
+    the rule ``pipeline run`` applies to its option (:mod:`pipeline.args`), named as here."""
+    from .args import (parse_cap_mass_ratio, parse_column, parse_directions, parse_dt, parse_limit,
+                       parse_scale, parse_units, parse_up_to)
     from .batch.tasks import Options
 
     unknown = sorted(set(more) - set(_MORE))
@@ -346,29 +420,37 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
                         f"named ones: {', '.join(_MORE)}")
     more = {**_MORE, **more}
     mode, explicit, triplets = _pairs(pairs)
-    if not isinstance(directions, int) or isinstance(directions, bool):
+    if not _is_whole(directions):
         raise TypeError(f"directions: expected a whole number, got {type(directions).__name__}")
     if out is not None and not _is_path(out):
         raise TypeError(f"out: expected a folder path (str or os.PathLike) or None, got {type(out).__name__}")
     if units is not None and not isinstance(units, str):
         raise TypeError(f"units: expected a unit name (e.g. 'g', 'm/s2', 'cm/s2'), got {type(units).__name__}")
-    opts = {"format": more["format"], "units": parse_units(units),
-            "dt": _number_option(dt, "dt"), "column": more["column"], "trace": more["trace"]}
-    kw = dict(plots=(out is not None) if plots is None else bool(plots), shapes=_shapes(shapes),
+    number = _number_option
+    column = more["column"]
+    if column is not None and not (_is_whole(column) or isinstance(column, str)):
+        raise TypeError(f"column: expected a whole number (counted from 1), got {type(column).__name__}")
+    opts = {"format": _text_option(more["format"], "format"), "units": parse_units(units, "units"),
+            "dt": None if dt is None else parse_dt(number(dt, "dt"), "dt"),
+            "column": parse_column(column, "column"), "trace": _text_option(more["trace"], "trace", whole=True)}
+    kw = dict(**_plots(plots, out), thorough=_flag(thorough, "thorough"), shapes=_shapes(shapes),
               weighting=_choice(weighting, "weighting", ("background", "plain")),
               vertical=_choice(vertical, "vertical", ("auto", "none")),
-              cap_mass_ratio=_number_option(more["cap_mass_ratio"], "cap_mass_ratio"),
-              fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"), **opts)
-    if limit is not None:
-        kw["limit"] = _number_option(limit, "limit")
-        if not 0.0 < kw["limit"] <= 1.0:
-            raise ValueError(f"limit (max|theta|/alpha) must lie in (0, 1], got {limit!r}")
+              cap_mass_ratio=parse_cap_mass_ratio(number(more["cap_mass_ratio"], "cap_mass_ratio"), "cap_mass_ratio"),
+              fragility=_flag(more["fragility"], "fragility"),
+              up_to=parse_up_to(number(more["up_to"], "up_to"), "up_to"),
+              limit=None if limit is None else parse_limit(number(limit, "limit"), "limit"), **opts)
+    if more["dask"] is not None and not isinstance(more["dask"], str):
+        raise TypeError(f"dask: expected 'local' or a scheduler address such as 'tcp://HOST:8786', "
+                        f"got {type(more['dask']).__name__}")
     return Plan(
         records=_records(records), columns=columns_from(blocks, heights), options=Options(**kw),
-        record_opts=opts, pairs=mode, pair=explicit, triplets=triplets, directions=str(directions),
-        scale=None if scale is None else repr(_number_option(scale, "scale")), scales=more["scales"],
-        peer_scales=bool(more["peer_scales"]), jobs=_jobs(jobs), out=out, force=bool(force),
-        quiet=bool(quiet), dask=more["dask"], log=more["log"], glob=more["glob"])
+        record_opts=opts, pairs=mode, pair=explicit, triplets=triplets,
+        directions=str(parse_directions(int(directions), "directions")),
+        scale=None if scale is None else repr(parse_scale(number(scale, "scale"), "scale")),
+        scales=_path_option(more["scales"], "scales"), peer_scales=_flag(more["peer_scales"], "peer_scales"),
+        jobs=_jobs(jobs), out=out, force=_flag(force, "force"), quiet=_flag(quiet, "quiet"),
+        dask=more["dask"], log=_path_option(more["log"], "log"), glob=_text_option(more["glob"], "glob"))
 
 
 @dataclass
@@ -441,12 +523,26 @@ def _tasks(plan, say):
 
 
 def run_plan(plan) -> DesignRun:
-    """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments)."""
+    """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments);
+    with ``quiet``, no warning is printed meanwhile, here or in the workers."""
+    from .batch.quiet import quieted
+
+    with quieted(plan.quiet):
+        return _run_plan(plan)
+
+
+def _run_plan(plan) -> DesignRun:
     from .batch.runner import run
 
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
     from .batch.peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
+    if plan.dask:
+        _check_dask(plan.dask)
+    if (plan.jobs or 1) > 1 or plan.dask == "local":  # worker processes, which import the script again
+        from .batch import mainguard
+
+        mainguard.check("dask='local'" if plan.dask == "local" else f"jobs={plan.jobs}")
     paths, tasks, absent = _tasks(plan, say)
     # with no folder of the caller's, the runner's messages would name the private one: the table
     # is printed here instead
@@ -461,7 +557,20 @@ def run_plan(plan) -> DesignRun:
 
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
-                     summary.n_failed, None if plan.out is None else summary.out)
+                     summary.n_failed, None if plan.out is None else summary.out, summary.n_unwritten)
+
+
+def _check_dask(address) -> None:
+    """``--dask``: dask.distributed installed and, for a scheduler's address, a scheduler there
+    (:func:`pipeline.batch.scheduler.check_address`): an argument error before any work."""
+    import importlib.util
+
+    if importlib.util.find_spec("distributed") is None:
+        raise ArgumentError("--dask needs dask.distributed: pip install 'rocking-columns[dask]'")
+    if address != "local":
+        from .batch.scheduler import check_address
+
+        check_address(address)
 
 
 @contextlib.contextmanager

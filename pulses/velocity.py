@@ -273,7 +273,8 @@ class PulseClassification:
         else:
             text = (f"not pulse-like: indicator PI = {self.indicator:.1f} <= 0 (without the extracted "
                     f"pulse the record keeps {100 * self.pgv_ratio:.0f} % of its peak velocity and "
-                    f"{100 * self.energy_ratio:.0f} % of its energy; PGV {100 * self.pgv:.0f} cm/s)")
+                    f"{100 * self.energy_ratio:.0f} % of its energy; the indicator's PGV, in the "
+                    f"pulse's direction and without baseline correction, {self.pgv:.3g} m/s)")
         v = self.velocity
         big, small = (max(v.max(), -v.min()), min(v.max(), -v.min())) if v.size else (0.0, 0.0)
         if not self.is_pulse and big > 0 and big >= ONE_SIDED_RATIO * max(small, 0.0):

@@ -94,8 +94,9 @@ FAILURE_COLUMNS = Columns(
                    "(velocity-pulse classification), `design` (design rules), `verify` (full-record time histories), `plot`, `write` (the record "
                    "was processed and its rows are in `summary.csv`, but its own report or figure "
                    "could not be written, or a file that `pipeline run` did not write is in the way "
-                   "and was left as it is), `worker` (the process running it died) or `internal` "
-                   "(an unforeseen error: please report it)."),
+                   "and was left as it is), `worker` (the process running it died), `cluster` (the "
+                   "dask scheduler was lost before the record was computed: run the same command "
+                   "again to finish the batch) or `internal` (an unforeseen error: please report it)."),
     ("error", "-", "Type of the error."),
     ("reason", "-", "The error message, in one line."),
 )

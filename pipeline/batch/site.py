@@ -20,7 +20,7 @@ from . import memo, peer_inputs
 from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
 from .peer_inputs import PEER_TP
 from ..reports.pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
-from ..args import SCALE_RANGE, parse_scale
+from ..args import SCALE_RANGE, parse_cap_mass_ratio, parse_limit, parse_up_to
 from ..reports.report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
                      Columns)
 
@@ -185,26 +185,12 @@ def add_options(parser) -> None:
                              "(about as many solver runs as an overturning design; docs/design.md)")
 
 
-def _number(text, what, lo, hi) -> float:
-    try:
-        value = float(str(text))
-    except ValueError:
-        raise SiteError(f"{what}: expected a number, got {text!r}") from None
-    if not (math.isfinite(value) and lo <= value <= hi):
-        raise SiteError(f"{what} must lie between {lo:g} and {hi:g}, got {text!r}")
-    return value
-
-
 def options_from_args(args) -> dict:
-    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.record.Options`."""
-    gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
-    up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
+    """``cap_mass_ratio``, ``fragility``, ``up_to``, ``limit`` of :class:`pipeline.batch.tasks.Options`
+    (the rules of :mod:`pipeline.args`, which ``pipeline.design()`` follows too)."""
     limit = getattr(args, "limit", None)
-    if limit is not None:
-        limit = _number(limit, "--limit (max|theta|/alpha)", 0.0, 1.0)
-        if limit <= 0.0:
-            raise SiteError(f"--limit (max|theta|/alpha) must lie in (0, 1], got {args.limit!r}")
-    return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to, "limit": limit}
+    return {"cap_mass_ratio": parse_cap_mass_ratio(args.cap_mass_ratio), "fragility": bool(args.fragility),
+            "up_to": parse_up_to(args.up_to), "limit": None if limit is None else parse_limit(limit)}
 
 
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------

@@ -355,7 +355,7 @@ def table_text(rows, failures=(), summary=()) -> str:
     lines += [line(c) for c in body]
     for f in failures:
         lines.append(f"{display(f['record'])}  failed ({f['stage']}): {' '.join(display(f['reason']).split())}")
-    lines += [""] + verdict_lines(rows) + [t for t in (fine_print(rows),) if t]
+    lines += [""] + verdict_lines(rows) + [t for t in (governing_print(rows, summary), fine_print(rows)) if t]
     seen = {}
     for r in summary:
         text = metadata_text(r)
@@ -397,11 +397,40 @@ def verdict_lines(rows) -> list[str]:
                         else f"FAILS: {fails} record(s) overturn it" + ("" if limit is None else " or exceed the level")
                         + f", {safe} leave it on a safe island"))
         out.append(line)
-        below = _count(group, "eq31_below_design")
-        over = _count(group, "eq31_width_overturns")
-        out.append(f"Eq. 31 is below the design width on {below} of {n} record(s); its design "
-                   f"overturns under {over}.")
+        out.append(eq31_line(group))
     return out
+
+
+def eq31_line(group) -> str:
+    """The Eq. 31 line of one column's design rows: how often its width is below the design width,
+    and how often a column of that width overturns under its record."""
+    n = len(group)
+    below = _count(group, "eq31_below_design")
+    over = _count(group, "eq31_width_overturns")
+    return (f"Eq. 31 is below the design width on {below} of {n} record(s); a column of Eq. 31's width "
+            f"overturns under {'none' if not over else f'{over} of them'}.")
+
+
+def governing_print(rows, summary) -> str | None:
+    """Why the governing pulse is not the best fit, where it is not on some record: the rule, and
+    the records (``rows``: design rows, ``summary``: summary.csv's, whose ``pulse_shape`` is the
+    best fit)."""
+    best = {}
+    for r in summary:
+        key = (r.get("pair") or r.get("record"), r.get("column"), r.get("direction_deg"))
+        best.setdefault(key, r.get("pulse_shape"))
+    others = []
+    for r in rows:
+        shape = best.get((r.get("record"), r.get("column"), r.get("direction_deg")))
+        if shape and r.get("governing_shape") and shape != r["governing_shape"]:
+            others.append(f"{display(r['record'])} fits {shape} best")
+    if not others:
+        return None
+    shown = "; ".join(dict.fromkeys(others[:3])) + ("; ..." if len(others) > 3 else "")
+    return ("Governing pulse: of the shapes that fit almost as well as the best (a score at least 0.7 "
+            "of its), the one whose Eq. 31 width is widest, since shapes that fit almost equally well "
+            "can ask for very different columns; so it is not always the best fit "
+            f"({len(others)} of {len(rows)} row(s) here: {shown}).")
 
 
 def check_reach_words() -> str:

@@ -17,7 +17,7 @@ import urllib.parse
 
 from . import report
 from .design_table import (check_reach_words, eq31_text, failing_text, metadata_text, pulse_text, search_text,
-                           survives_text, verdict_lines, fine_print, vertical_text)
+                           survives_text, verdict_lines, fine_print, governing_print, vertical_text)
 from .design_table import number as _num
 from .report import FIT_TOLERANCE
 
@@ -174,7 +174,9 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
         if _num(first.get("scale")) not in (None, 1.0):
             facts.append(("scale", first.get("scale")))
         facts += [
-            ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s"),
+            ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s "
+                         "(peaks of the record's acceleration and of its velocity after the fitter's "
+                         "baseline correction)"),
             ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
                            f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
                            f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"
@@ -201,8 +203,7 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      f"design width {_fixed(r.get('design_width_m')) or '-'} m"
                      + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
                      + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else "")
-                     + (f", at least the overturning design width {_fixed(r['overturning_width_m'])} m"
-                        if _num(r.get("overturning_width_m")) else ""),
+                     + _overturning_words(r),
                      f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
@@ -237,6 +238,18 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
     return out
 
 
+def _overturning_words(r) -> str:
+    """Under ``--limit``: what the overturning design width in the row is (in full where it sets
+    the design width, else the part established: it is refined only where it can change it)."""
+    over, design = _num(r.get("overturning_width_m")), _num(r.get("design_width_m"))
+    if over is None:
+        return ""
+    if design is None or over >= design:
+        return f", set by the overturning design width {_fixed(over)} m (a width that overturns fails every level)"
+    return (f", above the overturning design width (at least {_fixed(over)} m: refined only as far as "
+            "it could change the design width)")
+
+
 def report_html(design, rows, failures, record_ids, figures, title="pipeline run") -> str:
     """The page.
 
@@ -269,7 +282,7 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
            f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
            f"<h1>{_e(title)}</h1>"]
     out += [f'<p class="verdict"><b>{_e(line)}</b></p>' for line in verdict_lines(design)]
-    out += [f'<p class="muted">{_e(t)}</p>' for t in (fine_print(design),) if t]
+    out += [f'<p class="muted">{_e(t)}</p>' for t in (governing_print(design, rows), fine_print(design)) if t]
     out += [
            f"<p>{len(record_ids)} records, {len(failures)} failed. Files: "
            + ", ".join(f'<a href="{_href(f)}">{_e(f)}</a>' for f in

@@ -450,10 +450,11 @@ def columns_markdown(columns, failure_columns) -> str:
         "run into this folder replaces or removes only those, and only while their content is still "
         "what it wrote; any other file in its way is left as it is, and the run says so.",
         f"- `{RESUME}`: for each record computed, a key of its file content, options and "
-        "package version and a hash of its report: a later run into this folder with the same "
+        "the package's code (version, installed files, solver settings) and a hash of its report: a later run into this folder with the same "
         "command keeps those records and computes only the others (`--force`: all).",
         "",
-        "Accelerations are in g (g = 9.81 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
+        "Accelerations are in g (g = 9.81 m/s^2, the value of the paper the design rules come from, "
+        "in every conversion; standard gravity is 9.80665 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
         "digits; a blank cell means the value does not apply (or, in `<shape>_*` columns, that the shape "
         "does not fit or was not tried). Booleans are `True`/`False`.",
         "",

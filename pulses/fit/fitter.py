@@ -92,6 +92,10 @@ def default_tp_range(record: Record) -> tuple[float, float]:
     """
     tp_min = max(0.2, 10.0 * record.dt)
     tp_max = min(10.0, 0.25 * record.duration)
+    if tp_min >= 10.0:  # ten samples a period: no period up to 10 s has them
+        raise FitError(f"record {record.name!r} is sampled every {record.dt:g} s, too coarsely to fit "
+                       f"pulses: a period of at most 10 s needs 10 samples (dt at most 1 s; "
+                       f"strong-motion records are sampled at 50 to 1000 Hz)")
     if tp_max <= tp_min:
         raise FitError(f"record {record.name!r} ({record.duration:g} s) is too short to fit pulses of "
                          f"at least {tp_min:g} s")
