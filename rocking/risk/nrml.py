@@ -83,8 +83,9 @@ def nrml_text(functions, model_id="rocking_columns", description="Rocking column
     states = [s[0] for s in functions[0].limit_states]
     if any([s[0] for s in f.limit_states] != states for f in functions):
         raise ValueError("nrml: every function of a model has the same limit states")
+    model = re.sub(r"[^\w\-:]", "_", model_id or "model")
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', f'<nrml xmlns="{NAMESPACE}">',
-             f'<fragilityModel id="{re.sub(r"[^\w\-:]", "_", model_id or "model")}" '
+             f'<fragilityModel id="{model}" '
              'assetCategory="buildings" lossCategory="structural">',
              f"  <description>{_escape(description)}</description>",
              f"  <limitStates>{' '.join(states)}</limitStates>"]

@@ -173,20 +173,32 @@ def risk(records, hazard, *, height, width=None, target_rate=None, target_poe=No
     >>> f"{res.rate:.2e}", res.modes[0].fragility.n
     ('4.29e-04', 4)
     """
-    from ..restitution import Restitution
     from . import suite as suites
     from .curve import HazardCurve
+
+    curve = hazard if isinstance(hazard, HazardCurve) else _read(hazard, read)
+    suite = suites.members(records, curve.measure, names)
+    return assess(suite, curve, height=height, width=width, target_rate=target_rate,
+                  target_poe=target_poe, years=years, age=age, limit=limit, restitution=restitution,
+                  seed=seed, cap_mass_ratio=cap_mass_ratio, n_boot=n_boot, jobs=jobs)
+
+
+def assess(suite, curve, *, height, width=None, target_rate=None, target_poe=None, years=50.0,
+           age=None, limit=None, restitution=None, seed=0, cap_mass_ratio=0.0, n_boot=N_BOOT,
+           jobs=1) -> RiskResult:
+    """:func:`risk` for a suite already made (:class:`rocking.risk.suite.Member` s, as the
+    pipeline makes them from its tasks: a pair in the directions the run designed for)."""
+    from ..restitution import Restitution
+    from . import suite as suites
     from .rate import parse_poe, rate_for
     from .target import target_width
 
-    curve = hazard if isinstance(hazard, HazardCurve) else _read(hazard, read)
     rest = None if restitution is None else Restitution.parse(restitution)
     if target_poe is not None:
         if target_rate is not None:
             raise ValueError("risk: give target_rate or target_poe, not both")
         target_rate = rate_for(*parse_poe(target_poe))
     _check(height, width, target_rate, years, age)
-    suite = suites.members(records, curve.measure, names)
     gamma = float(cap_mass_ratio)
     with suites.Runner(suite, jobs) as runner:
         modes = []
