@@ -128,7 +128,7 @@ def _filter(period: float, damping: float, dt: float):
     # u = first state: U(z) = [z - p22, p12] (b0 + b1 z) A(z) / det(zI - Phi)
     num = np.array([b1[0], b0[0] - p22 * b1[0] + p12 * b1[1], -p22 * b0[0] + p12 * b0[1]])
     den = np.array([1.0, -(p11 + p22), p11 * p22 - p12 * p21])
-    return num, den
+    return num, den, b1
 
 
 def displacement(acc, dt: float, period: float, damping: float = DAMPING) -> np.ndarray:
@@ -137,8 +137,18 @@ def displacement(acc, dt: float, period: float, damping: float = DAMPING) -> np.
     from scipy.signal import lfilter
 
     _check_oscillator(period, damping)
-    b, a = _filter(float(period), float(damping), float(dt))
-    return lfilter(b, a, np.asarray(acc, dtype=float))
+    acc = np.asarray(acc, dtype=float)
+    b, a, b1 = _filter(float(period), float(damping), float(dt))
+    u = lfilter(b, a, acc)
+    # the filter starts as if the ground had ramped from 0 to acc[0] over one step before t = 0,
+    # leaving the oscillator in the state b1 acc[0]; at rest instead: its free vibration removed
+    d0, v0 = b1 * acc[0]
+    if d0 or v0:
+        w = 2.0 * math.pi / period
+        wd = w * math.sqrt(1.0 - damping * damping)
+        t = np.arange(acc.size) * dt
+        u -= np.exp(-damping * w * t) * (d0 * np.cos(wd * t) + (v0 + damping * w * d0) / wd * np.sin(wd * t))
+    return u
 
 
 def _check_oscillator(period, damping) -> None:

@@ -194,16 +194,16 @@ def assess_columns(tasks, rows, options, jobs, say):
     return out
 
 
-def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print) -> dict:
-    """Write the risk files (nothing without ``--hazard``); return ``{column: answer}`` for
-    design.csv and the printed answer (:func:`answer_fields`)."""
+def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print):
+    """Write the risk files (nothing without ``--hazard``); return ``({column: answer}, rows of
+    risk.csv)``: the answers for design.csv and the printed answer (:func:`answer_fields`)."""
     from rocking.risk import nrml, rows as risk_rows
 
     from ..reports import report
     from ..reports.figures import draw
 
     if getattr(options, "risk", None) is None:
-        return {}
+        return {}, []
     render = render or draw
     results = assess_columns(tasks, rows, options, jobs, say) if rows else {}
     done = [r for r in results.values() if not isinstance(r, str)]
@@ -229,7 +229,7 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
                                                made[RISK_CSV]))
         outputs.write(RISK_DISAGG_PLOT, render("plot_risk:disaggregation_figure_png",
                                                made[RISK_DISAGG_CSV]))
-    return {label: answer_fields(r, options) for label, r in results.items()}
+    return {label: answer_fields(r, options) for label, r in results.items()}, made[RISK_CSV]
 
 
 def _error_row(label, text, options):

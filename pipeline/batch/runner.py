@@ -231,14 +231,14 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         except report.NotOurs as exc:
             say(f"pipeline run: note: {exc}")
     with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
-        design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options, render,
-                                     jobs=jobs, say=say)
+        design, rows, risk_rows = _write_tables(outputs, out, tasks, header, text, failures, failed,
+                                                options, render, jobs=jobs, say=say)
     journal.finish([t.record_id for t in tasks])
     n_failed = len(failures)
     n_reused = len(tasks) - len(computed)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": site.suite_rows(rows) if rows else []})
+                          "suite": site.suite_rows(rows) if rows else [], "risk": risk_rows})
     if not quiet:
         msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
         if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
@@ -385,12 +385,12 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed, render)
-    answers = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
+    answers, risk_rows = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
     if options.plots:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options, answers)
     outputs.finish()
-    return design, rows
+    return design, rows, risk_rows
 
 
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------
