@@ -125,6 +125,21 @@ def read_hazard(path, *, format=None, site=None, site_row=None, imt=None, units=
     rocking.risk.HazardError
         One line saying what is wrong: a file that cannot be read, a format not recognised, a
         site not found, a measure or units not stated, a bad curve.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from rocking.risk import read_hazard
+    >>> path = os.path.join(tempfile.mkdtemp(), "site.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("# measure: SA(1.0)\\n# units: g\\niml,rate\\n0.1,1e-2\\n0.2,3e-3\\n0.4,5e-4\\n")
+    >>> curve = read_hazard(path)
+    >>> curve.measure, curve.n, round(curve.rate_at(0.3), 6)
+    ('SA(1.0)', 3, 0.001267)
+    >>> read_hazard(path, imt="PGA")
+    Traceback (most recent call last):
+    ...
+    rocking.risk.curve.HazardError: hazard file ...site.csv: the file states the measure 'SA(1.0)', not 'PGA'
     """
     shown = os.fspath(path)
     try:
