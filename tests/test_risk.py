@@ -56,7 +56,7 @@ def test_below_first_share_and_disaggregation():
 
 def test_discrete_rule_differs_on_coarse_curves():
     # OpenQuake's rule (rates of occurrence between midpoints) against the integral: close on a
-    # fine curve, a few percent off on a coarse one (SPEC: say which is used)
+    # fine curve, a few percent off on a coarse one (the docs say which is used: docs/risk.md, "Theory")
     frag = lambda v: ndtr(np.log(v / 0.5) / 0.4)  # noqa: E731
     fine = np.geomspace(1e-3, 100.0, 151)
     coarse = np.geomspace(1e-3, 100.0, 16)
@@ -71,7 +71,7 @@ def test_discrete_rule_differs_on_coarse_curves():
 def test_probabilities_from_rates():
     p, n = parse_poe("2%/50")
     assert (p, n) == (0.02, 50.0)
-    assert rate_for(p, n) == pytest.approx(4.04054e-4, rel=1e-5)    # SPEC section 11
+    assert rate_for(p, n) == pytest.approx(4.04054e-4, rel=1e-5)    # docs/risk.md: 2 % in 50 years
     assert parse_poe("10 % / 50 years") == (0.1, 50.0)
     assert probability_in(rate_for(0.1, 50), 50) == pytest.approx(0.1, rel=1e-12)
     assert survival(1e-4, 2560) == pytest.approx(math.exp(-0.256))

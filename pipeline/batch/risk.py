@@ -227,8 +227,9 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
     if options.plots:
         outputs.write(RISK_WIDTHS_PLOT, render("plot_risk:widths_figure_png", made[RISK_WIDTHS_CSV],
                                                made[RISK_CSV]))
+        c = options.risk.curve
         outputs.write(RISK_DISAGG_PLOT, render("plot_risk:disaggregation_figure_png",
-                                               made[RISK_DISAGG_CSV]))
+                                               made[RISK_DISAGG_CSV], f"{c.measure} ({c.units})"))
     return {label: answer_fields(r, options) for label, r in results.items()}, made[RISK_CSV]
 
 

@@ -44,7 +44,7 @@ def widths_figure_png(width_rows, risk_rows) -> bytes:
     return _png(widths_figure(width_rows, risk_rows))
 
 
-def disaggregation_figure(disagg_rows):
+def disaggregation_figure(disagg_rows, measure="intensity measure"):
     """The share of each column's rate per interval of the hazard curve (bars on a log axis)."""
     from matplotlib.figure import Figure
 
@@ -63,7 +63,7 @@ def disaggregation_figure(disagg_rows):
         ax.bar(left, 100 * share, width=right - left, align="edge", color=f"C{i % 10}", alpha=0.8,
                label=f"{label}, {mode} (first bar: below the curve's first level)")
     ax.set_xscale("log")
-    ax.set_xlabel("intensity measure")
+    ax.set_xlabel(measure)
     ax.set_ylabel("share of the rate (%)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
@@ -71,5 +71,5 @@ def disaggregation_figure(disagg_rows):
     return fig
 
 
-def disaggregation_figure_png(disagg_rows) -> bytes:
-    return _png(disaggregation_figure(disagg_rows))
+def disaggregation_figure_png(disagg_rows, measure="intensity measure") -> bytes:
+    return _png(disaggregation_figure(disagg_rows, measure))
