@@ -26,6 +26,8 @@ _WHERE = {
     "fragility": "fragility",
     "FIT_TOLERANCE": "governing", "GoverningPulse": "governing", "fitting_candidates": "governing",
     "governing_pulse": "governing",
+    "FrictionCheck": "friction", "FrictionDemand": "friction", "friction_demand": "friction",
+    "Body": "bodies",
 }
 
 __all__ = sorted(_WHERE)
