@@ -62,13 +62,13 @@ def _many(value, *, pair_is_one: bool = False):
 
 def _column(block):
     """A :class:`pipeline.batch.tasks.Column` (height, width) from one of the accepted forms."""
-    from .args import parse_block
+    from .args import parse_block, parse_column_block
     from .batch.tasks import Column
 
     if isinstance(block, Column):  # the command line's own, already checked
         return block
     if isinstance(block, str):
-        return Column(*parse_block(block))
+        return Column(*parse_column_block(block))
     if isinstance(block, tuple) and len(block) == 2 and all(map(_is_number, block)):
         return Column(*parse_block(f"{float(block[0])!r}x{float(block[1])!r}"))
     from rocking import Block
@@ -77,7 +77,8 @@ def _column(block):
         if block.height is None or block.width is None:
             raise ValueError("blocks: a rocking.Block with its full height and width (made by "
                              "Block.from_dimensions), not only p and alpha")
-        return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"))
+        return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"),
+                      block.body.kind)
     raise TypeError(f"blocks: expected {_COLUMN_FORMS}; got {type(block).__name__} {block!r:.60}")
 
 
@@ -262,7 +263,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         is missing or cannot be read is a row of :attr:`DesignRun.failures`, not an exception.
     blocks : Block, str, (float, float) or a list of them
         Columns as they stand: a :class:`rocking.Block`, ``"HxW"`` (full height x full width, m,
-        e.g. ``"7.5x1.8"``) or ``(height, width)`` in m.  ``pipeline run --block``.
+        e.g. ``"7.5x1.8"``; ``"cyl:HxD"`` a circular column of diameter D) or ``(height, width)``
+        in m.  ``pipeline run --block``.
     heights : float or list of float
         Heights (m) of columns whose width is only to be sized.  ``--height``.
     pairs : {"none", "auto"} or list of (A, B) or (A, B, V)
@@ -297,7 +299,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``.
+        ``glob``, ``friction`` (``--friction MU``: every response judged against the base's
+        friction coefficient; docs/validity.md).
 
     Returns
     -------
@@ -331,7 +334,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
 
 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
-         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None}
+         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None,
+         "friction": None}
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
@@ -358,7 +362,8 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
               weighting=_choice(weighting, "weighting", ("background", "plain")),
               vertical=_choice(vertical, "vertical", ("auto", "none")),
               cap_mass_ratio=_number_option(more["cap_mass_ratio"], "cap_mass_ratio"),
-              fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"), **opts)
+              fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"),
+              friction=_friction(more["friction"]), **opts)
     if limit is not None:
         kw["limit"] = _number_option(limit, "limit")
         if not 0.0 < kw["limit"] <= 1.0:
@@ -444,6 +449,7 @@ def run_plan(plan) -> DesignRun:
     """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments)."""
     from .batch.runner import run
 
+    _check_bodies(plan.columns, plan.options)
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
     from .batch.peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
@@ -462,6 +468,24 @@ def run_plan(plan) -> DesignRun:
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
                      summary.n_failed, None if plan.out is None else summary.out)
+
+
+def _friction(value):
+    """``friction=``: None, or a friction coefficient checked as ``--friction`` is."""
+    from .args import parse_friction
+
+    if value is not None and not _is_number(value):
+        raise TypeError(f"friction: expected a number (a friction coefficient), got {type(value).__name__}")
+    return None if value is None else parse_friction(repr(float(value)))
+
+
+def _check_bodies(columns, options) -> None:
+    """A rocking frame (``cap_mass_ratio``) of other than rectangular columns: an argument error."""
+    from .args import ArgumentError
+
+    if options.cap_mass_ratio and any(c.body != "rectangular" for c in columns):
+        raise ArgumentError("--cap-mass-ratio: rocking frames are modelled for rectangular "
+                            "columns only; give the circular columns (cyl:) without it")
 
 
 @contextlib.contextmanager
