@@ -1,7 +1,7 @@
 """Bodies other than the rectangular block (rocking.bodies, docs/theory.md "Bodies").
 
 References: the moment of inertia of a solid cylinder about an edge of its base, written out here
-from the parallel-axis theorem (not the module's ``4/3 - sin^2(alpha)/12``), with
+from the parallel-axis theorem (not the module's ``4/3 - sin^2(alpha)/12``; docs/theory.md, "Bodies"), with
 ``p^2 = m g R / I_o`` and Housner's ``eta = 1 - 2 m R^2 sin^2(alpha) / I_o``; the rectangular
 block itself for a body given its own ``I_o``, ``R`` and ``alpha``.
 """
@@ -30,7 +30,7 @@ def _cylinder(H, D, m=3.7):
 def test_cylinder_p_and_eta(H, D):
     I_o, R, alpha, m = _cylinder(H, D)
     drum = rocking.Block.from_dimensions(H, D, body="cylinder")
-    assert I_o == pytest.approx(m * (5 * D**2 / 16 + H**2 / 3), rel=1e-14)   # SPEC's I_o
+    assert I_o == pytest.approx(m * (5 * D**2 / 16 + H**2 / 3), rel=1e-14)   # the theory's I_o
     assert drum.p == pytest.approx(math.sqrt(m * G * R / I_o), rel=1e-14)
     assert drum.eta == pytest.approx(1.0 - 2.0 * m * R**2 * math.sin(alpha) ** 2 / I_o, rel=1e-14)
     assert drum.alpha == math.atan2(D, H) and drum.R == pytest.approx(R, rel=1e-14)

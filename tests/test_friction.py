@@ -70,7 +70,8 @@ def test_impulse_ratio_at_impact(body):
     need = friction_demand(rocking.simulate(block, rec), rec)
     assert need.impacts.size > 0 and need.impulse_ratio == pytest.approx(ref, rel=1e-12)
     if body == "rect":
-        # SPEC's 0.1775 is the ratio at eta rounded to 0.9183 (exact Eq. 5: 0.177445)
+        # 0.1775, as the statement of the issue gives it, is the ratio at eta rounded to 0.9183
+        # (with Eq. 5 exactly: 0.177445, docs/theory.md "Friction")
         assert round(impulse_ratio(round(block.eta, 4), block.alpha), 4) == 0.1775
         assert need.impulse_ratio == pytest.approx(0.1774448, abs=1e-7)
 
