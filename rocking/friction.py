@@ -222,6 +222,15 @@ class FrictionDemand:
         Impact times (s): where :attr:`impulse_ratio` is asked of the base.
     body, restitution : str
         Which model answered: the body's shape and ``eta``.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> pulse = pulses.OneSine(0.5 * pulses.G, 1.0)
+    >>> need = rocking.friction_demand(rocking.simulate(column, pulse), pulse)
+    >>> round(need.max_demand, 3), need.body, need.t.shape == need.demand.shape
+    (0.3, 'rectangular', True)
     """
 
     t: np.ndarray = field(repr=False)
@@ -266,6 +275,15 @@ class FrictionCheck:
 
     ``slides``: the demand exceeds ``mu`` at some instant (``t_slide``, the first; ``how``:
     ``"rocking"``, ``"at rest"`` or ``"at an impact"``); ``lifts_off``: the normal force reaches 0.
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8)
+    >>> pulse = pulses.Rectangular(0.5 * pulses.G, 1.0)
+    >>> check = rocking.friction_demand(rocking.simulate(column, pulse), pulse).judge(0.3)
+    >>> check.slides, check.how, check.describe()
+    (True, 'rocking', 'slides at 0 s, rocking (mu 0.3)')
     """
 
     mu: float
@@ -326,6 +344,15 @@ def friction_demand(result, excitation=None, *, vertical: Record | None = None) 
     Returns
     -------
     FrictionDemand
+
+    Examples
+    --------
+    >>> import pulses, rocking
+    >>> drum = rocking.Block.from_dimensions(7.5, 1.8, body="cylinder")
+    >>> pulse = pulses.Rectangular(0.6 * pulses.G, 1.0)
+    >>> need = rocking.friction_demand(rocking.simulate(drum, pulse), pulse)
+    >>> round(need.uplift_demand, 4), round(need.min_normal, 3)
+    (0.3239, 0.867)
     """
     block = getattr(result, "block", None)
     t = np.asarray(getattr(result, "t", ()), dtype=float)

@@ -60,6 +60,15 @@ class RestitutionFit:
         Each impact's own ``eta`` (successive peaks' energy ratio, or velocity ratio).
     times : ndarray
         Times (s) of the peaks (or impacts) used.
+
+    Examples
+    --------
+    >>> import rocking
+    >>> block = rocking.Block.from_dimensions(1.0, 0.25, eta=0.9)
+    >>> test = rocking.simulate(block, None, theta0=0.7 * block.alpha, duration=10.0)
+    >>> fit = rocking.fit_restitution(test.t, test.theta, alpha=block.alpha)
+    >>> round(fit.r, 4), fit.as_restitution(band=None)
+    (0.81, Restitution('eta=0.9'))
     """
 
     eta: float
@@ -110,6 +119,15 @@ def fit_restitution(t, theta, alpha: float | None = None, *, method: str = "peak
     Returns
     -------
     RestitutionFit
+
+    Examples
+    --------
+    >>> import rocking
+    >>> block = rocking.Block.from_dimensions(1.0, 0.25, eta=0.8)
+    >>> test = rocking.simulate(block, None, theta0=0.8 * block.alpha, duration=6.0)
+    >>> fit = rocking.fit_restitution(test.t, test.theta, alpha=block.alpha)
+    >>> round(fit.eta, 4), fit.n >= 3
+    (0.8, True)
     """
     t, theta = np.asarray(t, dtype=float).ravel(), np.asarray(theta, dtype=float).ravel()
     if t.size != theta.size or t.size < 4 * WINDOW or not np.all(np.diff(t) > 0):
