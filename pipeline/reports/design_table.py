@@ -424,7 +424,20 @@ def verdict_lines(rows) -> list[str]:
         over = _count(group, "eq31_width_overturns")
         out.append(f"Eq. 31 is below the design width on {below} of {n} record(s); its design "
                    f"overturns under {over}.")
+        out += _friction_line(column, group)
     return out
+
+
+def _friction_line(column, group) -> list[str]:
+    """With ``--friction``: how many records make the column slide (outside the model)."""
+    judged = [r for r in group if r.get("slides") is not None]
+    if not judged:
+        return []
+    demand = max((number(r.get("friction_demand")) or 0.0) for r in judged)
+    n = _count(judged, "slides")
+    return [f"Friction, column {display(column)}: {n} of {len(judged)} record(s) make it slide "
+            f"(as it stands or at its design width: outside the rocking model, see validity); "
+            f"the rocking needs up to {demand:.3g}."]
 
 
 def check_reach_words() -> str:
