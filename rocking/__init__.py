@@ -27,7 +27,7 @@ _WHERE = {
     "FIT_TOLERANCE": "governing", "GoverningPulse": "governing", "fitting_candidates": "governing",
     "governing_pulse": "governing",
     "FrictionCheck": "friction", "FrictionDemand": "friction", "friction_demand": "friction",
-    "Body": "bodies", "RestitutionFit": "restitution_fit", "fit_restitution": "restitution_fit",
+    "SlidingWidth": "sliding", "sliding_width": "sliding", "Body": "bodies", "RestitutionFit": "restitution_fit", "fit_restitution": "restitution_fit",
 }
 
 __all__ = sorted(_WHERE)

@@ -21,7 +21,8 @@ import pytest
 import pulses
 import rocking
 from pulses import G
-from rocking.friction import friction_demand, impulse_ratio, sliding_width, uplift_demand
+from rocking.friction import friction_demand, impulse_ratio, uplift_demand
+from rocking.sliding import sliding_width
 
 from .conftest import shared_record
 

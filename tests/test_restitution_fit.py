@@ -3,7 +3,6 @@ simulates with a known restitution (sampled as a test would: a zero ground motio
 sampling interval carries the block from its release tilt), with and without noise."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest

@@ -9,7 +9,6 @@ import json
 import math
 from importlib.resources import files
 
-import numpy as np
 import pytest
 
 import pulses

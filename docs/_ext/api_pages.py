@@ -44,7 +44,8 @@ THEMES = {
                                                   "Fragility"]),
         ("Rocking frames", ["frame_p", "eta_frame", "equivalent_size"]),
         ("Where the model holds: friction, bodies, a measured restitution",
-         ["friction_demand", "FrictionDemand", "FrictionCheck", "Body", "fit_restitution",
+         ["friction_demand", "FrictionDemand", "FrictionCheck", "sliding_width", "SlidingWidth",
+          "Body", "fit_restitution",
           "RestitutionFit"]),
     ]),
     "pipeline": ("pipeline: the command line and batches from Python", [

@@ -5,7 +5,7 @@ stay inside it: the friction they need against ``--friction MU``, and lift-off w
 Without ``--friction`` the friction demand is reported, not judged.  With it, a response whose
 demand exceeds ``MU`` slides (outside the model) and the row says when; a design width is valid
 only where the column at that width does not slide, and the row gives the narrowest width from it
-up that does not (``rocking.friction.sliding_width``), or says that none does.
+up that does not (``rocking.sliding_width``), or says that none does.
 """
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def fields(col, block, record, up, design, gamma, mu, eq31_block, cache):
 def _design(col, design, record, up, gamma, mu, eq31_block) -> dict:
     """The design width's (and the Eq. 31 design's) friction demand and verdicts."""
     import rocking
-    from rocking.friction import sliding_width
+    from rocking.sliding import sliding_width
 
     width = float(design.width)
     block = rocking.Block.from_dimensions(col.height, width, cap_mass_ratio=gamma, body=col.body)

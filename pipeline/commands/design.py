@@ -83,7 +83,7 @@ def _friction(block, height, width, body, pulse, mu) -> dict:
     """The friction the column as it stands and the exact design need under the pulse; with
     ``mu``, the verdicts and the narrowest width from the exact design up that does not slide."""
     import rocking
-    from rocking.friction import sliding_width
+    from rocking.sliding import sliding_width
 
     out = {"mu": mu}
     design = rocking.Block.from_dimensions(height, width, body=body)
