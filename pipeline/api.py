@@ -62,13 +62,13 @@ def _many(value, *, pair_is_one: bool = False):
 
 def _column(block):
     """A :class:`pipeline.batch.tasks.Column` (height, width) from one of the accepted forms."""
-    from .args import parse_block
+    from .args import parse_block, parse_column_block
     from .batch.tasks import Column
 
     if isinstance(block, Column):  # the command line's own, already checked
         return block
     if isinstance(block, str):
-        return Column(*parse_block(block))
+        return Column(*parse_column_block(block))
     if isinstance(block, tuple) and len(block) == 2 and all(map(_is_number, block)):
         return Column(*parse_block(f"{float(block[0])!r}x{float(block[1])!r}"))
     from rocking import Block
@@ -77,7 +77,8 @@ def _column(block):
         if block.height is None or block.width is None:
             raise ValueError("blocks: a rocking.Block with its full height and width (made by "
                              "Block.from_dimensions), not only p and alpha")
-        return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"))
+        return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"),
+                      block.body.kind)
     raise TypeError(f"blocks: expected {_COLUMN_FORMS}; got {type(block).__name__} {block!r:.60}")
 
 
@@ -326,7 +327,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         is missing or cannot be read is a row of :attr:`DesignRun.failures`, not an exception.
     blocks : Block, str, (float, float) or a list of them
         Columns as they stand: a :class:`rocking.Block`, ``"HxW"`` (full height x full width, m,
-        e.g. ``"7.5x1.8"``) or ``(height, width)`` in m.  ``pipeline run --block``.
+        e.g. ``"7.5x1.8"``; ``"cyl:HxD"`` a circular column of diameter D) or ``(height, width)``
+        in m.  ``pipeline run --block``.
     heights : float or list of float
         Heights (m) of columns whose width is only to be sized.  ``--height``.
     pairs : {"none", "auto"} or list of (A, B) or (A, B, V)
@@ -367,10 +369,9 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``; and risk at a site (docs/risk.md): ``hazard`` (a hazard file or a
-        :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)), ``site_row``, ``imt``,
-        ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe`` (``"2%/50"``),
-        ``risk_seed``: :attr:`DesignRun.risk`.
+        ``glob``, ``friction`` (docs/validity.md); risk at a site (docs/risk.md): ``hazard`` (a file
+        or a :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)), ``site_row``, ``imt``,
+        ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe`` (``"2%/50"``), ``risk_seed``.
 
     Returns
     -------
@@ -417,7 +418,7 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
          "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None,
          "hazard": None, "site": None, "site_row": None, "imt": None, "hazard_units": None, "years": 50,
-         "age": None, "target_rate": None, "target_poe": None, "risk_seed": 0}
+         "age": None, "target_rate": None, "target_poe": None, "risk_seed": 0, "friction": None}
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
@@ -453,7 +454,8 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
               cap_mass_ratio=parse_cap_mass_ratio(number(more["cap_mass_ratio"], "cap_mass_ratio"), "cap_mass_ratio"),
               fragility=_flag(more["fragility"], "fragility"),
               up_to=parse_up_to(number(more["up_to"], "up_to"), "up_to"),
-              limit=None if limit is None else parse_limit(number(limit, "limit"), "limit"), **opts)
+              limit=None if limit is None else parse_limit(number(limit, "limit"), "limit"),
+              friction=_friction(more["friction"]), **opts)
     kw["risk"] = _risk(more)
     if more["dask"] is not None and not isinstance(more["dask"], str):
         raise TypeError(f"dask: expected 'local' or a scheduler address such as 'tcp://HOST:8786', "
@@ -569,6 +571,7 @@ def run_plan(plan) -> DesignRun:
 def _run_plan(plan) -> DesignRun:
     from .batch.runner import run
 
+    _check_bodies(plan.columns, plan.options)
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
     from .batch.peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
@@ -607,6 +610,24 @@ def _check_dask(address) -> None:
         from .batch.scheduler import check_address
 
         check_address(address)
+
+
+def _friction(value):
+    """``friction=``: None, or a friction coefficient checked as ``--friction`` is."""
+    from .args import parse_friction
+
+    if value is not None and not _is_number(value):
+        raise TypeError(f"friction: expected a number (a friction coefficient), got {type(value).__name__}")
+    return None if value is None else parse_friction(repr(float(value)))
+
+
+def _check_bodies(columns, options) -> None:
+    """A rocking frame (``cap_mass_ratio``) of other than rectangular columns: an argument error."""
+    from .args import ArgumentError
+
+    if options.cap_mass_ratio and any(c.body != "rectangular" for c in columns):
+        raise ArgumentError("--cap-mass-ratio: rocking frames are modelled for rectangular "
+                            "columns only; give the circular columns (cyl:) without it")
 
 
 @contextlib.contextmanager

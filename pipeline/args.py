@@ -244,6 +244,47 @@ def parse_block(text: str) -> tuple[float, float]:
     return height, width
 
 
+#: what a column's text may start with to name its body (``cyl:7.5x1.8``), and the body's kind
+#: (rocking.bodies); no prefix: the rectangular block
+BODY_PREFIXES = {"cyl": "cylinder", "cylinder": "cylinder", "rect": "rectangular",
+                 "rectangular": "rectangular"}
+
+
+def split_body(text, what: str = "--block") -> tuple[str, str]:
+    """``"cyl:7.5x1.8"`` -> ``("cylinder", "7.5x1.8")``; no prefix: ``("rectangular", text)``."""
+    head, sep, rest = str(text).strip().partition(":")
+    if not sep:
+        return "rectangular", str(text)
+    kind = BODY_PREFIXES.get(head.strip().lower())
+    if kind is None:
+        raise ArgumentError(f"{what} {text!r}: unknown body {head!r}; write cyl:HxD for a "
+                            "circular column or HxW for a rectangular one")
+    return kind, rest
+
+
+def parse_column_block(text) -> tuple[float, float, str]:
+    """``--block``: ``HxW`` (rectangular) or ``cyl:HxD`` (a solid circular column of diameter D
+    rocking in a plane) -> ``(height, width, body)``."""
+    kind, rest = split_body(text)
+    return (*parse_block(rest), kind)
+
+
+def parse_column_height(text) -> tuple[float, str]:
+    """``--height``: ``H`` or ``cyl:H`` -> ``(height, body)``."""
+    kind, rest = split_body(text, "--height")
+    return parse_length(rest, "--height (m)"), kind
+
+
+def parse_friction(text):
+    """``--friction MU``: a friction coefficient, 0 < MU <= 10; None when not given."""
+    if text is None:
+        return None
+    value = parse_positive(text, "--friction (a friction coefficient)")
+    if value > 10.0:
+        raise ArgumentError(f"--friction is a friction coefficient (about 0.1 to 1), got {text!r}")
+    return value
+
+
 def parse_length(text: str, what: str = "length (m)") -> float:
     """A column's size in m (``"6"`` or ``"6m"``), within :data:`SIZE_RANGE_M`."""
     try:

@@ -6,7 +6,7 @@ Short numpy functions with their units in their names' documentation, as pyrotd'
     Peak ground acceleration, g.
 :func:`pgv`
     Peak ground velocity, cm/s (the unit of hazard curves of PGV), after the baseline correction
-    of :mod:`pulses.baseline`.
+    of :mod:`pulses.fit.baseline`.
 :func:`sa`
     5 %-damped pseudo-spectral acceleration ``omega^2 max|u|``, g, of a linear oscillator of
     period ``T`` from rest.  The oscillator is integrated exactly for a ground acceleration that is
@@ -40,7 +40,7 @@ import re
 
 import numpy as np
 
-from .record import G
+from .units import G
 
 #: the measures and the units their values are given in (those of OpenQuake's and USGS's files)
 UNITS = {"PGA": "g", "PGV": "cm/s", "SA": "g"}
@@ -99,8 +99,8 @@ def pga(record) -> float:
 
 
 def pgv(record) -> float:
-    """Peak ground velocity of ``record``, cm/s (baseline-corrected, :func:`pulses.baseline.pgv`)."""
-    from .baseline import pgv as peak_velocity
+    """Peak ground velocity of ``record``, cm/s (baseline-corrected, :func:`pulses.fit.baseline.pgv`)."""
+    from .fit.baseline import pgv as peak_velocity
 
     acc, dt = _acc(record)
     return 100.0 * peak_velocity(acc, dt)
@@ -187,7 +187,7 @@ def sa(record, period, damping: float = DAMPING):
 def _histories(record, name, period, damping):
     """The time history whose peak is the measure: acceleration (g), velocity (cm/s) or the
     oscillator's pseudo-acceleration ``w^2 u`` (g)."""
-    from .baseline import corrected_velocity
+    from .fit.baseline import corrected_velocity
 
     acc, dt = _acc(record)
     if name == "PGA":

@@ -87,7 +87,7 @@ def test_sa_against_pyrotd(name):
 def test_pga_pgv_rotd():
     rec = pulses.read_record(shared_record("RSN77_SFERN_PUL164.AT2"))
     assert im.pga(rec) == pytest.approx(np.max(np.abs(rec.acc)) / pulses.G)
-    from pulses.baseline import pgv
+    from pulses.fit.baseline import pgv
 
     assert im.pgv(rec) == pytest.approx(100 * pgv(rec.acc, rec.dt))
     # the same component twice: the rotated motion is sqrt(2) cos(theta - 45 deg) times it, so

@@ -98,7 +98,8 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
         # the record's figure, and the barcode of the check above the search width where it
         # found failing widths; a figure not drawn this time is removed (an earlier run's)
         for name, data in ((report.record_plot_name(rid), res.get("plot")),
-                           (report.record_widths_plot_name(rid), res.get("widths_plot"))):
+                           (report.record_widths_plot_name(rid), res.get("widths_plot")),
+                           (report.record_friction_plot_name(rid), res.get("friction_plot"))):
             try:
                 if data:
                     outputs.write(name, data)
@@ -106,7 +107,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
                     outputs.remove(name)
             except OSError as exc:
                 problems.append(exc)
-    res["widths_plot"] = None
+    res["widths_plot"] = res["friction_plot"] = None
     res["plot"] = None  # thousands of records: keep only the rows in memory
     for exc in problems:
         say(f"pipeline run: {rid}: {report.display(exc)}")

@@ -122,19 +122,22 @@ def read_task(task):
     return record.scaled(task.scale) if task.scale != 1.0 else record
 
 
-def extra_fields(H, block, record, fitting, options, cache) -> dict:
-    """The envelope design and (``--fragility``) the critical scale of one row."""
+def extra_fields(H, block, record, fitting, options, cache, body="rectangular") -> dict:
+    """The envelope design and (``--fragility``) the critical scale of one row (a column of
+    ``body``'s shape, rocking.bodies)."""
     import rocking
 
     g = options.cap_mass_ratio
-    if ("envelope", H) not in cache:
+    key = ("envelope", H) if body == "rectangular" else ("envelope", H, body)
+    if key not in cache:
         widths = [float(rocking.required_width(H, c.pulse, rule="envelope", shape=c.shape,
-                                               cap_mass_ratio=g).width) for c in fitting]
+                                               cap_mass_ratio=g, body=body).width) for c in fitting]
         w = max(widths)
-        res = rocking.simulate(rocking.Block.from_dimensions(H, w, cap_mass_ratio=g), record)
-        cache[("envelope", H)] = ENVELOPE_COLUMNS.row({"envelope_width_m": w,
-                                                       "envelope_width_overturns": bool(res.overturned)})
-    fields = dict(cache[("envelope", H)])
+        res = rocking.simulate(rocking.Block.from_dimensions(H, w, cap_mass_ratio=g, body=body),
+                               record)
+        cache[key] = ENVELOPE_COLUMNS.row({"envelope_width_m": w,
+                                           "envelope_width_overturns": bool(res.overturned)})
+    fields = dict(cache[key])
     if not options.fragility or block is None:
         fields.update(FRAGILITY_COLUMNS.blank())
         return fields

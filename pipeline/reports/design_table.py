@@ -69,6 +69,16 @@ DESIGN_COLUMNS = Columns(
                                  "the directions: the block leaves the ground, which the rocking model "
                                  "does not describe (its own verdict, `lifts off at t s`); blank when "
                                  "it never does."),
+    ("body", "-", "The body that rocks: `rectangular` or `cylinder (planar rocking)` (`cyl:`)."),
+    ("friction_demand", "-", "The largest friction coefficient the rocking needs, over the "
+                             "directions, of the column as it stands and at its design width "
+                             "(max |F_x|/F_z, docs/theory.md \"Friction\")."),
+    ("slides", "-", "With `--friction MU`: the column as it stands or at its design width needs more "
+                    "than MU in some direction: it slides, outside the rocking model (`validity` "
+                    "says where and when); blank without `--friction`."),
+    ("validity", "-", "Which model answered and its checks in the governing direction (body, "
+                      "restitution, friction, lift-off with the vertical; `summary.csv` has "
+                      "every direction's)."),
 )
 #: with ``--hazard`` (pipeline.batch.risk): each column's answer at the site, in each of its rows
 RISK_COLUMNS = Columns(
@@ -175,9 +185,22 @@ def design_rows(rows, failed=None, risk=None) -> list[dict]:
                 [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
                  if t is not None], default=None)),
             **{k: (risk or {}).get(column, {}).get(k) for k in RISK_COLUMNS.names},
+            **_validity(group, gov),
         })
         out.append(row)
     return out
+
+
+def _validity(group, gov) -> dict:
+    """The design row's ``body``, ``friction_demand``, ``slides`` and ``validity``."""
+    demands = [number(r.get(k)) for r in group for k in ("friction_demand", "design_friction_demand")]
+    demands = [d for d in demands if d is not None]
+    judged = [r for r in group if number(r.get("friction_mu")) is not None]
+    slides = None
+    if judged:
+        slides = any(bool(r.get("slides")) or bool(r.get("design_slides")) for r in judged)
+    return {"body": gov.get("body"), "friction_demand": max(demands) if demands else None,
+            "slides": slides, "validity": gov.get("validity")}
 
 
 def design_csv(rows, failed=None) -> str:
@@ -412,6 +435,7 @@ def verdict_lines(rows) -> list[str]:
                         + f", {safe} leave it on a safe island"))
         out.append(line + risk_words(gov))
         out.append(eq31_line(group))
+        out += _friction_line(column, group)
     return out
 
 
@@ -457,6 +481,18 @@ def risk_words(row) -> str:
     if width is not None:
         text += f"; the width for the site's target rate is {width:.3f} m"
     return text
+
+
+def _friction_line(column, group) -> list[str]:
+    """With ``--friction``: how many records make the column slide (outside the model)."""
+    judged = [r for r in group if r.get("slides") is not None]
+    if not judged:
+        return []
+    demand = max((number(r.get("friction_demand")) or 0.0) for r in judged)
+    n = _count(judged, "slides")
+    return [f"Friction, column {display(column)}: {n} of {len(judged)} record(s) make it slide "
+            f"(as it stands or at its design width: outside the rocking model, see validity); "
+            f"the rocking needs up to {demand:.3g}."]
 
 
 def check_reach_words() -> str:

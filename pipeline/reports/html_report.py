@@ -160,7 +160,7 @@ def _batch_table(design, anchors) -> list[str]:
     return out
 
 
-def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
+def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str]:
     first = rows[0] if rows else {}
     out = [f'<section class="rec" id="{anchor}"><h3>{_e(rid)}</h3>']
     if first:
@@ -228,12 +228,16 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                             "model stops there, no verdict)")
                     parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): {said}"
                                  + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}")
+            if r.get("validity"):
+                parts.append(f"model: {r['validity']}")
             out.append(f"<li>{_e('; '.join(parts))}</li>")
         out.append("</ul>")
     if failure:
         out.append(f'<p class="muted">failed ({_e(failure["stage"])}): {_e(failure["reason"])}</p>')
     if plot:
         out.append(f'<p><img src="{_href(plot)}" alt="{_e(rid)}: record, pulses and rotation histories"></p>')
+    if friction:
+        out.append(f'<p><a href="{_href(friction)}">the friction its responses need against time</a></p>')
     out.append("</section>")
     return out
 
@@ -310,10 +314,11 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
         out.append("<h2>Batch figures</h2>")
         for k, label in site:
             out.append(f"<h3>{_e(label)}</h3><p><img src=\"{_href(figures[k])}\" alt=\"{_e(label)}\"></p>")
+    out += _validity_section(rows, figures)
     out.append(f"<h2>Records ({n_ok} processed)</h2>")
     for rid in record_ids:
         out += _record_section(rid, by_record.get(rid, []), failed.get(rid), figures.get(("record", rid)),
-                               anchors[rid])
+                               anchors[rid], friction=figures.get(("friction", rid)))
     out.append(f"<script>{_JS}</script></body></html>")
     return "\n".join(out) + "\n"
 
@@ -332,5 +337,29 @@ def figures_in(out, record_ids, plots: bool, names: dict) -> dict:
         rel = report.record_plot_name(rid)
         if (out / rel).is_file():
             found[("record", rid)] = rel
+        rel = report.record_friction_plot_name(rid)
+        if (out / rel).is_file():
+            found[("friction", rid)] = rel
     return found
+
+
+def _validity_section(rows, figures) -> list[str]:
+    """Where the model holds: the governing record's (the widest design width's) checks and the
+    friction its responses need against time."""
+    judged = [r for r in rows if r.get("validity")]
+    if not judged:
+        return []
+    gov = max(judged, key=lambda r: _num(r.get("design_width_m")) or 0.0)   # first of the widest
+    rid = gov["record"]
+    out = ['<h2 id="validity">Where the rocking model holds</h2>',
+           f"<p>Governing record {_e(rid)} (column {_e(gov.get('column'))}, the widest design "
+           f"width, {_fixed(gov.get('design_width_m')) or '-'} m): {_e(gov['validity'])}.</p>"]
+    failed = [r for r in judged if "FAILED" in str(r.get("validity"))]
+    if failed:
+        out.append(f"<p><b>{len(failed)} of {len(judged)} rows leave the model</b> (friction or "
+                   "lift-off; their `validity` says which and when).</p>")
+    if figures.get(("friction", rid)):
+        out.append(f'<p><img src="{_href(figures[("friction", rid)])}" alt="{_e(rid)}: friction '
+                   'needed against time"></p>')
+    return out
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from . import design_table, html_report
 from .report import (COLUMNS_MD, FAILURES, FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, MANIFEST,
                      PAIRS_CSV, RESUME, SUITE_CSV, SUITE_PLOT, SUMMARY, SUMMARY_PLOT, record_csv_name,
-                     record_plot_name, record_widths_plot_name)
+                     record_friction_plot_name, record_plot_name, record_widths_plot_name)
 
 
 def site_files(plots: bool, fragility: bool) -> list[str]:
@@ -50,7 +50,8 @@ def fixed_files(options) -> list[str]:
 def record_files(record_id: str, plots: bool = True) -> list[str]:
     """A record's own report, and with ``plots`` its figures."""
     names = [record_csv_name(record_id)]
-    return names + ([record_plot_name(record_id), record_widths_plot_name(record_id)] if plots else [])
+    return names + ([record_plot_name(record_id), record_widths_plot_name(record_id),
+                     record_friction_plot_name(record_id)] if plots else [])
 
 
 def own_files(tasks, options) -> list[str]:

@@ -423,6 +423,11 @@ def record_widths_plot_name(record_id: str) -> str:
     return f"plots/widths/{record_id}.png"
 
 
+def record_friction_plot_name(record_id: str) -> str:
+    """Path of a record's figure of the friction its responses need (a folder of its own)."""
+    return f"plots/friction/{record_id}.png"
+
+
 def columns_markdown(columns, failure_columns) -> str:
     """``columns.md``: the files of the output folder and every column of the reports.
 
