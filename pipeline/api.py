@@ -241,6 +241,8 @@ class DesignRun:
     out: pathlib.Path | None = None
     #: the run's own figures that could not be written (a full disk ...), left out
     n_unwritten: int = 0
+    #: ``risk.csv`` (``hazard=``): each column's rate at the site and the width for the target
+    risk_rows: list = field(default_factory=list)
 
     @property
     def exit_code(self) -> int:
@@ -276,12 +278,19 @@ class DesignRun:
 
         return _frame(self.suite_rows, list(SUITE_COLUMNS.names))
 
+    @property
+    def risk(self):
+        """``risk.csv`` as a DataFrame (``hazard=``; empty without)."""
+        from rocking.risk.rows import RISK_COLUMNS
+
+        return _frame(self.risk_rows, list(RISK_COLUMNS.names))
+
     def as_dict(self) -> dict:
         """The tables as lists of plain rows (JSON-safe: NaN and infinities as None)."""
         from pulses.export import plain
 
         return plain({"design": self.design_rows, "summary": self.summary_rows,
-                      "failures": self.failure_rows, "suite": self.suite_rows,
+                      "failures": self.failure_rows, "suite": self.suite_rows, "risk": self.risk_rows,
                       "n_records": self.n_records, "n_failed": self.n_failed,
                       "out": None if self.out is None else str(self.out)})
 
@@ -358,7 +367,10 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``.
+        ``glob``; and risk at a site (docs/risk.md): ``hazard`` (a hazard file or a
+        :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)), ``site_row``, ``imt``,
+        ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe`` (``"2%/50"``),
+        ``risk_seed``: :attr:`DesignRun.risk`.
 
     Returns
     -------
@@ -403,7 +415,9 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
 
 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
-         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None}
+         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None,
+         "hazard": None, "site": None, "site_row": None, "imt": None, "hazard_units": None, "years": 50,
+         "age": None, "target_rate": None, "target_poe": None, "risk_seed": 0}
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
@@ -440,6 +454,7 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
               fragility=_flag(more["fragility"], "fragility"),
               up_to=parse_up_to(number(more["up_to"], "up_to"), "up_to"),
               limit=None if limit is None else parse_limit(number(limit, "limit"), "limit"), **opts)
+    kw["risk"] = _risk(more)
     if more["dask"] is not None and not isinstance(more["dask"], str):
         raise TypeError(f"dask: expected 'local' or a scheduler address such as 'tcp://HOST:8786', "
                         f"got {type(more['dask']).__name__}")
@@ -451,6 +466,26 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
         scales=_path_option(more["scales"], "scales"), peer_scales=_flag(more["peer_scales"], "peer_scales"),
         jobs=_jobs(jobs), out=out, force=_flag(force, "force"), quiet=_flag(quiet, "quiet"),
         dask=more["dask"], log=_path_option(more["log"], "log"), glob=_text_option(more["glob"], "glob"))
+
+
+def _risk(more):
+    """``hazard=`` and its options, checked (pipeline.batch.risk.RiskOptions), or None."""
+    from .batch import risk
+
+    if more["hazard"] is None:
+        given = [k for k in ("site", "site_row", "imt", "hazard_units", "age", "target_rate", "target_poe")
+                 if more[k] is not None]
+        if given:
+            raise ValueError(f"{given[0]} needs hazard= (the site's hazard curve)")
+        return None
+    try:
+        return risk.risk_options(more["hazard"], site=more["site"], site_row=more["site_row"],
+                                 imt=more["imt"], units=more["hazard_units"], years=more["years"],
+                                 age=more["age"], target_rate=more["target_rate"],
+                                 target_poe=more["target_poe"], seed=more["risk_seed"],
+                                 restitution=more.get("restitution"))
+    except ArgumentError as exc:
+        raise ValueError(str(exc)) from None
 
 
 @dataclass
@@ -557,7 +592,8 @@ def _run_plan(plan) -> DesignRun:
 
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
-                     summary.n_failed, None if plan.out is None else summary.out, summary.n_unwritten)
+                     summary.n_failed, None if plan.out is None else summary.out, summary.n_unwritten,
+                     t.get("risk", []))
 
 
 def _check_dask(address) -> None:

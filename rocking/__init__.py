@@ -24,6 +24,7 @@ _WHERE = {
     "equivalent_size": "frame", "eta_frame": "frame", "frame_p": "frame",
     "CriticalScale": "fragility", "Fragility": "fragility", "critical_scale": "fragility",
     "fragility": "fragility",
+    "risk": "risk", "HazardCurve": "risk", "read_hazard": "risk",
     "FIT_TOLERANCE": "governing", "GoverningPulse": "governing", "fitting_candidates": "governing",
     "governing_pulse": "governing",
 }

@@ -17,7 +17,7 @@ from ..reports import design_table, figures, html_report, outfiles, report
 
 from .. import interrupts
 
-from . import joblog, outlock, passes, resume, site
+from . import joblog, outlock, passes, resume, risk, site
 from ..args import ArgumentError, output_folder
 from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from . import executors
@@ -238,14 +238,15 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         except report.NotOurs as exc:
             say(f"pipeline run: note: {exc}")
     with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
-        design, rows, problems = _write_tables(outputs, out, tasks, header, text, failures, failed, options,
-                                               render, say)
+        design, rows, problems, risk_rows = _write_tables(outputs, out, tasks, header, text, failures,
+                                                          failed, options, render, jobs=jobs, say=say)
     journal.finish([t.record_id for t in tasks],
                    {p: [tasks[i].record_id for i in ix] for p, ix in by_pair.items()})
     n_failed = len(failures)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, len(tasks) - len(computed),
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else [])},
+                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else []),
+                          "risk": risk_rows},
                          problems)
     if not quiet:
         _print_end(summary, tasks, failed, len(computed), design, failures, rows)
@@ -475,37 +476,42 @@ class _Figures:
                 self.outputs.remove(rel)
 
 
-def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None, say=print):
+def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None, jobs=1,
+                  say=print):
     """Write the run's own files from every record's rows (``text``: summary.csv's rows as the records'
-    reports hold them, below ``header``); return the design rows, the rows of summary.csv and how
-    many figures could not be written."""
+    reports hold them, below ``header``); return the design rows, the rows of summary.csv, how
+    many figures could not be written and the rows of risk.csv."""
     outputs = _Figures(outputs, say)
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
-                  + site.columns_markdown() + design_table.columns_markdown())
+                  + site.columns_markdown() + design_table.columns_markdown()
+                  + (risk.columns_markdown() if options.risk is not None else ""))
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed, render)
+    answers, risk_rows = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
     if options.plots and rows:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
     elif options.plots:  # every record failed: no empty figures
         for rel in (report.SUMMARY_PLOT, report.SUITE_PLOT, report.FRAGILITY_PLOT):
             outputs.drop(rel)
-    design = write_answer(outputs, out, tasks, rows, failures, failed, options)
+    design = write_answer(outputs, out, tasks, rows, failures, failed, options, answers)
     outputs.finish()
-    return design, rows, outputs.problems
+    return design, rows, outputs.problems, risk_rows
 
 
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------
-def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
-    """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
-    design = design_table.design_rows(rows, failed)
+def write_answer(outputs, out, tasks, rows, failures, failed, options, answers=None) -> list[dict]:
+    """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run).
+    ``answers``: each column's risk at the site (pipeline.batch.risk.write_outputs)."""
+    design = design_table.design_rows(rows, failed, answers)
     outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.DESIGN_FIELDS, design))
     ids = [t.record_id for t in tasks]
     this_run = set(outfiles.fixed_files(options))  # a figure of an earlier run with other options is not shown
     names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", report.SUITE_PLOT),
-                                   ("fragility", report.FRAGILITY_PLOT)) if k == "summary" or rel in this_run}
+                                   ("fragility", report.FRAGILITY_PLOT), ("risk_widths", risk.RISK_WIDTHS_PLOT),
+                                   ("risk_disaggregation", risk.RISK_DISAGG_PLOT)) if k == "summary" or rel in this_run}
     figures = html_report.figures_in(out, ids, options.plots, names)
     outputs.write(html_report.REPORT_HTML, html_report.report_html(design, rows, failures, ids, figures))
     return design

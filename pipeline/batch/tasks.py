@@ -56,6 +56,9 @@ class Options:
     #: ``--thorough``: every direction of a pair gets the check above its search width and
     #: (with plots) its figures, as a lone record does (pipeline.batch.passes)
     thorough: bool = False
+    #: ``--hazard`` and its options (pipeline.batch.risk.RiskOptions), used after the batch only: kept
+    #: out of the records' resume keys (repr) and comparisons, so a record's work is reused whatever the curve
+    risk: object = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)

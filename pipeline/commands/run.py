@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..batch import peer_inputs, site, vertical
+from ..batch import peer_inputs, risk, site, vertical
 from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, jobs_count, parse_block,
                    parse_length, parse_shapes, record_options)
 
@@ -80,6 +80,7 @@ def add_parser(subparsers) -> None:
     site.add_options(p)
     peer_inputs.add_options(p)
     vertical.add_options(p)
+    risk.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -125,7 +126,8 @@ def main(args) -> int:
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
     options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
-                           vertical=args.vertical, **record_options(args), **site.options_from_args(args))
+                           vertical=args.vertical, **record_options(args), **site.options_from_args(args),
+                           risk=risk.options_from_args(args))
     plan = api.Plan(records=list(args.records), columns=columns, options=options, record_opts=record_options(args),
                     pairs=args.pairs, pair=list(args.pair),
                     triplets={(str(a), str(b)): str(v) for a, b, v in args.triplet},

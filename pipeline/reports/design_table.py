@@ -70,6 +70,18 @@ DESIGN_COLUMNS = Columns(
                                  "does not describe (its own verdict, `lifts off at t s`); blank when "
                                  "it never does."),
 )
+#: with ``--hazard`` (pipeline.batch.risk): each column's answer at the site, in each of its rows
+RISK_COLUMNS = Columns(
+    ("site_rate_per_year", "1/yr", "`--hazard`: the column as it stands: annual rate of overturning "
+                                   "at the site (the suite's fragility against the hazard curve; "
+                                   "with `--limit`, of exceeding the level; `risk.csv`), the same in "
+                                   "every row of the column."),
+    ("target_width_m", "m", "`--target-rate`/`--target-poe`: the narrowest width whose rate at the "
+                            "site meets the target (`risk.csv`), beside the record-by-record "
+                            "`design_width_m`; the same in every row of the column (the target "
+                            "is in `risk.csv`)."),
+)
+DESIGN_COLUMNS = Columns(*DESIGN_COLUMNS.columns, *RISK_COLUMNS.columns)
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
 
 
@@ -120,9 +132,10 @@ def _meets(r, limit):
     return (not r["overturns"]) and (limit is None or (ratio is not None and ratio <= limit))
 
 
-def design_rows(rows, failed=None) -> list[dict]:
+def design_rows(rows, failed=None, risk=None) -> list[dict]:
     """The rows of ``design.csv`` from the rows of ``summary.csv`` (dicts of typed values) and
-    ``failed`` (``{pair: directions that failed}``)."""
+    ``failed`` (``{pair: directions that failed}``); ``risk``: ``{column: its answer at the site}``
+    (pipeline.batch.risk.answer_fields), blank without."""
     out = []
     for (pair, column), group in _groups(rows).items():
         gov = max(group, key=lambda r: number(r.get("design_width_m")) or -math.inf)  # first of equals
@@ -161,6 +174,7 @@ def design_rows(rows, failed=None) -> list[dict]:
             "vertical_lift_off_s": (None if not block else min(
                 [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
                  if t is not None], default=None)),
+            **{k: (risk or {}).get(column, {}).get(k) for k in RISK_COLUMNS.names},
         })
         out.append(row)
     return out
@@ -396,7 +410,7 @@ def verdict_lines(rows) -> list[str]:
                      + ("passes: it survives every record" if not (safe or fails) and top <= number(gov["width_m"])
                         else f"FAILS: {fails} record(s) overturn it" + ("" if limit is None else " or exceed the level")
                         + f", {safe} leave it on a safe island"))
-        out.append(line)
+        out.append(line + risk_words(gov))
         out.append(eq31_line(group))
     return out
 
@@ -431,6 +445,18 @@ def governing_print(rows, summary) -> str | None:
             "of its), the one whose Eq. 31 width is widest, since shapes that fit almost equally well "
             "can ask for very different columns; so it is not always the best fit "
             f"({len(others)} of {len(rows)} row(s) here: {shown}).")
+
+
+def risk_words(row) -> str:
+    """``; at the site it fails at 2.1e-04/yr; the width for the site's target rate is 2.140 m``
+    from a design row's risk columns ("" without ``--hazard``; risk.csv says more)."""
+    rate, width = (number(row.get(k)) for k in RISK_COLUMNS.names)
+    text = ""
+    if rate is not None:
+        text += f"; at the site it fails at {rate:.2e}/yr"
+    if width is not None:
+        text += f"; the width for the site's target rate is {width:.3f} m"
+    return text
 
 
 def check_reach_words() -> str:

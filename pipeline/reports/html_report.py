@@ -302,7 +302,10 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
         out.append("</tbody></table>")
     site = [(k, label) for k, label in (("summary", "Required against actual slenderness"),
                                         ("suite", "Suite: share of records whose design width a column of width B reaches"),
-                                        ("fragility", "Collapse fragility")) if figures.get(k)]
+                                        ("fragility", "Collapse fragility"),
+                                        ("risk_widths", "Risk at the site: annual rate of failure against the width"),
+                                        ("risk_disaggregation", "Risk at the site: where the rate comes from"))
+            if figures.get(k)]
     if site:
         out.append("<h2>Batch figures</h2>")
         for k, label in site:
