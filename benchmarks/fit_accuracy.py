@@ -1,4 +1,4 @@
-"""Accuracy of the pulse fitter on synthetic records: the error-against-noise tables of docs/fitting.md.
+"""Accuracy of the pulse fitter on synthetic records: the error-against-noise tables of docs/validation-fitting.md.
 
 ``python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain] [seed=K]`` prints a Markdown table (N
 records per shape, Tp and noise level; default 10, fixed seeds; with a noise band LOW-HIGH Hz,

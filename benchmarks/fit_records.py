@@ -1,4 +1,4 @@
-"""Fit every record in ../shared/records: the table of real records in docs/fitting.md.
+"""Fit every record in ../shared/records: the table of real records in docs/validation-fitting.md.
 
 ``python benchmarks/fit_records.py`` prints a Markdown table: for every record (the two-column
 text files once per column, in cm/s^2 at dt = 0.005 s as their comments and MANIFEST.md say), its

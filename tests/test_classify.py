@@ -197,7 +197,7 @@ def test_published_pulse_pairs(first, second, rsn):
     assert result.pgv * 100 == pytest.approx(float(row["pgv_cm_s"]), rel=0.01)
     if rsn == 879:
         # Lucerne's components are 85 deg apart; the reference algorithm (which treats them as
-        # orthogonal) gives about 75 deg, the table 270 (i.e. 90): not asserted, see docs/classification.md
+        # orthogonal) gives about 75 deg, the table 270 (i.e. 90): not asserted, see docs/validation-classification.md
         return
     assert _axis_difference(result.azimuth, float(row["orientation_north_deg"])) < 1.0
 

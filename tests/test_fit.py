@@ -7,7 +7,7 @@ better than that limit.  The issue's percentage floors are asserted where the li
 everywhere the scatter must stay at the limit and every miss must be a pulse that explains the
 record at least as well as the true one (the search did not fail; the data are ambiguous).
 
-Monte-Carlo counts are small (fixed seeds, a few seconds in all); docs/fitting.md has
+Monte-Carlo counts are small (fixed seeds, a few seconds in all); docs/validation-fitting.md has
 the full tables, from ``python benchmarks/fit_accuracy.py``.
 """
 from __future__ import annotations
@@ -237,7 +237,7 @@ def test_noise_15_percent():
 @pytest.mark.slow
 def test_noise_30_percent_shape():
     cases = _cases(0.30, (0.5, 1.0, 2.0, 5.0), 3, seed=30)
-    # right shape in 90 % for Tp >= 1 s; at 0.5 s the shapes are ambiguous in this noise (docs/fitting.md)
+    # right shape in 90 % for Tp >= 1 s; at 0.5 s the shapes are ambiguous in this noise (docs/validation-fitting.md)
     assert _share([c for c in cases if c["tp"] >= 1.0], lambda c: c["fit"].best.shape == c["shape"]) >= 0.9
     for c in cases:  # every miss is a pulse that explains the record at least as well as the truth
         assert c["fit"].best.score >= c["true_score"] - 1e-3
@@ -247,7 +247,7 @@ def test_noise_30_percent_shape():
 # -- weighted least squares ---------------------------------------------------------------------------
 @pytest.mark.slow
 def test_weighted_fit_pins_the_edges_in_a_band_the_readme_does_not_use():
-    # 15 % background in 0.8-12 Hz (the tables of docs/fitting.md use 0.5-10 and 0.1-25 Hz), pulses inside
+    # 15 % background in 0.8-12 Hz (the tables of docs/validation-fitting.md use 0.5-10 and 0.1-25 Hz), pulses inside
     # the band; the same records fitted both ways.  The one-sine's and rectangle's edges carry
     # energy above the band where the background has almost none: weighted by the background's
     # spectrum, their Tp is pinned (limit 0.02-0.5 % against 1-5 % plain), so the RMS Tp error
@@ -278,7 +278,7 @@ def test_weighted_fit_pins_the_edges_in_a_band_the_readme_does_not_use():
 
 @pytest.mark.slow
 def test_weighted_fit_of_short_cornered_pulses_in_a_wide_band():
-    # 0.2 s one-sines and rectangles in 15 % background of 0.1-25 Hz (seeds docs/fitting.md does not
+    # 0.2 s one-sines and rectangles in 15 % background of 0.1-25 Hz (seeds docs/validation-fitting.md does not
     # use).  Above 25 Hz the weights are about 4000 times those in the band, so the corners pin
     # the pulse to a fraction of a sample, and the weighted objective has a kink each time an edge
     # crosses a sample: a descent alone stopped in one a sample or two from the optimum
@@ -308,7 +308,7 @@ def test_weighted_fit_of_a_low_passed_record_keeps_the_pulse():
     # nor a one-sine's corners or a rectangle's edges, and a fit weighted by the (tiny) power
     # there would shrink the pulse to hide its corners.  One-sines and rectangles with 15 %
     # background (0.1-25 Hz), the whole record then low-passed at 10 Hz (4th-order Butterworth,
-    # zero phase; seeds docs/fitting.md does not use): Hausman's test refuses the winner's weighted
+    # zero phase; seeds docs/validation-fitting.md does not use): Hausman's test refuses the winner's weighted
     # fit, and the ranking guard keeps the weighting from overturning it, so the shape and ap stay
     # the plain fit's (measured on these 8: the plain fit answered every one).  Without the test
     # the fits shrank to 1-91 % of ap and every best shape became a Ricker.  Bar: shape right, ap
@@ -411,7 +411,7 @@ def test_a_fit_does_not_import_scipy_signal():
 
 @pytest.mark.slow
 def test_weighted_score_of_long_pulses():
-    # 5 s pulses in 40 s records, 30 % background in 0.5-10 Hz (seeds docs/fitting.md does not use).
+    # 5 s pulses in 40 s records, 30 % background in 0.5-10 Hz (seeds docs/validation-fitting.md does not use).
     # Weighted by the inverse of the background's spectrum, the record's energy is almost all
     # below 0.5 Hz, where a 5 s pulse has its energy and the background none: the true shape,
     # fitted to its noise limit (0.02-0.04 % on ap and Tp), explains nearly all of it (measured

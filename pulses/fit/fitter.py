@@ -123,7 +123,7 @@ def fit_pulse(record: Record, shapes=None, *, tp_range=None, baseline: bool = Tr
         record itself (generalised least squares, :class:`~pulses.fit.background.Background`), and rank the candidates
         by the share of the record's energy they explain in that metric.  More accurate ap and
         Tp, and the shape right more often, on synthetic records with band-limited background
-        motion; about twice the cost of the plain fit (README, "Accuracy on synthetic records").
+        motion; about twice the cost of the plain fit (docs/validation-fitting.md, "Accuracy on synthetic records").
         Where the weighting would overturn the plain ranking although the record does not
         follow the plain winner at the frequencies the weights favour (Hausman's test), the
         plain fit answers, and ``PulseFit.weighting`` says so.
