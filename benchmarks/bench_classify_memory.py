@@ -25,7 +25,7 @@ about 11 GB on a machine shared with other jobs.  What went: the (51, n) maps of
 and power (1.6 GB for one component, 2.4 GB for a pair at 2e6 samples), the filter spectra cached
 16 sets at a time (1.1 GB a set) and up to 4096 refined filters of up to 6 MB each; now the map
 is kept as four arrays of n and every filter cache is bounded in bytes
-(:data:`pulses.velocity.FILTER_CACHE_BYTES`, :data:`pulses.velocity.SPECTRUM_CACHE_BYTES`).  The
+(:data:`pulses.db4.FILTER_CACHE_BYTES`, :data:`pulses.db4.SPECTRUM_CACHE_BYTES`).  The
 candidates and their numbers are the same, bit for bit.
 """
 from __future__ import annotations

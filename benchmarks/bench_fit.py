@@ -35,7 +35,7 @@ def _time(fn, repeat, clock=time.perf_counter):
 def run(repeat: int = 30) -> dict:
     """Measure the fitter; returns ``{name: value}`` (times in ms)."""
     from pulses import fit_pulse, read_record
-    from pulses.synthetic import synthetic_record
+    from pulses.fit.synthetic import synthetic_record
 
     out = {"python": platform.python_version(), "machine": platform.machine()}
     rec = synthetic_record("sine", 5.0, 1.0, 7.3, 20.0, 0.005, noise=0.15, seed=1)

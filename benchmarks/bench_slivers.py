@@ -23,7 +23,7 @@ and prints, per ``(q, N)``: on the records where the dense grid finds a failing 
 ``1.01 w``, and on how many it found none; on every record where the dense grid finds any
 failure, how often the check finds one; the median ratio ``(widest found - w) / (dense widest -
 w)``.  It also prints the search's own runs per record (today's cost, the 4x budget's
-base).  The table in docs/slivers.md is this script's output.
+base).  The tables in docs/validation-slivers.md are this script's output.
 """
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ VARIANTS = {"uniform": dict(check_near=0.0, check_follow=0.0),
             "near": dict(check_near=0.5, check_follow=0.0),
             "all near": dict(check_near=1.0, check_follow=0.0),
             "near + stages (default)": {},
-            # the later stages' rule varied one setting at a time (docs/slivers.md)
+            # the later stages' rule varied one setting at a time (docs/validation-slivers.md)
             "power 2": dict(check_power=2.0), "power 4": dict(check_power=4.0),
             "50 bins": dict(check_bins=50), "200 bins": dict(check_bins=200),
             "10 stages": dict(check_stages=10), "first stage 1/3": dict(check_follow=2.0 / 3.0),

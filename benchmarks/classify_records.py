@@ -1,8 +1,8 @@
 """Velocity-pulse classification of every record and pair in ``../shared/records/raw``, next to
-Shahi & Baker's published values (docs/classification.md).
+Shahi & Baker's published values (docs/validation-classification.md).
 
 Run: ``PYTHONPATH=. python benchmarks/classify_records.py [RAW_DIR]`` (default
-``../shared/records/raw``).  Prints a Markdown table and a summary; the table of docs/classification.md is this
+``../shared/records/raw``).  Prints a Markdown table and a summary; the table of docs/validation-classification.md is this
 output.  Record numbers come from ``../shared/records/MANIFEST.md``; published values from
 ``../shared/notes/sb14_nga_west2_pulses.csv``.  Azimuths are the readers' (AT2 headers), and
 for the two-column text files the directions the manifest states.  The last columns compare the velocity pulse's Tp with the best fitted acceleration

@@ -214,7 +214,7 @@ def headline_record():
         rec = pulses.read_record(path, units="cm/s2", dt=0.005, column=1)
         return Record(rec.acc[:4001], 0.005, name="Rinaldi 228 (rinaldi.txt FN), first 20 s, 200 Hz")
     # fallback: a synthetic near-fault record
-    from pulses.synthetic import synthetic_record
+    from pulses.fit.synthetic import synthetic_record
 
     rec = synthetic_record("sine", 0.7 * pulses.G, 0.8, 6.0, 20.0, 0.005, noise=0.15, seed=3)
     rec.name = "synthetic one-sine 0.7 g, 0.8 s + 15 % noise, 20 s, 200 Hz"

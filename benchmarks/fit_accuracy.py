@@ -1,10 +1,10 @@
-"""Accuracy of the pulse fitter on synthetic records: the error-against-noise tables of docs/fitting.md.
+"""Accuracy of the pulse fitter on synthetic records: the error-against-noise tables of docs/validation-fitting.md.
 
 ``python benchmarks/fit_accuracy.py [N] [LOW HIGH] [plain] [seed=K]`` prints a Markdown table (N
 records per shape, Tp and noise level; default 10, fixed seeds; with a noise band LOW-HIGH Hz,
 only the rows pooled over Tp; ``plain``: the fitter's plain least squares, ``weighting="plain"``,
 instead of its weighted ones; ``seed=K``: every seed shifted by K, other records than the
-tables', to check that a change is not fitted to those).  Each record (:func:`pulses.synthetic.synthetic_record`):
+tables', to check that a change is not fitted to those).  Each record (:func:`pulses.fit.synthetic.synthetic_record`):
 one pulse of random polarity, amplitude 2-8 m/s^2 and arrival; 20 s long (8 Tp for long pulses)
 at 200 Hz; background motion band-passed to 0.5-10 Hz whose RMS over the record is the stated
 fraction of ap.  Columns:
@@ -14,10 +14,10 @@ fraction of ap.  Columns:
 - ``shape``: share of cases whose best candidate is the true shape;
 - ``arrival``: share with t0 within 5 % of Tp;
 - ``limit ap / Tp``: the noise limit of plain least squares, the standard deviation of an exact
-  least-squares fit of the true shape (:func:`pulses.synthetic.least_squares_limit`), mean over
+  least-squares fit of the true shape (:func:`pulses.fit.synthetic.least_squares_limit`), mean over
   the cases;
 - ``weighted limit``: the same for the weighted least squares with the background's spectrum
-  known (:func:`pulses.synthetic.weighted_least_squares_limit`);
+  known (:func:`pulses.fit.synthetic.weighted_least_squares_limit`);
 - ``RMS/limit``: RMS of (error / limit) over ap and Tp for the sine and the Rickers, against the
   limit of the least squares used, 1.0 for a fit at that limit;
 - ``search fails`` (plain least squares only): cases whose fit of the true shape does worse on
@@ -46,7 +46,7 @@ def _window_sse(x, p, t, lo, hi):
 
 def cases(noise, tp, n, seed, band=(0.5, 10.0), weighting="background"):
     from pulses import fit_pulse
-    from pulses.synthetic import (least_squares_limit, sampled_pulse, synthetic_record,
+    from pulses.fit.synthetic import (least_squares_limit, sampled_pulse, synthetic_record,
                                   weighted_least_squares_limit)
 
     rng = np.random.default_rng(seed)

@@ -1,8 +1,8 @@
-"""Fit every record in ../shared/records: the table of real records in docs/fitting.md.
+"""Fit every record in ../shared/records: the table of real records in docs/validation-fitting.md.
 
 ``python benchmarks/fit_records.py`` prints a Markdown table: for every record (the two-column
 text files once per column, in cm/s^2 at dt = 0.005 s as their comments and MANIFEST.md say), its
-PGA, PGV (baseline-corrected, :mod:`pulses.baseline`), the best shape and every shape's fitted
+PGA, PGV (baseline-corrected, :mod:`pulses.fit.baseline`), the best shape and every shape's fitted
 ``|ap|`` (g), Tp (s) and score (share of the record's energy the pulse explains).
 
 ``python benchmarks/fit_records.py compare`` prints, for every record, where the weighted least

@@ -354,7 +354,7 @@ def fit_section(d, out_dir):
     if rinaldi:
         md.append(f"Rinaldi 228 (NGA-West2 AT2): one-sine fit {rinaldi[0]:.3f} g, {rinaldi[1]:.3f} s (paper: 0.71 g, 0.8 s); "
                   f"best shape {rinaldi[2]}; {rinaldi[3] * 1e3:.0f} ms for all shapes.\n")
-    md.append(f"Accuracy (`benchmarks/fit_accuracy.py`, {n} records per shape, Tp and noise level here; docs/fitting.md's "
+    md.append(f"Accuracy (`benchmarks/fit_accuracy.py`, {n} records per shape, Tp and noise level here; docs/validation-fitting.md's "
               "table uses 10): each shape, random polarity, amplitude and arrival, background motion band-passed "
               "to 0.5-10 Hz at the stated RMS fraction of ap. Columns as in `fit_accuracy.py`'s docstring.\n")
     md += lines

@@ -62,13 +62,13 @@ def _many(value, *, pair_is_one: bool = False):
 
 def _column(block):
     """A :class:`pipeline.batch.tasks.Column` (height, width) from one of the accepted forms."""
-    from .args import parse_block
+    from .args import parse_block, parse_column_block
     from .batch.tasks import Column
 
     if isinstance(block, Column):  # the command line's own, already checked
         return block
     if isinstance(block, str):
-        return Column(*parse_block(block))
+        return Column(*parse_column_block(block))
     if isinstance(block, tuple) and len(block) == 2 and all(map(_is_number, block)):
         return Column(*parse_block(f"{float(block[0])!r}x{float(block[1])!r}"))
     from rocking import Block
@@ -77,7 +77,8 @@ def _column(block):
         if block.height is None or block.width is None:
             raise ValueError("blocks: a rocking.Block with its full height and width (made by "
                              "Block.from_dimensions), not only p and alpha")
-        return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"))
+        return Column(*parse_block(f"{float(block.height)!r}x{float(block.width)!r}"),
+                      block.body.kind)
     raise TypeError(f"blocks: expected {_COLUMN_FORMS}; got {type(block).__name__} {block!r:.60}")
 
 
@@ -127,10 +128,58 @@ def _choice(value, what, choices):
     return value
 
 
+def _is_whole(x) -> bool:
+    """A whole number, numpy's included, not a boolean."""
+    import numbers
+
+    return isinstance(x, numbers.Integral) and not _is_flag(x)
+
+
+def _is_flag(x) -> bool:
+    """``True``/``False``, numpy's included."""
+    return isinstance(x, bool) or (type(x).__module__ == "numpy" and type(x).__name__ in ("bool", "bool_"))
+
+
 def _jobs(jobs) -> int:
-    if not isinstance(jobs, int) or isinstance(jobs, bool):
+    if not _is_whole(jobs):
         raise TypeError(f"jobs: expected a whole number of processes (0: one per CPU), got {type(jobs).__name__}")
-    return jobs_count(jobs, "jobs")
+    return jobs_count(int(jobs), "jobs")
+
+
+def _flag(value, what) -> bool:
+    """A boolean argument: True or False only (``"no"`` is not False)."""
+    if not _is_flag(value):
+        raise TypeError(f"{what}: expected True or False, got {type(value).__name__} {value!r:.60}")
+    return bool(value)
+
+
+#: what ``plots`` takes, as ``pipeline run``'s ``--plots [governing|all]`` and ``--no-plots``
+_PLOTS = ("governing", "all", "none")
+
+
+def _plots(plots, out) -> dict:
+    """``plots`` and ``plots_all`` of the options from ``plots`` (None: figures when ``out``)."""
+    if plots is None:
+        plots = out is not None
+    if not _is_flag(plots) and not isinstance(plots, str):
+        raise TypeError(f"plots: expected True, False, None or one of {', '.join(map(repr, _PLOTS))}, "
+                        f"got {type(plots).__name__}")
+    scope = ("governing" if plots else "none") if _is_flag(plots) else _choice(plots, "plots", _PLOTS)
+    return {"plots": scope != "none", "plots_all": scope == "all"}
+
+
+def _text_option(value, what, *, whole=False):
+    """A text argument (or None); ``whole``: a whole number is taken as its text too."""
+    if value is None or isinstance(value, str) or (whole and _is_whole(value)):
+        return None if value is None else str(value)
+    raise TypeError(f"{what}: expected {'a whole number or ' if whole else ''}text, got "
+                    f"{type(value).__name__} {value!r:.60}")
+
+
+def _path_option(value, what):
+    if value is not None and not _is_path(value):
+        raise TypeError(f"{what}: expected a file path (str or os.PathLike) or None, got {type(value).__name__}")
+    return value
 
 
 def _shapes(shapes):
@@ -170,6 +219,9 @@ class DesignRun:
         Tasks run (a pair's directions count one each) and tasks that failed.
     out : pathlib.Path or None
         The folder the reports were written to (None: nothing was written).
+    n_unwritten : int
+        The run's own figures that could not be written (a full disk): left out, the tables and
+        ``report.html`` written all the same.
 
     Examples
     --------
@@ -188,11 +240,16 @@ class DesignRun:
     n_records: int = 0
     n_failed: int = 0
     out: pathlib.Path | None = None
+    #: the run's own figures that could not be written (a full disk ...), left out
+    n_unwritten: int = 0
+    #: ``risk.csv`` (``hazard=``): each column's rate at the site and the width for the target
+    risk_rows: list = field(default_factory=list)
 
     @property
     def exit_code(self) -> int:
-        """``pipeline run``'s exit status: 0 when every record was processed, 1 when some failed."""
-        return 0 if self.n_failed == 0 else 1
+        """``pipeline run``'s exit status: 0 when every record was processed, 1 when some failed
+        (or a figure of the run's could not be written)."""
+        return 0 if self.n_failed == 0 and not self.n_unwritten else 1
 
     @property
     def design(self):
@@ -222,12 +279,19 @@ class DesignRun:
 
         return _frame(self.suite_rows, list(SUITE_COLUMNS.names))
 
+    @property
+    def risk(self):
+        """``risk.csv`` as a DataFrame (``hazard=``; empty without)."""
+        from rocking.risk.rows import RISK_COLUMNS
+
+        return _frame(self.risk_rows, list(RISK_COLUMNS.names))
+
     def as_dict(self) -> dict:
         """The tables as lists of plain rows (JSON-safe: NaN and infinities as None)."""
         from pulses.export import plain
 
         return plain({"design": self.design_rows, "summary": self.summary_rows,
-                      "failures": self.failure_rows, "suite": self.suite_rows,
+                      "failures": self.failure_rows, "suite": self.suite_rows, "risk": self.risk_rows,
                       "n_records": self.n_records, "n_failed": self.n_failed,
                       "out": None if self.out is None else str(self.out)})
 
@@ -251,7 +315,8 @@ def _frame(rows, columns):
 
 def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 0, vertical: str = "auto",
            limit=None, jobs: int = 1, out=None, shapes=None, weighting: str = "background", units=None,
-           dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True, **more) -> DesignRun:
+           dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True, thorough: bool = False,
+           **more) -> DesignRun:
     """Design columns for a batch of records, as ``pipeline run`` does, and return the tables.
 
     Parameters
@@ -262,7 +327,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         is missing or cannot be read is a row of :attr:`DesignRun.failures`, not an exception.
     blocks : Block, str, (float, float) or a list of them
         Columns as they stand: a :class:`rocking.Block`, ``"HxW"`` (full height x full width, m,
-        e.g. ``"7.5x1.8"``) or ``(height, width)`` in m.  ``pipeline run --block``.
+        e.g. ``"7.5x1.8"``; ``"cyl:HxD"`` a circular column of diameter D) or ``(height, width)``
+        in m.  ``pipeline run --block``.
     heights : float or list of float
         Heights (m) of columns whose width is only to be sized.  ``--height``.
     pairs : {"none", "auto"} or list of (A, B) or (A, B, V)
@@ -288,16 +354,24 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         What a file does not say (``--units``, ``--dt``).
     scale : float, optional
         A factor on every record (``--scale``).
-    plots : bool, optional
-        Draw the figures (default: when ``out`` is given).
+    plots : bool or {"governing", "all", "none"}, optional
+        Draw the figures (default: when ``out`` is given): True or ``"governing"`` (for a pair in
+        several directions, its governing direction's), ``"all"`` (every direction's), False or
+        ``"none"``.  ``--plots [all]``, ``--no-plots``.
     force : bool
         Compute every record again instead of keeping an earlier run's reports in ``out``.
     quiet : bool
-        No messages and no table on stderr/stdout (default); False prints what ``pipeline run`` prints.
+        No messages, no warnings and no table on stderr/stdout (default); False prints what
+        ``pipeline run`` prints.
+    thorough : bool
+        For pairs: the check above the search width (and the figures) in every direction
+        (``--thorough``); the same pair design width.
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``.
+        ``glob``, ``friction`` (docs/validity.md); risk at a site (docs/risk.md): ``hazard`` (a file
+        or a :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)), ``site_row``, ``imt``,
+        ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe`` (``"2%/50"``), ``risk_seed``.
 
     Returns
     -------
@@ -309,7 +383,17 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     TypeError
         An argument of a type not accepted (the message names the accepted forms).
     ValueError
-        A value out of range (a negative height, an unknown shape ...).
+        A value out of range (a negative height, an unknown shape ...), refused with the words
+        ``pipeline run`` uses for it.
+    RuntimeError
+        ``jobs > 1`` (or ``dask="local"``) called at the top level of a script without the
+        ``if __name__ == "__main__":`` guard: the worker processes import the script again,
+        and would run the call again (see Notes).
+
+    Notes
+    -----
+    With ``jobs > 1`` the workers import the calling script again: in a script, call
+    :func:`design` under ``if __name__ == "__main__":`` (docs/notebook.md); a notebook needs nothing.
 
     Examples
     --------
@@ -326,18 +410,23 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     """
     plan = _plan(records, blocks=blocks, heights=heights, pairs=pairs, directions=directions,
                  vertical=vertical, limit=limit, jobs=jobs, out=out, shapes=shapes, weighting=weighting,
-                 units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet, **more)
+                 units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet, thorough=thorough,
+                 **more)
     return run_plan(plan)
 
 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
-         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None}
+         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None,
+         "hazard": None, "site": None, "site_row": None, "imt": None, "hazard_units": None, "years": 50,
+         "age": None, "target_rate": None, "target_poe": None, "risk_seed": 0, "friction": None}
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
-          units, dt, scale, plots, force, quiet, **more) -> Plan:
-    """Every argument of :func:`design` checked and in the forms the runner takes."""
-    from .args import parse_units
+          units, dt, scale, plots, force, quiet, thorough, **more) -> Plan:
+    """Every argument of :func:`design` checked and in the forms the runner takes: each value by
+    the rule ``pipeline run`` applies to its option (:mod:`pipeline.args`), named as here."""
+    from .args import (parse_cap_mass_ratio, parse_column, parse_directions, parse_dt, parse_limit,
+                       parse_scale, parse_units, parse_up_to)
     from .batch.tasks import Options
 
     unknown = sorted(set(more) - set(_MORE))
@@ -346,29 +435,59 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
                         f"named ones: {', '.join(_MORE)}")
     more = {**_MORE, **more}
     mode, explicit, triplets = _pairs(pairs)
-    if not isinstance(directions, int) or isinstance(directions, bool):
+    if not _is_whole(directions):
         raise TypeError(f"directions: expected a whole number, got {type(directions).__name__}")
     if out is not None and not _is_path(out):
         raise TypeError(f"out: expected a folder path (str or os.PathLike) or None, got {type(out).__name__}")
     if units is not None and not isinstance(units, str):
         raise TypeError(f"units: expected a unit name (e.g. 'g', 'm/s2', 'cm/s2'), got {type(units).__name__}")
-    opts = {"format": more["format"], "units": parse_units(units),
-            "dt": _number_option(dt, "dt"), "column": more["column"], "trace": more["trace"]}
-    kw = dict(plots=(out is not None) if plots is None else bool(plots), shapes=_shapes(shapes),
+    number = _number_option
+    column = more["column"]
+    if column is not None and not (_is_whole(column) or isinstance(column, str)):
+        raise TypeError(f"column: expected a whole number (counted from 1), got {type(column).__name__}")
+    opts = {"format": _text_option(more["format"], "format"), "units": parse_units(units, "units"),
+            "dt": None if dt is None else parse_dt(number(dt, "dt"), "dt"),
+            "column": parse_column(column, "column"), "trace": _text_option(more["trace"], "trace", whole=True)}
+    kw = dict(**_plots(plots, out), thorough=_flag(thorough, "thorough"), shapes=_shapes(shapes),
               weighting=_choice(weighting, "weighting", ("background", "plain")),
               vertical=_choice(vertical, "vertical", ("auto", "none")),
-              cap_mass_ratio=_number_option(more["cap_mass_ratio"], "cap_mass_ratio"),
-              fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"), **opts)
-    if limit is not None:
-        kw["limit"] = _number_option(limit, "limit")
-        if not 0.0 < kw["limit"] <= 1.0:
-            raise ValueError(f"limit (max|theta|/alpha) must lie in (0, 1], got {limit!r}")
+              cap_mass_ratio=parse_cap_mass_ratio(number(more["cap_mass_ratio"], "cap_mass_ratio"), "cap_mass_ratio"),
+              fragility=_flag(more["fragility"], "fragility"),
+              up_to=parse_up_to(number(more["up_to"], "up_to"), "up_to"),
+              limit=None if limit is None else parse_limit(number(limit, "limit"), "limit"),
+              friction=_friction(more["friction"]), **opts)
+    kw["risk"] = _risk(more)
+    if more["dask"] is not None and not isinstance(more["dask"], str):
+        raise TypeError(f"dask: expected 'local' or a scheduler address such as 'tcp://HOST:8786', "
+                        f"got {type(more['dask']).__name__}")
     return Plan(
         records=_records(records), columns=columns_from(blocks, heights), options=Options(**kw),
-        record_opts=opts, pairs=mode, pair=explicit, triplets=triplets, directions=str(directions),
-        scale=None if scale is None else repr(_number_option(scale, "scale")), scales=more["scales"],
-        peer_scales=bool(more["peer_scales"]), jobs=_jobs(jobs), out=out, force=bool(force),
-        quiet=bool(quiet), dask=more["dask"], log=more["log"], glob=more["glob"])
+        record_opts=opts, pairs=mode, pair=explicit, triplets=triplets,
+        directions=str(parse_directions(int(directions), "directions")),
+        scale=None if scale is None else repr(parse_scale(number(scale, "scale"), "scale")),
+        scales=_path_option(more["scales"], "scales"), peer_scales=_flag(more["peer_scales"], "peer_scales"),
+        jobs=_jobs(jobs), out=out, force=_flag(force, "force"), quiet=_flag(quiet, "quiet"),
+        dask=more["dask"], log=_path_option(more["log"], "log"), glob=_text_option(more["glob"], "glob"))
+
+
+def _risk(more):
+    """``hazard=`` and its options, checked (pipeline.batch.risk.RiskOptions), or None."""
+    from .batch import risk
+
+    if more["hazard"] is None:
+        given = [k for k in ("site", "site_row", "imt", "hazard_units", "age", "target_rate", "target_poe")
+                 if more[k] is not None]
+        if given:
+            raise ValueError(f"{given[0]} needs hazard= (the site's hazard curve)")
+        return None
+    try:
+        return risk.risk_options(more["hazard"], site=more["site"], site_row=more["site_row"],
+                                 imt=more["imt"], units=more["hazard_units"], years=more["years"],
+                                 age=more["age"], target_rate=more["target_rate"],
+                                 target_poe=more["target_poe"], seed=more["risk_seed"],
+                                 restitution=more.get("restitution"))
+    except ArgumentError as exc:
+        raise ValueError(str(exc)) from None
 
 
 @dataclass
@@ -441,12 +560,27 @@ def _tasks(plan, say):
 
 
 def run_plan(plan) -> DesignRun:
-    """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments)."""
+    """Run a checked plan (:func:`design`; ``pipeline run`` builds its plan from its arguments);
+    with ``quiet``, no warning is printed meanwhile, here or in the workers."""
+    from .batch.quiet import quieted
+
+    with quieted(plan.quiet):
+        return _run_plan(plan)
+
+
+def _run_plan(plan) -> DesignRun:
     from .batch.runner import run
 
+    _check_bodies(plan.columns, plan.options)
     say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
     from .batch.peer_inputs import NOT_DOWNLOADED, not_downloaded_text
 
+    if plan.dask:
+        _check_dask(plan.dask)
+    if (plan.jobs or 1) > 1 or plan.dask == "local":  # worker processes, which import the script again
+        from .batch import mainguard
+
+        mainguard.check("dask='local'" if plan.dask == "local" else f"jobs={plan.jobs}")
     paths, tasks, absent = _tasks(plan, say)
     # with no folder of the caller's, the runner's messages would name the private one: the table
     # is printed here instead
@@ -461,7 +595,39 @@ def run_plan(plan) -> DesignRun:
 
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,
-                     summary.n_failed, None if plan.out is None else summary.out)
+                     summary.n_failed, None if plan.out is None else summary.out, summary.n_unwritten,
+                     t.get("risk", []))
+
+
+def _check_dask(address) -> None:
+    """``--dask``: dask.distributed installed and, for a scheduler's address, a scheduler there
+    (:func:`pipeline.batch.scheduler.check_address`): an argument error before any work."""
+    import importlib.util
+
+    if importlib.util.find_spec("distributed") is None:
+        raise ArgumentError("--dask needs dask.distributed: pip install 'rocking-columns[dask]'")
+    if address != "local":
+        from .batch.scheduler import check_address
+
+        check_address(address)
+
+
+def _friction(value):
+    """``friction=``: None, or a friction coefficient checked as ``--friction`` is."""
+    from .args import parse_friction
+
+    if value is not None and not _is_number(value):
+        raise TypeError(f"friction: expected a number (a friction coefficient), got {type(value).__name__}")
+    return None if value is None else parse_friction(repr(float(value)))
+
+
+def _check_bodies(columns, options) -> None:
+    """A rocking frame (``cap_mass_ratio``) of other than rectangular columns: an argument error."""
+    from .args import ArgumentError
+
+    if options.cap_mass_ratio and any(c.body != "rectangular" for c in columns):
+        raise ArgumentError("--cap-mass-ratio: rocking frames are modelled for rectangular "
+                            "columns only; give the circular columns (cyl:) without it")
 
 
 @contextlib.contextmanager

@@ -89,12 +89,12 @@ def parse_units(text, what: str = "--units"):
 DT_RANGE_S = (1e-5, 1.0)
 
 
-def parse_dt(text) -> float:
+def parse_dt(text, what: str = "--dt") -> float:
     """``--dt``: a sampling interval in s within :data:`DT_RANGE_S`."""
-    dt = parse_positive(text, "--dt (s)")
+    dt = parse_positive(text, f"{what} (s)")
     lo, hi = DT_RANGE_S
     if not lo <= dt <= hi:
-        raise ArgumentError(f"--dt (s) must lie between {lo:g} s and {hi:g} s, got {dt:g}")
+        raise ArgumentError(f"{what} (s) must lie between {lo:g} s and {hi:g} s, got {dt:g}")
     return dt
 
 
@@ -142,7 +142,7 @@ def pair_files(pairs, what: str = "--pair") -> list[tuple[str, str]]:
     return out
 
 
-def parse_column(text):
+def parse_column(text, what: str = "--column"):
     """``--column``: a column number counted from 1, None when not given."""
     if text is None:
         return None
@@ -151,8 +151,59 @@ def parse_column(text):
     except ValueError:
         column = 0
     if column < 1:
-        raise ArgumentError(f"--column counts from 1, got {text!r}")
+        raise ArgumentError(f"{what} counts from 1, got {text!r}")
     return column
+
+
+# -- the rules of pipeline run's values (the command line and pipeline.design() both ask these) -----
+def _float(text, what: str, rule: str) -> float:
+    try:
+        return float(str(text).strip())
+    except ValueError:
+        raise ArgumentError(f"{what} {rule}, got {text!r}") from None
+
+
+def parse_limit(text, what: str = "--limit") -> float:
+    """``--limit R``: a performance level max|theta|/alpha, ``0 < R <= 1``."""
+    rule = "(max|theta|/alpha) must be a number in (0, 1]"
+    value = _float(text, what, rule)
+    if not (math.isfinite(value) and 0.0 < value <= 1.0):
+        raise ArgumentError(f"{what} {rule}, got {text!r}")
+    return value
+
+
+#: the largest cap beam mass over the columns' mass of a rocking frame (``--cap-mass-ratio``)
+MAX_CAP_MASS_RATIO = 1e3
+
+
+def parse_cap_mass_ratio(text, what: str = "--cap-mass-ratio") -> float:
+    """``--cap-mass-ratio``: a rocking frame's cap beam mass over its columns', 0 (lone columns)
+    to :data:`MAX_CAP_MASS_RATIO`."""
+    rule = f"must be a number between 0 and {MAX_CAP_MASS_RATIO:g}"
+    value = _float(text, what, rule)
+    if not (math.isfinite(value) and 0.0 <= value <= MAX_CAP_MASS_RATIO):
+        raise ArgumentError(f"{what} {rule}, got {text!r}")
+    return value
+
+
+def parse_up_to(text, what: str = "--up-to") -> float:
+    """``--up-to``: the largest scale factor ``--fragility`` examines, above 1 (the scale rule)."""
+    return parse_scale(text, what, low=1.0 + 1e-9)
+
+
+#: the most evenly spaced directions of a pair (``--directions``)
+MAX_DIRECTIONS = 180
+
+
+def parse_directions(text, what: str = "--directions") -> int:
+    """``--directions N``: evenly spaced directions added for a pair, 0 to :data:`MAX_DIRECTIONS`."""
+    try:
+        n = int(str(text).strip())
+    except ValueError:
+        raise ArgumentError(f"{what} expects a whole number, got {text!r}") from None
+    if not 0 <= n <= MAX_DIRECTIONS:
+        raise ArgumentError(f"{what} must be 0 to {MAX_DIRECTIONS}, got {n}")
+    return n
 
 
 def _finite_positive(value: float, what: str) -> float:
@@ -191,6 +242,47 @@ def parse_block(text: str) -> tuple[float, float]:
         print(f"pipeline: warning: --block {text} is {width:g} m wide and {height:g} m high (HEIGHTxWIDTH); "
               f"did you mean {parts[1]}x{parts[0]}?", file=sys.stderr)
     return height, width
+
+
+#: what a column's text may start with to name its body (``cyl:7.5x1.8``), and the body's kind
+#: (rocking.bodies); no prefix: the rectangular block
+BODY_PREFIXES = {"cyl": "cylinder", "cylinder": "cylinder", "rect": "rectangular",
+                 "rectangular": "rectangular"}
+
+
+def split_body(text, what: str = "--block") -> tuple[str, str]:
+    """``"cyl:7.5x1.8"`` -> ``("cylinder", "7.5x1.8")``; no prefix: ``("rectangular", text)``."""
+    head, sep, rest = str(text).strip().partition(":")
+    if not sep:
+        return "rectangular", str(text)
+    kind = BODY_PREFIXES.get(head.strip().lower())
+    if kind is None:
+        raise ArgumentError(f"{what} {text!r}: unknown body {head!r}; write cyl:HxD for a "
+                            "circular column or HxW for a rectangular one")
+    return kind, rest
+
+
+def parse_column_block(text) -> tuple[float, float, str]:
+    """``--block``: ``HxW`` (rectangular) or ``cyl:HxD`` (a solid circular column of diameter D
+    rocking in a plane) -> ``(height, width, body)``."""
+    kind, rest = split_body(text)
+    return (*parse_block(rest), kind)
+
+
+def parse_column_height(text) -> tuple[float, str]:
+    """``--height``: ``H`` or ``cyl:H`` -> ``(height, body)``."""
+    kind, rest = split_body(text, "--height")
+    return parse_length(rest, "--height (m)"), kind
+
+
+def parse_friction(text):
+    """``--friction MU``: a friction coefficient, 0 < MU <= 10; None when not given."""
+    if text is None:
+        return None
+    value = parse_positive(text, "--friction (a friction coefficient)")
+    if value > 10.0:
+        raise ArgumentError(f"--friction is a friction coefficient (about 0.1 to 1), got {text!r}")
+    return value
 
 
 def parse_length(text: str, what: str = "length (m)") -> float:

@@ -19,10 +19,15 @@ COMMANDS = ["simulate", "fit", "convert", "design", "spectrum", "chart", "run", 
 class _Parser(argparse.ArgumentParser):
     #: every option string of the command and its sub-commands, for the suggestions of :func:`suggestion`
     known_options: set = set()
+    #: the options that take one value (``--limit R``), for :func:`numbers_as_values`
+    one_value: set = set()
 
     def add_argument(self, *names, **kwargs):
         _Parser.known_options.update(n for n in names if isinstance(n, str) and n.startswith("--"))
-        return super().add_argument(*names, **kwargs)
+        action = super().add_argument(*names, **kwargs)
+        if action.option_strings and action.nargs is None:
+            _Parser.one_value.update(action.option_strings)
+        return action
 
     def error(self, message):  # one line and exit status 2, as argparse does, without usage noise
         self.exit(2, f"{self.prog}: error: {message}{suggestion(message, _Parser.known_options)}\n")
@@ -49,6 +54,29 @@ def suggestion(message: str, options) -> str:
             if close:
                 out.append(f"{close[0]} for {word}")
     return f"; did you mean {', '.join(out)}?" if out else ""
+
+
+def numbers_as_values(argv, options) -> list:
+    """``argv`` with ``--limit -inf`` written ``--limit=-inf``: argparse takes a value that starts
+    with ``-`` for an option unless it looks like a plain negative number (``-1``, ``-0.5``), so
+    ``-inf``, ``-1e5`` or ``-0.5g`` after an option that takes a value got "expected one argument"
+    instead of the option's own rule."""
+    def number_like(word):
+        if word[1:2].isdigit() or word[1:2] == ".":
+            return True
+        try:
+            float(word)
+        except ValueError:
+            return False
+        return True
+
+    out = list(argv)
+    k = 0
+    while k < len(out) - 1:
+        if out[k] in options and out[k + 1].startswith("-") and number_like(out[k + 1]):
+            out[k:k + 2] = [f"{out[k]}={out[k + 1]}"]
+        k += 1
+    return out
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -108,7 +136,8 @@ def main(argv=None) -> int:
     >>> main(["simulate", "--block", "7.5x1.8", "--pulse", "sine", "--ap", "0.5g", "--tp", "1.0"])
     7.5 x 1.8 m column (tan(alpha) = 0.24, p = 1.381 rad/s) under sine pulse ap=0.5g tp=1 s:
       survives; max|theta|/alpha = 0.7906 (max|theta| = 0.1862 rad)
-      impacts: 1; model: fast (verdict by energy rule)
+      impacts: 1; model: fast (verdict by energy rule); body: rectangular, eta = 0.9183
+      friction needed: up to 0.2997 at t = 0.237 s (at uplift 0.24), impulse ratio at impacts 0.1774; smallest normal force 0.8624 of the weight
     0
     """
     from . import interrupts
@@ -119,7 +148,7 @@ def main(argv=None) -> int:
     with interrupts.handling(to_exit=argv is None):  # argv None: the program itself, about to exit
         try:
             parser = build_parser()
-            args = parser.parse_args(argv)
+            args = parser.parse_args(numbers_as_values(sys.argv[1:] if argv is None else argv, _Parser.one_value))
             if not getattr(args, "func", None):
                 parser.print_help()
                 return 2

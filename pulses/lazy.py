@@ -9,7 +9,7 @@ import importlib
 import sys
 
 
-def lazy_names(package: str, where: dict, modules=()):
+def lazy_names(package: str, where: dict, modules=None):
     """The ``__getattr__`` and ``__dir__`` of a package whose names load on first use.
 
     Parameters
@@ -18,8 +18,9 @@ def lazy_names(package: str, where: dict, modules=()):
         The package's ``__name__``.
     where : dict
         Public name -> the module of the package that defines it (``{"fit_pulse": "fit"}``).
-    modules : iterable of str, optional
-        Submodules that are themselves public names of the package.
+    modules : dict, optional
+        Submodules that are themselves public names of the package: public name -> the module of
+        the package it is (``{"peer": "io.peer"}``).
 
     Returns
     -------
@@ -28,12 +29,12 @@ def lazy_names(package: str, where: dict, modules=()):
         namespace (so it is looked up once); AttributeError for a name the package does not have.
         ``__dir__()``: the package's names, loaded or not.
     """
-    modules = tuple(modules)
+    modules = dict(modules or {})
     public = set(where) | set(modules)
 
     def __getattr__(name):
         if name in modules:
-            return importlib.import_module(f".{name}", package)
+            return importlib.import_module(f".{modules[name]}", package)
         module = where.get(name)
         if module is None:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")

@@ -1,4 +1,5 @@
-"""Two horizontal components of one station: reading, checking, rotating and pairing files.
+"""Two horizontal components of one station: checking, rotating and pairing files (two files are
+read as a pair by :func:`pulses.read_pair`).
 
 A pair is two records of the same station in orthogonal horizontal directions.  The component
 in the direction ``theta`` measured from the first component towards the second is
@@ -141,36 +142,6 @@ def truncated(record: Record, n: int) -> Record:
     if record.npts == n:
         return record
     return Record(record.acc[:n], record.dt, record.name, record.t_start, record.metadata)
-
-
-def read_pair(path1, path2, **read_options) -> tuple[Record, Record]:
-    """Read two files as the horizontal components of one station.
-
-    Parameters
-    ----------
-    path1, path2 : str or path-like
-        The two component files; orientations are measured from the first towards the second.
-    **read_options
-        Passed to :func:`pulses.read_record` for both files (``units``, ``dt``, ``format``, ...).
-
-    Returns
-    -------
-    (Record, Record)
-        Accelerations in m/s^2, truncated to the same length (see :func:`check_pair`).
-
-    Examples
-    --------
-    >>> from importlib.resources import files
-    >>> import pulses
-    >>> data = files("pipeline.data")
-    >>> first, second = pulses.read_pair(str(data / "synth_sine_055g_0.9s.sac"),
-    ...                                  str(data / "synth_broadband_only.sac"))
-    >>> first.npts == second.npts, first.dt
-    (True, 0.01)
-    """
-    from .io import read_record
-
-    return check_pair(read_record(path1, **read_options), read_record(path2, **read_options))
 
 
 def component(first, second, theta):

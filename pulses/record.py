@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-G = 9.81  #: standard gravity used throughout the package, m/s^2
+from .units import G
 
 
 class Record:
@@ -16,7 +16,8 @@ class Record:
     Parameters
     ----------
     acc : array_like
-        Ground acceleration samples, in m/s^2 unless ``units`` says otherwise.
+        Ground acceleration samples of one component (one-dimensional; a 2-D array is refused),
+        in m/s^2 unless ``units`` says otherwise.
     dt : float
         Sampling interval, s.
     name : str, optional
@@ -44,7 +45,13 @@ class Record:
     shape = "record"
 
     def __init__(self, acc, dt, name=None, t_start=0.0, metadata=None, *, units=None):
-        acc = np.ascontiguousarray(np.asarray(acc, dtype=float).ravel())
+        acc = np.asarray(acc, dtype=float)
+        if acc.ndim != 1:  # (2, N) would be two components end to end, (N, 2) interleaved
+            raise ValueError(f"record {name!r}: acc must be one-dimensional, the samples of one "
+                             f"component; got an array of shape {acc.shape}: for two components "
+                             "make a Record of each (acc[:, k] or acc[k]; pulses.component "
+                             "combines two), for a column of one (N, 1) use acc.ravel()")
+        acc = np.ascontiguousarray(acc)
         raw_peak = float(np.max(np.abs(acc))) if acc.size else 0.0
         if units is not None:
             from .units import canonical_units, unit_factor
@@ -107,9 +114,9 @@ class Record:
         >>> round(pulses.Record.from_trace(tr, units="g").pga / pulses.G, 3)
         0.874
         """
-        from .traces import from_trace
+        from .formats.traces import trace_fields  # the formats load when a trace is first converted
 
-        return from_trace(trace, units, name=name)
+        return cls(**trace_fields(trace, units, name=name))
 
     def to_trace(self):
         """This record as an :class:`obspy.Trace`: ``data`` in m/s^2, ``delta`` = ``dt``,
@@ -125,9 +132,9 @@ class Record:
         >>> tr.stats.delta, list(tr.data) == list(rec.acc), pulses.Record.from_trace(tr).name
         (0.01, True, 'demo')
         """
-        from .traces import to_trace
+        from .formats.traces import record_trace
 
-        return to_trace(self)
+        return record_trace(self)
 
     # -- basic facts -------------------------------------------------------------------
     @property

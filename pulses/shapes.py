@@ -10,8 +10,9 @@ A shape owns what is known about it, as class attributes and methods on the unit
 (amplitude 1, period 1, dimensionless time ``tau = (t - t0) / tp``): its formula and slope,
 support, extrema, Fourier transform, energy, velocity-to-acceleration factor, display name and
 the windows the fitter uses.  Code elsewhere asks the shape (through the registry
-:data:`SHAPES`) and never branches on its name, so a new shape is one new class here, added to
-:data:`SHAPES`, and its tests.
+:data:`SHAPES`) and never branches on its name: within ``pulses`` a new shape is one new class
+here, added to :data:`SHAPES`.  What it still needs outside ``pulses`` is listed, step by step,
+in :class:`Pulse`.
 """
 from __future__ import annotations
 
@@ -46,16 +47,39 @@ class Pulse:
 
     Notes
     -----
-    What a subclass defines, on the unit shape (``tau = (t - t0) / tp``):
+    Adding a shape.  In ``pulses`` a shape is one class: the fitter's shapes, the wavelet
+    matching, the command line's ``--shapes`` and ``--pulse`` choices and the reports' shape
+    columns all iterate :data:`SHAPES`.  The solvers in ``rocking`` still need code of their own:
 
-    - ``shape`` (short name), ``label`` (display name), ``kind`` (code of the compiled solver);
-    - :meth:`unit` and :meth:`slope` (the formula and its derivative in ``tau``), :meth:`spectrum`
-      (Fourier transform), ``energy`` (``integral unit^2 d tau``), ``vp_to_ap``;
-    - ``support_tau`` (outside it the acceleration is zero), ``extrema_tau``, ``centre_tau``
-      (middle of the pulse: its arrival is half a period earlier), ``antisymmetric``, ``boxcar``;
-    - ``window_tau`` (where the fitter's correlation is measured) and ``fit_tau`` (the samples
-      its least squares uses, before a margin is added);
-    - ``pywt`` (PyWavelets' wavelet of the same curve and Tp per unit scale) where there is one.
+    1. Subclass :class:`Pulse` in this module and define, on the unit shape
+       (``tau = (t - t0) / tp``): ``shape`` (the short name), ``label`` (display name),
+       ``equation`` (where the paper defines it, or None), ``kind`` (its code in the compiled
+       solver: the next unused integer); :meth:`unit` and :meth:`slope` (the formula and its
+       derivative in ``tau``), :meth:`spectrum` (Fourier transform), ``energy``
+       (``integral unit^2 d tau``), ``vp_to_ap``; ``support_tau`` (outside it the acceleration is
+       zero), ``extrema_tau``, ``centre_tau`` (middle of the pulse: its arrival is half a period
+       earlier), ``antisymmetric``, ``realisable`` (ends at rest), ``boxcar``; ``window_tau``
+       (where the fitter's correlation is measured), ``fit_tau`` (the samples its least squares
+       uses, before a margin is added); ``pywt`` (PyWavelets' wavelet of the same curve and Tp per
+       unit scale) where there is one.  Override :meth:`sampled` (and
+       :meth:`sampled_with_derivatives`) where point samples do not place the shape finer than
+       ``dt``, as :class:`Rectangular` does.
+    2. Add the class to :data:`SHAPES`: everything in ``pulses`` and the command line takes it
+       from there.
+    3. The compiled solver, ``rocking/_core.pyx``: the code in its enum of forcing kinds and in
+       ``KIND_CODES``, the acceleration in ``forcing`` and its Taylor coefficients in
+       ``forcing_series``; ``rocking/engine.py`` names the codes and checks them against the
+       shapes' at import.  Until then give a solver the shape only as samples
+       (``pulses.Record(pulse(t), dt)``): the engine's kinds are read from :data:`SHAPES`, and the
+       core computes no forcing for a code it was not compiled for.
+    4. The reference solver, ``rocking/reference.py``: its piecewise forcing (a boxcar is
+       constant on its support, every other shape is evaluated by :meth:`unit`).
+    5. The envelope rule, ``ENVELOPE`` in ``rocking/closed_forms.py``: the shape's coefficients,
+       derived by ``python -m rocking.envelope`` (which also lists the realisable shapes it fits
+       together).
+    6. Tests: the spectrum against the FFT of the sampled pulse, the slope and the extrema
+       (``tests/test_fit.py``, which iterates :data:`SHAPES`), the fit of a noise-free pulse, and
+       the solvers against the reference solver (``tests/test_design.py``).
 
     Examples
     --------
@@ -74,6 +98,8 @@ class Pulse:
     shape = "pulse"
     #: display name
     label = "pulse"
+    #: where Makris & Vassiliou (2012) define it ("Eq. 9"), or None
+    equation = None
     #: integer code used by the compiled solver
     kind = 0
     #: ``(start, end)`` of the unit shape's support, in tau
@@ -85,6 +111,8 @@ class Pulse:
     #: odd about its centre: it matches a record nearly as well with the opposite polarity
     #: half a lobe away
     antisymmetric = False
+    #: the ground ends at rest (no residual velocity): a motion the ground can make
+    realisable = True
     #: ``(start, end)`` in tau of the window over which a fitted pulse's correlation is measured
     window_tau = (0.0, 1.0)
     #: ``(start, end)`` in tau of the samples a least-squares fit uses (before its margin)
@@ -311,6 +339,7 @@ class Rectangular(Pulse):
     shape = "rect"
     label = "rectangular"
     kind = 1
+    realisable = False
     boxcar = True
     energy = 1.0
     #: peak velocity ``ap Tp`` at its end
@@ -375,6 +404,7 @@ class OneSine(Pulse):
 
     shape = "sine"
     label = "one-sine"
+    equation = "Eq. 9"
     kind = 2
     extrema_tau = (0.25, 0.75)
     antisymmetric = True
@@ -428,6 +458,7 @@ class SymmetricRicker(_Ricker):
 
     shape = "ricker-sym"
     label = "symmetric Ricker"
+    equation = "Eq. 7"
     kind = 3
     #: beyond 2.2 Tp the wavelet stays below 2e-19 ap, far below any digit a double-precision
     #: solver resolves, so the truncation changes nothing
@@ -481,6 +512,7 @@ class AntisymmetricRicker(_Ricker):
 
     shape = "ricker-anti"
     label = "antisymmetric Ricker"
+    equation = "Eq. 8"
     kind = 4
     #: beyond 2.8 Tp the wavelet stays below 3e-20 ap
     support_tau = (-2.8, 2.8)

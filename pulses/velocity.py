@@ -4,7 +4,7 @@ A port of the authors' own MATLAB code (``shreyshahi/PulseClassification``, MIT 
 ``classification_algo.m``, ``analyze_record.m``, ``find_Ipulse.m``, ``find_Tp.m``), step by step:
 
 1. Velocity in cm/s: cumulative sum of the acceleration times ``dt`` (no baseline correction).
-2. The continuous wavelet transform with the Daubechies-4 wavelet (:func:`db4_cwt`, MATLAB's
+2. The continuous wavelet transform with the Daubechies-4 wavelet (:func:`pulses.db4.db4_cwt`, MATLAB's
    legacy ``cwt(x, scales, 'db4')``) of both components at 51 coarse scales: pseudo-periods
    ``Tp = 1.4 a dt`` from 0.25 s to 15 s (:func:`coarse_scales`).
 3. Five candidates.  The strongest orientation at a point of the (scale, time) map is exact:
@@ -32,21 +32,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 import pywt
-from scipy import fft as sfft
 
-from .bytecache import byte_lru
+from .db4 import FC, WAVELET, WindowedTransform, cwt_at, cwt_point, cwt_rows, unit_wavelet
 from .errors import RecordError
 from .record import Record
 
-#: the mother wavelet (MATLAB name and PyWavelets name agree)
-WAVELET = "db4"
-#: centre frequency of db4 (MATLAB ``centfrq('db4')``: the peak of |FFT(psi)| over its support
-#: of 7, at 5/7), so that a scale ``a`` has pseudo-period ``Tp = a dt / FC = 1.4 a dt``
-FC = 5.0 / 7.0
 #: range of pseudo-periods of the coarse scales, s, and the number of steps between them
 TP_MIN, TP_MAX, N_STEPS = 0.25, 15.0, 50
 #: candidates taken from the (scale, time) map
@@ -55,10 +48,6 @@ N_CANDIDATES = 5
 N_WAVELETS = 10
 #: half-width, in units of the scale, of the window around a pulse (candidates and wavelets)
 WINDOW = 10.0 / 25.0
-#: precision (2^-PRECISION grid) of the integrated wavelet, MATLAB ``cwt``'s ``precis = 10``
-PRECISION = 10
-#: iterations of the wavelet drawn into the pulse, ``wavefun('db4', 4)`` in ``analyze_record.m``
-PULSE_ITERATIONS = 4
 #: principal component PC = PC_PGV * PGV ratio + PC_ENERGY * energy ratio
 PC_PGV, PC_ENERGY = 0.63, 0.777
 #: centring of PC and of PGV (cm/s) in the indicator
@@ -73,232 +62,6 @@ ONE_SIDED_RATIO = 4.0
 LATE_PULSE_PERCENT, LATE_RECORD_PERCENT = 5.0, 17.0
 #: m/s to cm/s: the indicator's constants are in cm/s
 CM_PER_M = 100.0
-#: bytes the caches of filters may hold (each): every filter of a 200 Hz record fits many times
-#: over (51 coarse filters of at most 15,000 samples: 6 MB), while a 10 kHz record's, whose
-#: longest filter has 750,000 samples, are recomputed rather than held by the gigabyte
-FILTER_CACHE_BYTES = 64 * 2**20
-#: bytes the cache of the coarse filters' spectra may hold: a 200 Hz record of 40 s needs 10 MB
-SPECTRUM_CACHE_BYTES = 128 * 2**20
-
-
-# -- the db4 continuous transform ------------------------------------------------------------
-
-@lru_cache(maxsize=None)
-def _integrated_wavelet():
-    """Integrated db4 wavelet on its grid (step 2^-10 over the support 0..7)."""
-    int_psi, x = pywt.integrate_wavelet(pywt.Wavelet(WAVELET), precision=PRECISION)
-    return int_psi, float(x[1] - x[0]), float(x[-1] - x[0])
-
-
-def resampled_integral(scale: float) -> np.ndarray:
-    """The integrated wavelet resampled at ``scale`` and reversed, as MATLAB's legacy ``cwt``:
-    ``j = 1 + floor((0:a*xmax) / (a*step))``, ``f = fliplr(intpsi(j))``."""
-    int_psi, step, xmax = _integrated_wavelet()
-    j = (np.arange(int(math.floor(scale * xmax)) + 1) / (scale * step)).astype(int)
-    j = j[j < int_psi.size]
-    if j.size == 1:
-        j = np.array([j[0], j[0]])
-    return int_psi[j][::-1]
-
-
-@byte_lru(FILTER_CACHE_BYTES)  # the coarse scales; the refined ones are kept by _point_filter
-def difference_filter(scale: float) -> np.ndarray:
-    """Filter ``g`` with ``conv(x, g) = diff(conv(x, f))``, ``f`` the :func:`resampled_integral`
-    (``g = [f0, f1 - f0, ..., -f_last]``); read-only."""
-    f = resampled_integral(scale)
-    g = np.empty(f.size + 1)
-    g[0] = f[0]
-    g[1:-1] = np.diff(f)
-    g[-1] = -f[-1]
-    g.flags.writeable = False
-    return g
-
-
-def _offset(scale: float) -> int:
-    """Index in ``conv(x, g)`` of the transform's sample 0: MATLAB keeps the central ``n``
-    samples of ``diff(conv(x, f))`` (``wkeep1``), i.e. from ``floor((len(f) - 2) / 2)``, and
-    ``diff(y)[k] = conv(x, g)[k + 1]``."""
-    return _offset_of(difference_filter(scale).size)
-
-
-def _offset_of(length: int) -> int:
-    """:func:`_offset` of a filter ``g`` of ``length`` samples (``len(f) = length - 1``)."""
-    return (length - 3) // 2 + 1
-
-
-def db4_cwt_direct(x, scales) -> np.ndarray:
-    """The db4 transform by direct convolution (:func:`numpy.convolve`): the reference for
-    :func:`db4_cwt`, as MATLAB's legacy ``cwt(x, scales, 'db4')`` computes it.
-
-    Returns an array (len(scales), len(x)).
-    """
-    x = np.asarray(x, dtype=float)
-    out = np.empty((len(scales), x.size))
-    for i, a in enumerate(scales):
-        y = np.diff(np.convolve(x, resampled_integral(a)))
-        start = (y.size - x.size) // 2
-        out[i] = -math.sqrt(a) * y[start:start + x.size]
-    return out
-
-
-@byte_lru(SPECTRUM_CACHE_BYTES)
-def _filter_spectrum(scale: float, size: int) -> np.ndarray:
-    """``-sqrt(scale)`` times the FFT of size ``size`` of :func:`difference_filter`; read-only."""
-    spectrum = sfft.rfft(difference_filter(scale), size) * (-math.sqrt(scale))
-    spectrum.flags.writeable = False
-    return spectrum
-
-
-def db4_cwt(x, scales) -> np.ndarray:
-    """Continuous wavelet transform with the db4 wavelet, MATLAB's legacy ``cwt(x, scales, 'db4')``.
-
-    The integrated wavelet (``psi`` integrated on a 2^-10 grid) is resampled at each scale,
-    convolved with the signal, differentiated, its central part kept and multiplied by
-    ``-sqrt(scale)``; here the convolution and the differentiation are one FFT convolution
-    with :func:`difference_filter`, on a grid just long enough that the kept part is exact.
-
-    Parameters
-    ----------
-    x : array_like, shape (n,) or (m, n)
-        Signal(s), uniformly sampled (scales are in samples).
-    scales : sequence of float
-        Scales, in samples.
-
-    Returns
-    -------
-    numpy.ndarray, shape (len(scales), n) or (m, len(scales), n)
-    """
-    x = np.asarray(x, dtype=float)
-    scales = tuple(float(a) for a in scales)
-    out = np.empty(x.shape[:-1] + (len(scales), x.shape[-1]))
-    for i, row in _cwt_rows(x, scales):
-        out[..., i, :] = row
-    return out
-
-
-def _cwt_rows(x: np.ndarray, scales: tuple):
-    """The rows of :func:`db4_cwt`, one scale at a time (in the order of their FFT sizes):
-    pairs (index of the scale, transform of shape ``x.shape``), so that a caller can use each
-    row while it is in the cache."""
-    n = x.shape[-1]
-    for size, members in _size_groups(scales, n):
-        spectrum = sfft.rfft(x, size, axis=-1)
-        product = np.empty_like(spectrum)
-        for i in members:
-            k = _offset(scales[i])
-            np.multiply(spectrum, _filter_spectrum(scales[i], size), out=product)
-            yield i, sfft.irfft(product, size, axis=-1)[..., k:k + n]
-
-
-@lru_cache(maxsize=8)
-def _size_groups(scales: tuple, n: int, groups: int = 4) -> tuple:
-    """FFT sizes for the scales: circular convolution of size M equals the linear one on the
-    kept samples when ``M >= n + len(g) - 1 - offset`` and ``M >= offset + n``; scales are put
-    in up to ``groups`` runs sharing one size (one forward FFT of the signal per run)."""
-    need = [sfft.next_fast_len(max(n + difference_filter(a).size - 1 - _offset(a), _offset(a) + n), real=True)
-            for a in scales]
-    order = sorted(range(len(scales)), key=lambda i: need[i])
-    runs = [order[i * len(order) // groups:(i + 1) * len(order) // groups] for i in range(groups)]
-    return tuple((max(need[i] for i in run), tuple(run)) for run in runs if run)
-
-
-#: longest dot product handed to BLAS in one call: OpenBLAS (in NumPy's and SciPy's wheels)
-#: spreads a dot product of more than 10,000 elements over threads, which stalls on a busy
-#: machine (4 ms instead of 4 us measured); shorter pieces run on the calling thread, three
-#: times faster than :func:`numpy.einsum`
-DOT_PIECE = 8192
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> float:
-    """``sum(a * b)`` of two 1-D arrays, by BLAS in pieces of at most :data:`DOT_PIECE`."""
-    if a.size <= DOT_PIECE:
-        return float(np.dot(a, b))
-    return float(sum(np.dot(a[i:i + DOT_PIECE], b[i:i + DOT_PIECE]) for i in range(0, a.size, DOT_PIECE)))
-
-
-@byte_lru(FILTER_CACHE_BYTES)
-def _point_filter(scale: float) -> tuple[int, np.ndarray, float]:
-    """What the transform at one sample needs at ``scale``: (the :func:`_offset`, the
-    :func:`difference_filter` reversed (read-only), ``-sqrt(scale)``)."""
-    g = difference_filter.__wrapped__(scale)  # uncached: only the reversed copy is kept
-    reverse = g[::-1].copy()
-    reverse.flags.writeable = False
-    return _offset_of(g.size), reverse, -math.sqrt(scale)
-
-
-def _cwt_point(x: np.ndarray, scales, at: int) -> np.ndarray:
-    """The db4 transform of ``x`` at sample ``at`` for each of ``scales`` (one dot product each,
-    over the samples of ``x`` the filter meets)."""
-    out = np.empty(len(scales))
-    n = x.size
-    for i, a in enumerate(scales):
-        offset, gr, factor = _point_filter(a)
-        hi = at + offset + 1  # x indices at + offset - (G - 1) .. at + offset
-        lo = hi - gr.size
-        x_lo, x_hi = max(lo, 0), min(hi, n)
-        out[i] = factor * _dot(x[x_lo:x_hi], gr[x_lo - lo:x_hi - lo]) if x_hi > x_lo else 0.0
-    return out
-
-
-#: largest (outputs x input samples) for which a windowed transform is a direct convolution:
-#: below it :func:`numpy.convolve` is cheaper than two FFTs
-DIRECT_LIMIT = 100_000
-
-
-class _Window:
-    """The db4 transform at one scale over output samples ``start..stop-1`` of signals that are
-    zero outside input samples ``lo..hi-1``.
-
-    Only the stretch of the filter those outputs and inputs meet is used (zero-extended where
-    it runs past the filter's ends), so the work scales with ``(stop - start) + (hi - lo)``
-    rather than with the filter's length ``7 scale``: for long scales the filter is longer than
-    the record.  Output ``q`` is ``conv(seg, part)[q + len(seg) - 1]``, the 'valid' part of a
-    linear convolution; a circular one of size ``>= len(part)`` has it exact.
-    """
-
-    def __init__(self, scale: float, start: int, stop: int, lo: int, hi: int):
-        k, reverse, self.factor = _point_filter(scale)
-        g = reverse[::-1]
-        self.lo = max(lo, start + k - (g.size - 1))  # inputs the outputs see
-        self.hi = min(hi, stop + k)
-        self.width = stop - start
-        size = self.hi - self.lo
-        if size <= 0:
-            self.part = None
-            return
-        first = start + k - self.hi + 1  # filter index of the first output and the last input
-        self.part = np.zeros(self.width + size - 1)
-        a, b = max(first, 0), min(first + self.part.size, g.size)
-        if b > a:
-            self.part[a - first:b - first] = g[a:b]
-        self.direct = self.width * size < DIRECT_LIMIT
-        if not self.direct:
-            self.fft_size = sfft.next_fast_len(self.part.size, real=True)
-            self.spectrum = sfft.rfft(self.part, self.fft_size) * self.factor
-
-    def __call__(self, piece: np.ndarray, at: int) -> np.ndarray:
-        """Transform of the signal equal to ``piece`` from sample ``at`` on (zero elsewhere)."""
-        if self.part is None:
-            return np.zeros(self.width)
-        a, b = max(at, self.lo), min(at + piece.size, self.hi)
-        if b <= a:
-            return np.zeros(self.width)
-        size = self.hi - self.lo
-        if a == self.lo and b == self.hi:
-            seg = piece[a - at:b - at]
-        else:
-            seg = np.zeros(size)
-            seg[a - self.lo:b - self.lo] = piece[a - at:b - at]
-        if self.direct:
-            return self.factor * np.convolve(seg, self.part, mode="valid")
-        y = sfft.irfft(sfft.rfft(seg, self.fft_size) * self.spectrum, self.fft_size)
-        return y[size - 1:size - 1 + self.width]
-
-
-def _cwt_at(x: np.ndarray, scale: float, start: int, stop: int) -> np.ndarray:
-    """The db4 transform of ``x`` at one scale, samples ``start..stop-1`` only (exact: the
-    convolution of the stretch of ``x`` those samples see)."""
-    return _Window(scale, start, stop, 0, x.size)(x, 0)
 
 
 def coarse_scales(dt: float) -> np.ndarray:
@@ -314,26 +77,6 @@ def coarse_scales(dt: float) -> np.ndarray:
 def tp_of_scale(scale: float, dt: float) -> float:
     """Pseudo-period (s) of the db4 wavelet at ``scale`` samples of ``dt`` s."""
     return scale * dt / FC
-
-
-@lru_cache(maxsize=None)
-def _pulse_wavelet():
-    _, psi, x = pywt.Wavelet(WAVELET).wavefun(level=PULSE_ITERATIONS)
-    return psi, x
-
-
-@byte_lru(FILTER_CACHE_BYTES)
-def _unit_wavelet(scale: float) -> tuple[int, np.ndarray]:
-    """The db4 wavelet at ``scale`` on samples, centred on sample 0, linearly interpolated from
-    the ``wavefun('db4', 4)`` grid (zero outside its support) as ``analyze_record.m`` draws it:
-    (first sample, relative to the centre; values), read-only."""
-    psi, x = _pulse_wavelet()
-    centre = 0.5 * (x[0] + x[-1])
-    first = int(math.ceil((x[0] - centre) * scale))
-    k = np.arange(first, int(math.floor((x[-1] - centre) * scale)) + 1)
-    values = np.interp(k / scale + centre, x, psi)
-    values.flags.writeable = False
-    return first, values
 
 
 def dwt_energy(v) -> float:
@@ -530,7 +273,8 @@ class PulseClassification:
         else:
             text = (f"not pulse-like: indicator PI = {self.indicator:.1f} <= 0 (without the extracted "
                     f"pulse the record keeps {100 * self.pgv_ratio:.0f} % of its peak velocity and "
-                    f"{100 * self.energy_ratio:.0f} % of its energy; PGV {100 * self.pgv:.0f} cm/s)")
+                    f"{100 * self.energy_ratio:.0f} % of its energy; the indicator's PGV, in the "
+                    f"pulse's direction and without baseline correction, {self.pgv:.3g} m/s)")
         v = self.velocity
         big, small = (max(v.max(), -v.min()), min(v.max(), -v.min())) if v.size else (0.0, 0.0)
         if not self.is_pulse and big > 0 and big >= ONE_SIDED_RATIO * max(small, 0.0):
@@ -578,12 +322,12 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
     Wavelets cut by the record's ends are transformed as they are."""
     n = signal.size
     refined = np.arange(scales[max(0, row - 1)], scales[min(scales.size - 1, row + 1)] + 1)
-    z = np.abs(_cwt_point(signal, refined, col))
+    z = np.abs(cwt_point(signal, refined, col))
     scale = int(refined[int(np.argmax(z))])
     half = math.ceil(scale * WINDOW)
     # every window searched lies within 2 half of the candidate's time: one transform covers all
     reach_lo, reach_hi = max(0, col - 2 * half), min(n, col + 2 * half + 1)
-    around = _cwt_at(signal, scale, reach_lo, reach_hi)
+    around = cwt_at(signal, scale, reach_lo, reach_hi)
     lo, hi = max(0, col - half), min(n, col + half + 1)
     k = int(np.argmax(np.abs(around[lo - reach_lo:hi - reach_lo])))
     at0 = lo + k
@@ -591,7 +335,7 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
     # later wavelets are sought within `half` samples of the first one
     lo, hi = max(0, at0 - half), min(n, at0 + half + 1)
     window = around[lo - reach_lo:hi - reach_lo].copy()
-    first, shape = _unit_wavelet(scale)
+    first, shape = unit_wavelet(scale)
     centre = -first
     span = 2 * half
     kernel = None  # transform of the unit wavelet at lags -span..span, when first needed
@@ -610,11 +354,11 @@ def _analyze(signal: np.ndarray, dt: float, col: int, row: int, scales: np.ndarr
             break
         if a == start and b == start + shape.size:  # wholly inside: the shifted kernel
             if kernel is None:
-                kernel = _Window(scale, centre, centre + 2 * span + 1, span, span + shape.size)(shape, span)
+                kernel = WindowedTransform(scale, centre, centre + 2 * span + 1, span, span + shape.size)(shape, span)
             window -= amp * kernel[lo - at + span:hi - at + span]
         else:  # cut by the record's ends: the transform of the samples kept
             if cut is None:  # inputs: every sample a wavelet centred in the window can cover
-                cut = _Window(scale, lo, hi, max(0, lo - centre), min(n, hi - 1 - centre + shape.size))
+                cut = WindowedTransform(scale, lo, hi, max(0, lo - centre), min(n, hi - 1 - centre + shape.size))
             window -= cut(amp * shape[a - start:b - start], a)
     resid = signal - pulse
     e_signal = np.cumsum(signal * signal)
@@ -731,7 +475,7 @@ def classify_pulse(record: Record, other: Record | None = None, *, energy=dwt_en
     # the (scale, time) map of C1^2 + C2^2, kept as the candidates need it (_StrongestMap)
     x = v1 if v2 is None else np.stack([v1, v2])
     strongest = _StrongestMap(x.shape[-1], scales.size, v2 is not None)
-    for i, row in _cwt_rows(x, tuple(float(a) for a in scales)):
+    for i, row in cwt_rows(x, tuple(float(a) for a in scales)):
         strongest.add(i, row)
     del x
     candidates = []

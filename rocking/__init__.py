@@ -24,8 +24,11 @@ _WHERE = {
     "equivalent_size": "frame", "eta_frame": "frame", "frame_p": "frame",
     "CriticalScale": "fragility", "Fragility": "fragility", "critical_scale": "fragility",
     "fragility": "fragility",
+    "risk": "risk", "HazardCurve": "risk", "read_hazard": "risk",
     "FIT_TOLERANCE": "governing", "GoverningPulse": "governing", "fitting_candidates": "governing",
     "governing_pulse": "governing",
+    "FrictionCheck": "friction", "FrictionDemand": "friction", "friction_demand": "friction",
+    "SlidingWidth": "sliding", "sliding_width": "sliding", "Body": "bodies", "RestitutionFit": "restitution_fit", "fit_restitution": "restitution_fit",
 }
 
 __all__ = sorted(_WHERE)

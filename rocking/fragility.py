@@ -275,7 +275,9 @@ class Fragility:
     beta : float
         Lognormal dispersion: the standard deviation of ``ln`` of the critical intensities.
     measure : str
-        ``"scale"`` (factor on the records) or ``"pga"`` (PGA of the scaled record, g).
+        ``"scale"`` (factor on the records), ``"pga"`` (PGA of the scaled record, g), or the
+        measure of a hazard curve (``"PGA"``, ``"PGV"`` in cm/s, ``"SA(1.0)"`` in g: the critical
+        scale times the measure of the unscaled record, :func:`fragility`'s ``intensities``).
     values : ndarray
         The critical intensities fitted (``inf`` for records that did not overturn up to their
         ``up_to``: right-censored there).
@@ -323,6 +325,20 @@ class Fragility:
         return plain({"median": self.median, "beta": self.beta, "measure": self.measure, "n": self.n,
                       "values": self.values, "censored_at": self.censored_at})
 
+    def goodness_of_fit(self, n_boot: int = 200, seed: int = 0):
+        """How well the lognormal fits the critical values: Kolmogorov-Smirnov's distance and its
+        p-value by a parametric bootstrap (:func:`rocking.risk.fit.goodness_of_fit`)."""
+        from .risk.fit import goodness_of_fit
+
+        return goodness_of_fit(self, n_boot=n_boot, seed=seed)
+
+    def bootstrap(self, n: int = 200, seed: int = 0):
+        """``(medians, betas)`` of the fit to ``n`` resamplings of the records with replacement:
+        its sampling uncertainty (:func:`rocking.risk.fit.bootstrap`)."""
+        from .risk.fit import bootstrap
+
+        return bootstrap(self, n=n, seed=seed)
+
     def empirical(self):
         """``(x, share)``: the sorted critical intensities and the share of records overturned at
         or below each (the points the curve is fitted to; censored records never count)."""
@@ -330,7 +346,24 @@ class Fragility:
         return x, np.arange(1, x.size + 1) / self.values.size
 
 
-def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility:
+def _measure(measure, intensities):
+    """The measure's name as the fit keeps it (``scale``, ``pga``, or a hazard curve's)."""
+    if measure in ("scale", "pga") and intensities is None:
+        return measure
+    from pulses.intensity import measure_name, parse_measure
+
+    try:
+        name = measure_name(*parse_measure(measure))
+    except ValueError as exc:
+        raise ValueError(f"fragility: measure must be 'scale', 'pga' or a hazard curve's (PGA, "
+                         f"PGV, SA(T)): {exc}") from None
+    if intensities is None:
+        raise ValueError(f"fragility: measure {name} needs intensities= (the {name} of each "
+                         "unscaled record, pulses.intensity)")
+    return name
+
+
+def fragility(critical, *, measure="scale", up_to=None, limit=None, intensities=None) -> Fragility:
     """Lognormal fragility fitted by maximum likelihood to the critical scales of a suite.
 
     Parameters
@@ -347,6 +380,10 @@ def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility
     limit : float, optional
         The performance level the critical scales were found for (``critical_scale(...,
         limit=)``; None: overturning); a :class:`CriticalScale` entry of another level is refused.
+    intensities : sequence of float, optional
+        With a hazard curve's ``measure`` (``"PGA"``, ``"PGV"``, ``"SA(1.0)"``): the measure of each
+        record as given (unscaled; g, or cm/s for PGV), one per entry.  A record scaled by ``k``
+        has ``k`` times each of them, so the critical value is the critical scale times it.
 
     Returns
     -------
@@ -363,16 +400,19 @@ def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility
     >>> round(f.median, 3), round(f.beta, 3), f.n
     (1.921, 0.442, 4)
     """
-    if measure not in ("scale", "pga"):
-        raise ValueError(f"fragility: measure must be 'scale' or 'pga', got {measure!r}")
+    measure = _measure(measure, intensities)
     limit = check_limit(limit)
+    critical = list(critical)
+    ims = None if intensities is None else [float(v) for v in intensities]
+    if ims is not None and len(ims) != len(critical):
+        raise ValueError(f"fragility: {len(ims)} intensities for {len(critical)} critical scales")
     values, limits = [], []
-    for item in critical:
+    for i, item in enumerate(critical):
         if isinstance(item, CriticalScale) and item.limit != limit:
             raise ValueError(f"fragility: a critical scale for limit {item.limit!r} among those "
                              f"for limit {limit!r} (max|theta|/alpha; None: overturning)")
         if isinstance(item, CriticalScale):
-            unit = 1.0 if measure == "scale" else item.pga / G
+            unit = ims[i] if ims is not None else 1.0 if measure == "scale" else item.pga / G
             values.append(math.inf if item.scale is None else item.scale * unit)
             limits.append(item.up_to * unit)
         else:
@@ -384,8 +424,9 @@ def fragility(critical, *, measure="scale", up_to=None, limit=None) -> Fragility
             if math.isinf(v) and up_to is None:
                 raise ValueError("fragility: a record that did not overturn needs up_to "
                                  "(the largest intensity examined)")
-            values.append(v)
-            limits.append(math.nan if up_to is None else float(up_to))
+            unit = 1.0 if ims is None else ims[i]
+            values.append(v * unit)
+            limits.append(math.nan if up_to is None else float(up_to) * unit)
     values, limits = np.asarray(values, dtype=float), np.asarray(limits, dtype=float)
     if values.size == 0:
         raise ValueError("fragility: no critical scales given")

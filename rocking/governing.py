@@ -93,7 +93,7 @@ class GoverningPulse:
 
 
 def governing_pulse(fit, height: float, *, cap_mass_ratio: float = 0.0,
-                    tolerance: float = FIT_TOLERANCE) -> GoverningPulse:
+                    tolerance: float = FIT_TOLERANCE, body=None) -> GoverningPulse:
     """The pulse Eq. 31 is applied to, as ``pipeline run`` chooses it.
 
     Among the shapes that fit the record (:func:`fitting_candidates`), the one whose Eq. 31
@@ -110,6 +110,8 @@ def governing_pulse(fit, height: float, *, cap_mass_ratio: float = 0.0,
         A rocking frame's cap beam mass over the columns' (0: a lone column).
     tolerance : float
         Share of the best score a shape needs to fit.
+    body : rocking.bodies.Body or str, optional
+        The column's shape (default rectangular; ``"cylinder"``: its ``p`` in Eq. 31).
 
     Returns
     -------
@@ -127,7 +129,8 @@ def governing_pulse(fit, height: float, *, cap_mass_ratio: float = 0.0,
     """
     from .widths import required_width
 
-    widths = [(float(required_width(height, c.pulse, rule="eq31", cap_mass_ratio=cap_mass_ratio).width), c)
+    widths = [(float(required_width(height, c.pulse, rule="eq31", cap_mass_ratio=cap_mass_ratio,
+                                    body=body).width), c)
               for c in fitting_candidates(fit, tolerance)]
     width, gov = max(widths, key=lambda wc: wc[0])  # max keeps the first of equal widths: the better fit
     return GoverningPulse(gov, width, float(height), widths)

@@ -254,7 +254,7 @@ def simulate_vertical_reference(block: Block, record: Record, vertical: Record |
         Horizontal ground acceleration ``ag``.
     vertical : pulses.Record, optional
         Upward ground acceleration ``av`` on the same time axis (a PEER ``DWN`` file multiplied by
-        -1 first: :func:`pulses.peer.upward`); None: horizontal motion only.
+        -1 first: :func:`pulses.triplets.upward`); None: horizontal motion only.
     duration : float, optional
         Only the first ``duration`` seconds of the records.
     zeno_tol : float, optional

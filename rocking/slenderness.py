@@ -91,7 +91,7 @@ def _unit_pulse(shape, tp):
 
 def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_scan=None,
                           n_zone=None, rtol=None, model="fast", refine="all", ksection=None,
-                          settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0):
+                          settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, body=None):
     """Exact minimum slenderness for many ``(pTp, ap/g)`` points of one pulse shape at once.
 
     By the similarity law (docs/theory.md section 4) the answer depends only on ``pTp`` and ``ap/g``, so
@@ -103,6 +103,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     bisection: the same ``tan_alpha`` (to ``rtol``) from fewer runs, which is what
     ``pipeline run`` needs for a few blocks per record.  ``n_scan``, ``n_zone``, ``rtol`` and
     ``ksection`` override the fields of ``settings`` (:class:`rocking.search.SearchSettings`).
+    ``body`` (:mod:`rocking.bodies`): the impact rule at each slenderness is that body's.
 
     Examples
     --------
@@ -127,7 +128,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     known[:, -1] = True            # tan(alpha) = ap/g: never uplifts
 
     def evaluate(idx, tans):
-        blocks = Blocks.from_tan_alpha(p_tp[idx], tans, cap_mass_ratio=gamma)
+        blocks = Blocks.from_tan_alpha(p_tp[idx], tans, cap_mass_ratio=gamma, body=body)
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
     scan = _scan_refine(evaluate, x, settings, known=known, zone=settings.zone_points != 0,
@@ -149,7 +150,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
 
 
 def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None, rtol=None,
-                    model="fast", settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0):
+                    model="fast", settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, body=None):
     """Exact minimum slenderness (docs/theory.md section 5, the paper's Fig. 8).
 
     The smallest ``tan(alpha)`` for which a block of frequency parameter ``p`` survives
@@ -180,6 +181,8 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     cap_mass_ratio : float
         A rocking frame (docs/theory.md section 8): ``p`` is then the frame's (``block.p``) and ``eta`` the
         frame's at each slenderness; 0, the lone column.
+    body : rocking.bodies.Body or str, optional
+        The body's shape (default rectangular): ``eta`` at each slenderness is its impact rule.
 
     Returns
     -------
@@ -204,7 +207,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
         res = min_slenderness_batch(pulse.shape, p * pulse.tp, abs(pulse.ap) / G,
                                     criterion=criterion, n_scan=n_scan, n_zone=n_zone, rtol=rtol,
                                     model=model, settings=settings,
-                                    cap_mass_ratio=cap_mass_ratio)[0]
+                                    cap_mass_ratio=cap_mass_ratio, body=body)[0]
         res.p, res.excitation = p, pulse
         return res
     # a record (or any excitation the solver accepts): scan tan(alpha) directly
@@ -216,7 +219,8 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     known[:, -1] = True
 
     def evaluate(idx, tans):
-        blocks = Blocks.from_tan_alpha(np.full(len(tans), p), tans, cap_mass_ratio=gamma)
+        blocks = Blocks.from_tan_alpha(np.full(len(tans), p), tans, cap_mass_ratio=gamma,
+                                       body=body)
         return _failed(_batch(blocks, pulse, None, model=model), criterion)
 
     scan = _scan_refine(evaluate, x, settings, known=known, refine="top",

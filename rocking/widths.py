@@ -13,7 +13,8 @@ import numpy as np
 from pulses import G, SHAPES
 
 from . import scan, searches
-from .block import Block, Blocks
+from .block import Block, Blocks, _p_alpha
+from .bodies import RECTANGULAR, Body, check_frame
 from .frame import check_cap_mass_ratio, frame_p
 from .closed_forms import envelope_rule, eq20, eq31
 from .search import (DEFAULT_SETTINGS, _batch, _check_criterion, _failed, _peak, _scan_points,
@@ -113,6 +114,8 @@ class RequiredWidth:
     #: what the runs depend on (record and vertical hashed, height, restitution, frame, model):
     #: a level may reuse only the runs of the same inputs
     inputs: tuple | None = field(default=None, repr=False, compare=False)
+    #: the column's shape (:mod:`rocking.bodies`): the width is a cylinder's diameter
+    body: Body = field(default=RECTANGULAR, compare=False)
 
     @property
     def total_runs(self) -> int:
@@ -157,7 +160,7 @@ class RequiredWidth:
     @property
     def block(self) -> Block:
         return Block.from_dimensions(self.height, self.width, self.eta,
-                                     cap_mass_ratio=self.cap_mass_ratio)
+                                     cap_mass_ratio=self.cap_mass_ratio, body=self.body)
 
     @property
     def p(self) -> float:
@@ -168,7 +171,9 @@ class RequiredWidth:
         return math.atan2(self.width, self.height)
 
 
-def _p_of(height, width, gamma=0.0):
+def _p_of(height, width, gamma=0.0, body=RECTANGULAR):
+    if not body.is_rectangular:
+        return _p_alpha(height, width, gamma, body)[0]
     return frame_p(math.sqrt(3.0 * G / (4.0 * math.hypot(height / 2.0, width / 2.0))), gamma)
 
 
@@ -178,7 +183,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
                    shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
                    settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None, limit=None,
-                   horizontal=None, overturning=None):
+                   horizontal=None, overturning=None, body=None):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -221,6 +226,9 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         ``rule="exact"`` under a record: its upward vertical acceleration on the same time axis
         (docs/theory.md section 10): every run uses the compiled engine with it; the no-uplift
         width is ``H max|ag|/(g + av)``; a vertical reaching -g (free flight) is refused.
+    body : rocking.bodies.Body or str, optional
+        The column's shape: rectangular (default) or ``"cylinder"`` (the width is its diameter;
+        its ``p`` and impact rule, docs/theory.md "Bodies").
 
     Returns
     -------
@@ -235,10 +243,15 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     [2.17, 1.736]
     """
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
+    body = Body.parse(body)
+    check_frame(body, gamma)
+    if not body.has_dimensions:
+        raise ValueError("required_width: a custom body has no width to vary; check it as it "
+                         "stands (rocking.simulate, rocking.eq31 at its p)")
     height = _check_arguments(height, rule, overturning, limit, vertical, excitation)
     if rule == "exact":
         kw = dict(criterion=criterion, eta=eta, n_scan=n_scan, rtol=rtol, model=model,
-                  n_zone=n_zone, settings=settings, gamma=gamma, limit=limit)
+                  n_zone=n_zone, settings=settings, gamma=gamma, limit=limit, body=body)
         if vertical is None:
             return _exact_width(height, excitation, overturning=overturning, **kw)
         over_h, over_v = _motions(overturning, horizontal)
@@ -249,6 +262,11 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
         raise ValueError(f"rule={rule!r} needs a pulse (ap, Tp); for a whole record fit its pulse "
                          "first or use rule='exact'")
+    return _closed_form_width(height, excitation, rule, shape, lam, eta, gamma, body)
+
+
+def _closed_form_width(height, excitation, rule, shape, lam, eta, gamma, body) -> RequiredWidth:
+    """A closed form ``rule`` solved as a fixed point in the width (:func:`required_width`)."""
     ap, tp = abs(excitation.ap), excitation.tp
     if rule == "eq31":
         f = lambda p: eq31(ap, tp, p)
@@ -261,7 +279,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     # steps.  Started from the no-uplift width H ap/g, an upper bound of the answer.
     width = height * ap / G
     for it in range(1, 201):
-        new = height * f(_p_of(height, width, gamma))
+        new = height * f(_p_of(height, width, gamma, body))
         if abs(new - width) <= 1e-13 * max(height, 1.0):
             width = new
             break
@@ -269,12 +287,12 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     else:  # pragma: no cover - the map is a strong contraction for any realistic column
         from scipy.optimize import brentq
 
-        width = brentq(lambda b: b - height * f(_p_of(height, b, gamma)), 0.0,
+        width = brentq(lambda b: b - height * f(_p_of(height, b, gamma, body)), 0.0,
                        height * ap / G + 1e-300,
                        xtol=1e-14)
     return RequiredWidth(width=float(width), height=height, rule=rule, iterations=it,
                          method=f"fixed point of {rule} in B (p depends on B): "
-                                f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
+                                f"{it} iterations", eta=eta, cap_mass_ratio=gamma, body=body)
 
 
 def _check_arguments(height, rule, overturning, limit, vertical, excitation) -> float:
@@ -351,16 +369,17 @@ def _uplift_ratio(record, vertical) -> float:
 
 
 def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_zone=None,
-                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None, limit=None, overturning=None):
+                 settings=DEFAULT_SETTINGS, gamma=0.0, vertical=None, limit=None, overturning=None,
+                 body=RECTANGULAR):
     _check_criterion(criterion)
     # wider than this the column never uplifts
     top = height * (_peak(excitation) / G if vertical is None else _uplift_ratio(excitation, vertical))
     if top <= 0:
         return RequiredWidth(0.0, height, "exact", 0, "no ground motion", criterion,
-                             cap_mass_ratio=gamma, limit=limit, search_width=0.0)
+                             cap_mass_ratio=gamma, limit=limit, search_width=0.0, body=body)
 
     def run_widths(widths):  # not `runs`: that name counts the runs below
-        blocks = Blocks.from_dimensions(height, widths, eta, cap_mass_ratio=gamma)
+        blocks = Blocks.from_dimensions(height, widths, eta, cap_mass_ratio=gamma, body=body)
         if vertical is not None:
             import rocking
 
@@ -371,19 +390,25 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
     if not is_pulse:
         inputs = (searches.digest(excitation.acc), float(excitation.dt),
                   None if vertical is None else (searches.digest(vertical.acc), float(vertical.dt)),
-                  float(height), eta, float(gamma), model)
+                  float(height), eta, float(gamma), model) + _body_key(body)
         runs = _Runs(run_widths, None if overturning is True else overturning, inputs)
         settings = settings.replace(record_scan=n_scan, rtol=rtol, record_zone_points=n_zone)
         res = _record_design(height, excitation, top, runs, criterion=criterion, eta=eta,
                              gamma=gamma, limit=limit, model=model, vertical=vertical,
-                             settings=settings, overturning=overturning)
-        res.inputs = inputs
+                             settings=settings, overturning=overturning, body=body)
+        res.inputs, res.body = inputs, body
         return res
     res = _pulse_width(height, top, lambda idx, widths: _failed(run_widths(widths), criterion, limit),
                        settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol))
     res.criterion, res.eta, res.cap_mass_ratio, res.limit = criterion, eta, gamma, limit
-    res.search_width = res.width
+    res.search_width, res.body = res.width, body
     return res
+
+
+def _body_key(body) -> tuple:
+    """What a body adds to the keys of a search's runs and seeds: nothing for the rectangle (its
+    keys, seeds and so its numbers are those of a package that knew no other body)."""
+    return () if body.is_rectangular else (repr(body),)
 
 
 class _Runs:
@@ -432,7 +457,7 @@ class _Runs:
 
 
 def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limit, model, vertical,
-                   settings, overturning):
+                   settings, overturning, body=RECTANGULAR):
     """The design width under a record: the search (kept between calls, :mod:`rocking.searches`),
     the check above it, and with ``overturning`` (a design, or True: :func:`_overturning_above`)
     at least that design's width."""
@@ -452,9 +477,10 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
         return out
 
     res, seen = searches.remembered(  # a batch's later pass: the same search (rocking.searches)
-        searches.key(excitation, vertical, settings, height, criterion, eta, gamma, limit, model), search)
+        searches.key(excitation, vertical, settings, height, criterion, eta, gamma, limit, model,
+                     *_body_key(body)), search)
     shared, runs.shared, runs.log = res.shared_runs, 0, list(res.outcomes or ())
-    res.cap_mass_ratio, res.limit, res.search_width = gamma, limit, res.width
+    res.cap_mass_ratio, res.limit, res.search_width, res.body = gamma, limit, res.width, body
     if vertical is not None:
         res.method += "; with the vertical record (compiled engine, fast-vertical)"
     if limit is not None:
@@ -464,12 +490,13 @@ def _record_design(height, excitation, top, runs, *, criterion, eta, gamma, limi
     if not res.below_scan and settings.check_runs > 0 and (binned or reach > settings.check_above):
         seed = settings.check_seed
         if seed is None:
-            seed = _record_seed(excitation, height, criterion, eta, gamma, limit)
+            seed = _record_seed(excitation, height, criterion, eta, gamma, limit, body)
         check = _check_bins if binned else _check_rounds
         seen = check(res, top, evaluate_record, settings, seed, seen)
     if overturning is True:
         overturning = _overturning_above(res, height, excitation, top, runs, eta=eta, gamma=gamma,
-                                         model=model, vertical=vertical, settings=settings)
+                                         model=model, vertical=vertical, settings=settings,
+                                         body=body)
     if overturning is not None:
         res.overturning_width = float(overturning.width)
         if overturning.width > res.width:
@@ -589,10 +616,10 @@ def follow_widths(width, top, widths, ratio, failed, n, settings=DEFAULT_SETTING
     return np.sort(np.concatenate(x))
 
 
-def _record_seed(record, height, criterion, eta, gamma, limit=None) -> int:
+def _record_seed(record, height, criterion, eta, gamma, limit=None, body=RECTANGULAR) -> int:
     """A seed made from the record's samples and the column (the same run, the same check)."""
     h = hashlib.sha256(np.ascontiguousarray(record.acc, dtype="<f8").tobytes())
-    key = (float(record.dt), float(height), criterion, eta, float(gamma))
+    key = (float(record.dt), float(height), criterion, eta, float(gamma)) + _body_key(body)
     h.update(repr(key if limit is None else key + (float(limit),)).encode())
     return int.from_bytes(h.digest()[:8], "little")
 
@@ -674,7 +701,7 @@ def _store_check(res, checked, seen, hi, method) -> None:
 
 
 def _overturning_above(res, height, excitation, top, runs, *, eta, gamma, model, vertical,
-                       settings):
+                       settings, body=RECTANGULAR):
     """The overturning design of the level ``res`` (its search and check done, ``runs`` its runs)
     where it can change the level's answer: its search (answered from the level's batches where
     they coincide: the geometric scan, the fine zone's blocks where the two zones overlap), and
@@ -690,7 +717,7 @@ def _overturning_above(res, height, excitation, top, runs, *, eta, gamma, model,
         settings = settings.replace(check_above=max(float(settings.check_above), float(res.width)))
     over = _record_design(height, excitation, top, own, criterion="overturn", eta=eta, gamma=gamma,
                           limit=None, model=model, vertical=vertical, settings=settings,
-                          overturning=None)
+                          overturning=None, body=body)
     runs.share(over.outcomes)   # the level's run at its width and a bisection above: maybe run there
     res.overturning_above, res.overturning_design = float(res.width), over
     return over

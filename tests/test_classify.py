@@ -9,16 +9,10 @@ import numpy as np
 import pytest
 
 import pulses
-from pulses.pairs import check_pair, component, pair_files, read_pair, rotate_pair
-from pulses.velocity import (
-    FC,
-    _cwt_at,
-    _pulse_wavelet,
-    classify_pulse,
-    coarse_scales,
-    db4_cwt,
-    db4_cwt_direct,
-)
+from pulses.io import read_pair
+from pulses.pairs import check_pair, component, pair_files, rotate_pair
+from pulses.db4 import FC, _pulse_wavelet, cwt_at, db4_cwt, db4_cwt_direct
+from pulses.velocity import classify_pulse, coarse_scales
 
 from .conftest import SHARED_RECORDS, shared_record
 
@@ -80,7 +74,7 @@ def test_transform_on_windows_equals_full_transform():
     for a in (20.0, 300.0):
         full = db4_cwt_direct(x, [a])[0]
         for start, stop in [(0, 1), (1500, 1501), (2999, 3000), (0, 400), (1200, 1900), (2700, 3000)]:
-            part = _cwt_at(x, a, start, stop)
+            part = cwt_at(x, a, start, stop)
             np.testing.assert_allclose(part, full[start:stop], rtol=0, atol=1e-11 * np.max(np.abs(full)))
 
 
@@ -203,7 +197,7 @@ def test_published_pulse_pairs(first, second, rsn):
     assert result.pgv * 100 == pytest.approx(float(row["pgv_cm_s"]), rel=0.01)
     if rsn == 879:
         # Lucerne's components are 85 deg apart; the reference algorithm (which treats them as
-        # orthogonal) gives about 75 deg, the table 270 (i.e. 90): not asserted, see docs/classification.md
+        # orthogonal) gives about 75 deg, the table 270 (i.e. 90): not asserted, see docs/validation-classification.md
         return
     assert _axis_difference(result.azimuth, float(row["orientation_north_deg"])) < 1.0
 

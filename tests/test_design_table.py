@@ -91,7 +91,7 @@ def test_eq31_safe_island_and_the_suite_answer():
     assert lines["b"].rstrip().endswith("NO: safe island")
     assert ("Suite, column 7.5x1.8: the design width covering all 3 record(s) is 2.200 m (set by b); "
             "as it stands (1.800 m) it FAILS: 0 record(s) overturn it, 1 leave it on a safe island") in text
-    assert "Eq. 31 is below the design width on 1 of 3 record(s); its design overturns under 1." in text
+    assert "Eq. 31 is below the design width on 1 of 3 record(s); a column of Eq. 31's width overturns under 1 of them." in text
     # a level: a column that stands but exceeds R fails it
     lv = design_rows([dict(base, record="a", pair="a", design_limit=0.4)])[0]
     assert lv["survives"] is False and lv["verdict"] == "NO"

@@ -88,9 +88,9 @@ def test_a_list_of_results_is_one_frame():
         pulses.to_frame([1.0])
 
 
-@pytest.mark.parametrize("module", ["pulses.export", "pulses.traces", "pulses.record", "pulses.shapes",
-                                    "pulses.velocity", "pulses.scenario", "pulses.fit", "pulses.pairs", "pulses.sac",
-                                    "pulses.io", "rocking.governing", "rocking.widths", "rocking._common",
+@pytest.mark.parametrize("module", ["pulses.export", "pulses.io.streams", "pulses.record", "pulses.shapes",
+                                    "pulses.velocity", "pulses.scenario", "pulses.fit.fitter", "pulses.fit.results", "pulses.pairs",
+                                    "pulses.formats.sac", "pulses.io.read", "rocking.governing", "rocking.widths", "rocking._common",
                                     "rocking.slenderness", "rocking.block", "rocking.closed_forms", "rocking.frame",
                                     "rocking.solver", "rocking.fragility", "rocking.spectrum",
                                     "rocking.reference_vertical", "pulses.errors", "pipeline.api"])

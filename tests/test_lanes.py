@@ -20,7 +20,7 @@ import pytest
 import pulses
 import rocking
 from pulses import G
-from pulses.synthetic import synthetic_record
+from pulses.fit.synthetic import synthetic_record
 from rocking import Block, lanes, simulate, simulate_many
 
 

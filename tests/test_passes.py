@@ -22,6 +22,9 @@ ROUNDS = DEFAULT_SETTINGS.replace(check_layout="rounds")
 #: what the check decides besides its own columns: the direction's design width (the search's
 #: width where it found no failing width above it)
 DESIGN = CHECK + ["design_width_m", "design_tan_alpha", "design_adequate"]
+#: and what follows from the design width: the column's restitution, friction and checks there
+DESIGN += ["design_eta", "design_friction_demand", "design_min_normal_force", "design_slides",
+           "design_t_slide_s", "friction_width_m", "validity"]
 #: and with ``--limit``, the overturning design's width (its check runs where the level's does)
 LEVEL_DESIGN = DESIGN + ["overturning_width_m"]
 

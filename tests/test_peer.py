@@ -14,7 +14,7 @@ import pytest
 import pulses
 from pipeline.cli import main
 from pulses import RecordError
-from pulses import peer
+from pulses import peer, triplets
 
 #: ``../shared/records/peer_download`` beside the checkout: a real PEER search report and the files
 #: of four of its 86 records (RSN 15, 41, 77, 78; RSN 78 has no vertical in PEER's database)
@@ -43,7 +43,7 @@ def download_zip(download, tmp_path) -> pathlib.Path:
 
 
 def reference_table(download) -> pd.DataFrame:
-    """The metadata table read by pandas, independently of pulses.peer."""
+    """The metadata table read by pandas, independently of pulses.io.peer."""
     lines = (download / peer.SEARCH_RESULTS).read_text().splitlines()
     start = next(i for i, ln in enumerate(lines) if ln.startswith("Result ID,"))
     n = next(i for i in range(start + 1, len(lines)) if not lines[i].strip()) - start - 1
@@ -199,9 +199,9 @@ def test_vertical_polarity_from_name_and_header(download):
     d = peer.PeerDownload(download)
     up = d.read_component("RSN15_KERN_TAF-UP.AT2")
     dwn = d.read_component("RSN41_LYTLECR_ORRDWN.AT2")
-    assert peer.vertical_polarity(up) == 1 and peer.vertical_polarity(dwn) == -1
-    np.testing.assert_array_equal(peer.upward(dwn).acc, -dwn.acc)  # DWN: multiplied by -1
-    np.testing.assert_array_equal(peer.upward(up).acc, up.acc)
+    assert triplets.vertical_polarity(up) == 1 and triplets.vertical_polarity(dwn) == -1
+    np.testing.assert_array_equal(triplets.upward(dwn).acc, -dwn.acc)  # DWN: multiplied by -1
+    np.testing.assert_array_equal(triplets.upward(up).acc, up.acc)
 
 
 @pytest.mark.parametrize("name, component, expected", [
@@ -214,9 +214,9 @@ def test_vertical_polarity_is_never_guessed(tmp_path, name, component, expected)
     rec = pulses.read_record(path)
     if expected is None:
         with pytest.raises(RecordError, match="polarity"):
-            peer.vertical_polarity(rec)
+            triplets.vertical_polarity(rec)
     else:
-        assert peer.vertical_polarity(rec) == expected
+        assert triplets.vertical_polarity(rec) == expected
 
 
 # -- pipeline run on the shared download -------------------------------------------------------------

@@ -154,7 +154,8 @@ def test_plots_identical_whatever_jobs_and_on_rerun(tmp_path):
     assert main(["run", *recs, *PLOT_ARGS, "--out", str(one), "--jobs", "1"]) == 0
     assert main(["run", *recs, *PLOT_ARGS, "--out", str(two), "--jobs", "2"]) == 0
     first = tree(one)
-    assert sum(n.endswith(".png") for n in first) == 6 + 2  # the records, summary.png, suite.png
+    # the records, their friction figures, summary.png, suite.png
+    assert sum(n.endswith(".png") for n in first) == 6 + 6 + 2
     assert tree(two) == first
     assert main(["run", *recs[::-1], *PLOT_ARGS, "--out", str(two), "--jobs", "2"]) == 0
     assert {n: b for n, b in tree(two).items() if n.endswith(".png") and "summary" not in n} == \

@@ -158,7 +158,7 @@ def test_record_figure_velocity_pulse_and_design_width(tmp_path):
 
     path = write_good(tmp_path, 4)
     task, = make_tasks([str(path)], [Column(7.5, 1.8)], Options())
-    rows, (record, fit, fitting, histories, _velocity), _designs = _process(task)
+    rows, (record, fit, fitting, histories, _velocity), _designs, _friction = _process(task)
     (label, curves), = histories
     assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "design width"]
     _, block_v, res_v = curves[2]

@@ -10,7 +10,7 @@ import pytest
 
 import pulses
 from pulses import G, Record, RecordError, read_record, write_sac
-from pulses.at2 import _is_at2, _read_at2, parse_npts_dt
+from pulses.formats.at2 import _is_at2, _read_at2, parse_npts_dt
 
 from .conftest import shared_record
 
@@ -419,8 +419,8 @@ def test_records_longer_than_max_samples_refused(tmp_path):
 
 
 def test_reading_in_blocks_gives_every_sample(tmp_path, monkeypatch):
-    import pulses.at2
-    import pulses.textfile
+    import pulses.formats.at2
+    import pulses.formats.text
 
     rng = np.random.default_rng(3)
     acc = rng.normal(0.0, 0.2, 1003)
@@ -432,8 +432,8 @@ def test_reading_in_blocks_gives_every_sample(tmp_path, monkeypatch):
                                        for i in range(0, acc.size, 5)), npts=acc.size)
     whole = read_record(csv, units="g"), read_record(at2)
     # blocks of about 100 characters: block edges fall everywhere, a comment inside one
-    monkeypatch.setattr(pulses.textfile, "_BLOCK_CHARS", 100)
-    monkeypatch.setattr(pulses.at2, "_BLOCK_CHARS", 100)
+    monkeypatch.setattr(pulses.formats.text, "_BLOCK_CHARS", 100)
+    monkeypatch.setattr(pulses.formats.at2, "_BLOCK_CHARS", 100)
     blocks = read_record(csv, units="g"), read_record(at2)
     # repr() and %.7E digits read back exactly (float64 parsing is correctly rounded)
     np.testing.assert_array_equal(whole[0].acc, acc * G)

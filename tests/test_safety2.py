@@ -497,7 +497,7 @@ def test_classification_caches_stay_within_their_bytes():
     import numpy as np
 
     import pulses
-    from pulses import velocity
+    from pulses import db4
 
     dt = 1e-4
     t = np.arange(60_000) * dt
@@ -505,6 +505,5 @@ def test_classification_caches_stay_within_their_bytes():
     acc += 0.05 * np.sin(2 * np.pi * 7.0 * t)
     res = pulses.classify_pulse(pulses.Record(acc, dt, name="fine"))
     assert res.tp > 0
-    for cache in (velocity.difference_filter, velocity._point_filter, velocity._unit_wavelet,
-                  velocity._filter_spectrum):
+    for cache in (db4.difference_filter, db4._point_filter, db4.unit_wavelet, db4._filter_spectrum):
         assert 0 < cache.cache_bytes() <= cache.max_bytes

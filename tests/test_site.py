@@ -44,7 +44,7 @@ def _pair(folder, name, ap1, ap2, seed):
 
 
 def _synthetic(ap, seed):
-    from pulses.synthetic import synthetic_record
+    from pulses.fit.synthetic import synthetic_record
 
     return synthetic_record("sine", ap * pulses.G, 1.0, 2.0, 8.0, dt=0.01, noise=0.3, seed=seed)
 
@@ -219,7 +219,7 @@ def test_pulse_columns_and_warning(pairs, tmp_path):
     folder, ((a1, a2), _) = pairs
     out = tmp_path / "cls"
     noise = tmp_path / "noise.sac"
-    from pulses.synthetic import band_noise
+    from pulses.fit.synthetic import band_noise
 
     acc = band_noise(800, 0.01, 0.5, np.random.default_rng(3))
     pulses.write_sac(pulses.Record(acc, 0.01, "noise", 0.0, {}), noise)

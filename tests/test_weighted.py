@@ -1,12 +1,12 @@
 """The pulse fitter's least squares, part by part, against independent dense references.
 
-:mod:`pulses.weighted` computes generalised least squares in the frequency domain: a noise whose
+:mod:`pulses.fit.weighted` computes generalised least squares in the frequency domain: a noise whose
 covariance is the circulant of a power spectrum ``P`` (over the FFT's ``nfft`` points) weights a
 residual's bins by ``1 / P``.  The references here build the same covariance as a dense matrix
 (``C = circulant(ifft(P))``, ``C^-1 = circulant(ifft(1 / P))``), whiten with its Cholesky factor and
 solve with :func:`numpy.linalg.lstsq` or :func:`scipy.optimize.least_squares`; the window is shorter
 than ``nfft`` (zero-padded), so the metric on the window's samples is ``C^-1[:n, :n]``.
-:mod:`pulses.lsq`'s Levenberg-Marquardt and baseline projector are checked the same way.
+:mod:`pulses.fit.lsq`'s Levenberg-Marquardt and baseline projector are checked the same way.
 
 Tolerances: the FFT sums and the dense products are two roundings of the same double-precision
 sums over a few hundred samples with a spectrum spanning a factor 10 (condition numbers below
@@ -22,9 +22,9 @@ from scipy import fft as sfft
 from scipy import linalg, optimize
 
 from pulses import shape_class
-from pulses.fit import Background
-from pulses.lsq import baseline_projector, levenberg_marquardt, normal_equations
-from pulses.weighted import WeightedWindow, difference_covariance, gram
+from pulses.fit.background import Background
+from pulses.fit.lsq import baseline_projector, levenberg_marquardt, normal_equations
+from pulses.fit.weighted import WeightedWindow, difference_covariance, gram
 
 DT = 0.01
 N = 397  # window samples; the FFT pads them to 400 points (5-smooth), so padding is exercised
@@ -38,7 +38,7 @@ def spectrum(nfft):
 
 
 def weights(nfft):
-    """The bins' weights for :func:`spectrum`, as :meth:`pulses.fit.Background.weights` makes them:
+    """The bins' weights for :func:`spectrum`, as :meth:`pulses.fit.background.Background.weights` makes them:
     interior bins stand for two bins of the full FFT."""
     w = 2.0 / (nfft * spectrum(nfft))
     w[0] *= 0.5
@@ -358,14 +358,14 @@ def test_support_columns_are_sampled_with_derivatives(shape):
 @pytest.mark.parametrize("baseline", [True, False])
 @pytest.mark.parametrize("noise", [0.1, 1e-9])
 def test_pulse_normal_equations_are_those_of_the_projected_residual(shape, baseline, noise):
-    """:func:`pulses.lsq.pulse_normal_equations` (products on the pulse's support, the projector
+    """:func:`pulses.fit.lsq.pulse_normal_equations` (products on the pulse's support, the projector
     applied algebraically) against :func:`normal_equations` of the residual ``xp - ap P m`` and its
     Jacobian formed on the whole window.  Two roundings of the same sums over ~400 samples:
     ``J'J`` to 1e-10 of its largest entry, ``J'r`` to 1e-12 of ``||J|| ||xp||`` (near the exact fit its
     entries are differences of products that large).  With noise 1e-9 the pulse explains all but
     1e-18 of the record and the cost comes from the residual itself (COST_EXPLICIT): still 1e-10
     relative."""
-    from pulses.lsq import pulse_normal_equations
+    from pulses.fit.lsq import pulse_normal_equations
 
     cls = shape_class(shape)
     rng = np.random.default_rng(5)
@@ -393,7 +393,7 @@ def test_small_solve_is_numpys():
     """Gaussian elimination with partial pivoting against LAPACK's on the damped normal
     equations' sizes (3 and 5 unknowns, condition numbers up to ~1e6): 1e-9 relative; a singular
     system raises numpy's LinAlgError."""
-    from pulses.lsq import _solve_small
+    from pulses.fit.lsq import _solve_small
 
     rng = np.random.default_rng(2)
     for k in (3, 5):
@@ -411,7 +411,7 @@ def test_weighted_norms_and_scan_paths(shape, tp, window, monkeypatch):
     against :func:`gram` of the full transforms: 1e-12 relative (two roundings of sums of ~100
     products).  The scan's two ways (sums in time for short pulses, a transform of each pulse
     otherwise, forced here by a zero BLAS_PRODUCT) pick the same pulse and shift."""
-    import pulses.weighted as weighted
+    import pulses.fit.weighted as weighted
 
     cls = shape_class(shape)
     _, tw, xw = window

@@ -43,6 +43,10 @@ THEMES = {
         ("A site: scaled records and fragility", ["critical_scale", "CriticalScale", "fragility",
                                                   "Fragility"]),
         ("Rocking frames", ["frame_p", "eta_frame", "equivalent_size"]),
+        ("Where the model holds: friction, bodies, a measured restitution",
+         ["friction_demand", "FrictionDemand", "FrictionCheck", "sliding_width", "SlidingWidth",
+          "Body", "fit_restitution",
+          "RestitutionFit"]),
     ]),
     "pipeline": ("pipeline: the command line and batches from Python", [
         ("The batch from Python", ["design", "DesignRun"]),

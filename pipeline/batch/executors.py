@@ -12,6 +12,7 @@ import os
 from .. import interrupts
 from ..args import ArgumentError
 from . import memo, worker
+from .lifeline import lifeline
 from ..reports.figures import draw
 from .worker import TEST_KILL_ENV, _init_pool_worker, init_worker, work, work_many, worker_failure
 
@@ -70,7 +71,7 @@ def _pool(tasks, jobs, more=None):
     finished = False
     def new_pool():
         return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
-                                   initargs=(os.environ.get(TEST_KILL_ENV),))
+                                   initargs=(os.environ.get(TEST_KILL_ENV), lifeline(), worker.quiet_now()))
 
     try:
         while queue or suspects or _refill(queue, more):
@@ -242,21 +243,35 @@ def dask_client(address: str, jobs: int | None):
             cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1,
                                    processes=True, dashboard_address=None, silence_logs=logging.ERROR)
         return Client(cluster), cluster
+    from .scheduler import CONNECT_TIMEOUT
+
+    # what is no scheduler was refused before the run (pipeline.batch.scheduler.check_address)
     try:
-        return Client(address, timeout="20s"), None
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise ArgumentError(f"--dask: cannot connect to the scheduler at {address!r}: {exc}") from None
+        return Client(address, timeout=CONNECT_TIMEOUT), None
+    except Exception as exc:  # what a client raises for a scheduler it cannot talk to varies
+        raise ArgumentError(f"--dask {address}: cannot connect to the scheduler: "
+                            f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
 
 
 def _dask(tasks, address, jobs, more=None):
     from .remote import run_dask
+    from .scheduler import ClusterLost, Watch
 
-    client, cluster = dask_client(address, jobs)
     try:
-        client.run(init_worker)
-        workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
+        client, cluster = dask_client(address, jobs)
+    except ArgumentError as exc:  # checked before the run: the scheduler went away since
+        if address == "local":
+            raise
+        raise ClusterLost(str(exc)) from None
+    watch = Watch(client, address, cluster is not None)
+    try:
+        try:
+            client.run(init_worker, cluster is not None and worker.quiet_now())
+            workers = len(client.scheduler_info().get("workers", {})) or (jobs or 1)
+        except Exception as exc:
+            raise watch.lost() from exc
         while tasks:
-            yield from run_dask(tasks, client, workers, more)
+            yield from run_dask(tasks, client, workers, more, watch)
             tasks = more() if more is not None else []
     finally:
         client.close()
@@ -299,7 +314,7 @@ def renderer(away: bool):
             methods = multiprocessing.get_all_start_methods()
             ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
             pool = ProcessPoolExecutor(1, mp_context=ctx, initializer=_init_pool_worker,
-                                       initargs=(None,))
+                                       initargs=(None, lifeline(), worker.quiet_now()))
         fut = pool.submit(draw, name, *args)
         while True:  # a short wait, so that Ctrl-C stops the run
             try:

@@ -20,13 +20,11 @@ import sys
 from . import peer_inputs
 
 from ..reports import pulse_row
-from ..args import ArgumentError, pair_files, parse_scale
+from ..args import MAX_DIRECTIONS, ArgumentError, pair_files, parse_directions, parse_scale  # noqa: F401 (MAX_DIRECTIONS: also here)
 from .tasks import Task, make_tasks, record_ids
 
 #: directions closer than this (deg, modulo 180) are one direction
 ANGLE_TOL_DEG = 1e-6
-#: most evenly spaced directions accepted (``--directions``): 1 deg apart
-MAX_DIRECTIONS = 180
 
 
 
@@ -65,12 +63,7 @@ def _file_tasks(args, paths, columns, options):
 
 def settings_from_args(args):
     """``(directions N, --scale factor, --scales table or None)``, checked."""
-    try:
-        n = int(str(args.directions))
-    except ValueError:
-        raise SiteError(f"--directions expects a whole number, got {args.directions!r}") from None
-    if not 0 <= n <= MAX_DIRECTIONS:
-        raise SiteError(f"--directions must be 0 to {MAX_DIRECTIONS}, got {n}")
+    n = parse_directions(args.directions)
     if args.scale is not None and args.scales is not None:
         raise SiteError("give --scale or --scales, not both")
     scale = 1.0 if args.scale is None else parse_scale(args.scale, "--scale")
@@ -243,15 +236,28 @@ def _map_pairs(args, jobs):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
+    from .lifeline import lifeline
+    from .quiet import quiet_now
+
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_ignore_interrupts) as pool:
+    with ProcessPoolExecutor(min(jobs, len(args)), mp_context=ctx, initializer=_ignore_interrupts,
+                             initargs=(lifeline(), quiet_now())) as pool:
         return list(pool.map(_prepare_packed, args, chunksize=max(1, len(args) // (4 * jobs))))
 
 
-def _ignore_interrupts() -> None:
-    """Ctrl-C left to the main process (a worker interrupted on its own would print a traceback)."""
+def _ignore_interrupts(line=None, quiet: bool = False) -> None:
+    """Ctrl-C left to the main process (a worker interrupted on its own would print a traceback);
+    the worker ends when the main process does (``line``, :mod:`pipeline.batch.lifeline`);
+    ``quiet``: no warning printed (pipeline.batch.worker.quieted)."""
     import signal
+    import warnings
+
+    from .lifeline import hold
+
+    hold(line)
+    if quiet:
+        warnings.simplefilter("ignore")
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 

@@ -130,6 +130,9 @@ class Plan:
         self._dirty: set = set()
         #: the held directions by pair, not handed out yet (made at the first :meth:`next_pass`)
         self._held: dict | None = None
+        #: the pairs whose passes :meth:`next_pass` found done, not yet taken by the caller (the
+        #: runner notes them in the resume journal: a later run keeps such a pair whole)
+        self.done: list = []
 
     def note(self, task, rows) -> None:
         """Record what ``task`` (as computed, with its switches) gave: its rows (empty: failed)."""
@@ -187,6 +190,8 @@ class Plan:
                 out += self._held_pass(tasks, pair, held.pop(pair))
                 continue
             want, design, whole = _wanted(self.pairs.get(pair, {}), bool(self.options.plots))
+            if not want:
+                self.done.append(pair)
             for i, plot in sorted(want.items()):
                 # the governing direction's check whole; the others' rounds where they could reach
                 # above the pair's design width so far

@@ -1,7 +1,7 @@
 """PEER NGA-West2 downloads as inputs of ``pipeline run``: ``pipeline run DOWNLOAD.zip --block HxW``
 (or the folder it was unpacked into).
 
-The search report ``_SearchResults.csv`` (:mod:`pulses.peer`) says which files form a record: each
+The search report ``_SearchResults.csv`` (:mod:`pulses.io.peer`) says which files form a record: each
 record with both horizontals in the download is designed as a pair, in every direction
 (:mod:`pipeline.batch.pairs`, as ``--pair`` does), with the report's metadata in every row
 (:data:`PEER_COLUMNS`, and ``peer_tp_s`` next to the package's ``velocity_tp_s``).  A record whose
@@ -9,7 +9,7 @@ listed files are not all in the download fails, with the files it lacks, in ``fa
 run goes on and exits with status 1.  Records are designed as recorded unless ``--peer-scales``
 applies the search's scale factors; the ``peer_scaled`` column says which.
 
-A zip is read in memory, never unpacked (:class:`pulses.peer.PeerDownload`).  A task of a PEER
+A zip is read in memory, never unpacked (:class:`pulses.PeerDownload`).  A task of a PEER
 record carries a :class:`PeerSource` (plain data): the worker reads its files from the download.
 """
 from __future__ import annotations
@@ -39,7 +39,7 @@ PEER_COLUMNS = Columns(
     ("peer_vertical_file", "-", "The record's vertical component as the report lists it (blank: none); "
                                 "with `--vertical auto` it is used in the vertical_* columns."),
 )
-#: the report's metadata key behind each column (pulses.peer.METADATA)
+#: the report's metadata key behind each column (pulses.io.peer.METADATA)
 _KEYS = {"peer_rsn": "rsn", "peer_event": "event", "peer_year": "year", "peer_station": "station",
          "peer_magnitude": "magnitude", "peer_mechanism": "mechanism", "peer_rjb_km": "rjb_km",
          "peer_rrup_km": "rrup_km", "peer_vs30_m_s": "vs30_m_s",
@@ -84,7 +84,7 @@ def add_options(parser) -> None:
 def split_inputs(items, format: str | None = None) -> tuple[list[str], list[str]]:
     """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``.
     With ``--format`` given, every file is a record of that format (a zip is no download)."""
-    from pulses.peer import is_peer_download
+    from pulses.io.peer import is_peer_download
 
     downloads, others = [], []
     for item in items:
@@ -95,13 +95,13 @@ def split_inputs(items, format: str | None = None) -> tuple[list[str], list[str]
 
 @functools.lru_cache(maxsize=8)
 def _open(path: str, stamp):
-    from pulses.peer import PeerDownload
+    from pulses.io.peer import PeerDownload
 
     return PeerDownload(path)
 
 
 def open_download(path: str):
-    """The :class:`pulses.peer.PeerDownload` at ``path``, parsed once per process (per content)."""
+    """The :class:`pulses.PeerDownload` at ``path``, parsed once per process (per content)."""
     try:
         st = os.stat(path)
         stamp = (st.st_mtime_ns, st.st_size, st.st_ino)

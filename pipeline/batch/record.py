@@ -15,9 +15,9 @@ import time
 
 from pulses.shapes import AntisymmetricRicker
 
-from . import memo, peer_inputs, site, vertical
+from . import memo, peer_inputs, site, validity, vertical
 from ..reports.design_table import check_bin_words, check_reach_words
-from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
+from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key, shape_list
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
 
 class StageError(Exception):
@@ -58,9 +58,9 @@ def process_record(task: Task) -> dict:
 
 def _process_record(task: Task) -> dict:
     out = {"index": task.index, "record": task.record_id, "file": task.path, "rows": [],
-           "failure": None, "plot": None, "widths_plot": None}
+           "failure": None, "plot": None, "widths_plot": None, "friction_plot": None}
     try:
-        rows, fit_parts, designs = _process(task)
+        rows, fit_parts, designs, friction_parts = _process(task)
         out["rows"] = rows
     except StageError as err:
         out["failure"] = failure(task, err.stage, err.exc)
@@ -75,10 +75,18 @@ def _process_record(task: Task) -> dict:
 
         try:
             out["plot"] = _stage("plot", run_figure_png, task.record_id, *fit_parts)
+            out["friction_plot"] = _stage("plot", _friction_png, task.record_id, *friction_parts)
             out["widths_plot"] = _stage("plot", _widths_png, task.record_id, designs)
         except StageError as err:
             out["failure"] = failure(task, err.stage, err.exc)
     return out
+
+
+def _friction_png(record_id, frictions, mu):
+    """``plots/friction/<record>.png``: the friction each column's responses need against time."""
+    from ..reports.plot_friction import friction_png
+
+    return friction_png(record_id, frictions, mu)
 
 
 def _widths_png(record_id, designs):
@@ -86,7 +94,8 @@ def _widths_png(record_id, designs):
     (docs/slivers.md); None elsewhere."""
     from ..reports.plot_widths import record_widths_png
 
-    return record_widths_png(record_id, {f"{H:g} m": v for H, v in designs.items()})
+    return record_widths_png(record_id, {(f"{k:g} m" if not isinstance(k, tuple) else
+                                          f"{k[1]} {k[0]:g} m"): v for k, v in designs.items()})
 
 
 FAILURE_COLUMNS = Columns(
@@ -96,8 +105,9 @@ FAILURE_COLUMNS = Columns(
                    "(velocity-pulse classification), `design` (design rules), `verify` (full-record time histories), `plot`, `write` (the record "
                    "was processed and its rows are in `summary.csv`, but its own report or figure "
                    "could not be written, or a file that `pipeline run` did not write is in the way "
-                   "and was left as it is), `worker` (the process running it died) or `internal` "
-                   "(an unforeseen error: please report it)."),
+                   "and was left as it is), `worker` (the process running it died), `cluster` (the "
+                   "dask scheduler was lost before the record was computed: run the same command "
+                   "again to finish the batch) or `internal` (an unforeseen error: please report it)."),
     ("error", "-", "Type of the error."),
     ("reason", "-", "The error message, in one line."),
 )
@@ -165,9 +175,7 @@ RECORD_COLUMNS = Columns(
     ("pga_g", "g", "Peak absolute ground acceleration."),
     ("pgv_m_s", "m/s", "Peak absolute ground velocity (from the fitter, after its baseline correction)."),
     ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated."),
-    ("pulse_shape", "-", "Best-fitting pulse shape: `sine` (one-sine, Eq. 9), `ricker-sym` (symmetric "
-                         "Ricker, Eq. 7), `" + AntisymmetricRicker.shape + "` (antisymmetric Ricker, Eq. 8) or `rect` "
-                         "(rectangular)."),
+    ("pulse_shape", "-", f"Best-fitting pulse shape: {shape_list()}."),
     ("pulse_ap_g", "g", "Amplitude ap of the best-fitting pulse, signed by its polarity."),
     ("pulse_tp_s", "s", "Period Tp of the best-fitting pulse (for the Rickers, the period at the peak "
                         "of the Fourier amplitude)."),
@@ -448,7 +456,8 @@ COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER
            + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
            + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + DESIGN_WIDTH_COLUMNS.columns
            + CHECK_COLUMNS.columns
-           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns + vertical.VERTICAL_COLUMNS.columns)
+           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns + vertical.VERTICAL_COLUMNS.columns
+           + validity.VALIDITY_COLUMNS.columns)
 FIELDS = [name for name, _, _ in COLUMNS]
 
 
@@ -480,24 +489,27 @@ def _process(task: Task):
     settings = _check_settings(task)
 
     gamma = opts.cap_mass_ratio
-    blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
+    blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma,
+                                                 body=col.body)
               for col in task.columns if col.width is not None}
-    exact = _stage("design", _exact_by_shape, fitting, list(blocks.values()), gamma)
+    exact = _stage("design", _exact_by_body, fitting, list(blocks.values()), gamma)
     extra_cache = {}
 
     rows = []
-    histories = []
+    histories, frictions = [], []
     design_cache = {}
     eq31_cache = {}
     for col in task.columns:
         H = col.height
         block = blocks.get(col)
         curves = []
+        hk = _height_key(col)
 
         # -- Eq. 31 width for this height, for every fitting shape: the widest governs ------------
-        if H not in eq31_cache:  # rocking.governing_pulse: pipeline run's rule, in public
-            eq31_cache[H] = _stage("design", rocking.governing_pulse, fit, H, cap_mass_ratio=gamma)
-        widths, w31, gov = eq31_cache[H].widths, eq31_cache[H].width, eq31_cache[H].candidate
+        if hk not in eq31_cache:  # rocking.governing_pulse: pipeline run's rule, in public
+            eq31_cache[hk] = _stage("design", rocking.governing_pulse, fit, H, cap_mass_ratio=gamma,
+                                    body=col.body)
+        widths, w31, gov = eq31_cache[hk].widths, eq31_cache[hk].width, eq31_cache[hk].candidate
 
         # -- the column as it stands: design rules, then the full record ---------------------------
         def design():
@@ -515,36 +527,48 @@ def _process(task: Task):
                 curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
-        block31 = rocking.Block.from_dimensions(H, w31, cap_mass_ratio=gamma)
+        block31 = rocking.Block.from_dimensions(H, w31, cap_mass_ratio=gamma, body=col.body)
         res31 = _stage("verify", _sim, block31, record, draw)
         if draw:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
 
         # -- design width: smallest width surviving the full record (islands respected), above
         #    every width found to fail, with the vertical where there is one ----------------------
-        if H not in design_cache:
-            design_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col])
+        if hk not in design_cache:
+            design_cache[hk] = design_width(record, up, H, gamma, opts.limit, settings[col], col.body)
+        ver = design_cache[hk]
         if draw:  # the column at its design width, for the figure
-            wv = float(design_cache[H].width)
-            block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
+            wv = float(ver.width)
+            block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma, body=col.body)
             curves.append((f"design width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
             histories.append((col.label, curves))
+        valid, need = _stage("verify", validity.fields, col, block, record, up, ver, gamma,
+                             opts.friction, block31, extra_cache)
+        frictions.append((col.label, need))
 
         row = dict(base)
         row.update(_column_fields(col))
         row.update(designed)
         row.update(_as_stands_fields(block, designed, res))
         row.update(_eq31_design_fields(H, w31, res31))
-        row.update(_design_width_fields(col, design_cache[H]))
-        row.update(_check_fields(design_cache[H]))
-        row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, design_cache[H]))
+        row.update(_design_width_fields(col, ver))
+        row.update(_check_fields(ver))
+        row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache,
+                          col.body))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, ver))
+        row.update(valid)
         rows.append(row)
 
-    return rows, (record, fit, fitting, histories, velocity), design_cache
+    return rows, (record, fit, fitting, histories, velocity), design_cache, (frictions, opts.friction)
 
 
-def design_width(record, up, height, cap_mass_ratio, limit, settings):
+def _height_key(col):
+    """What a height's designs are kept under: the height (a rectangular column's, as before), or
+    with the body's kind (``(7.5, "cylinder")``)."""
+    return col.height if col.body == "rectangular" else (col.height, col.body)
+
+
+def design_width(record, up, height, cap_mass_ratio, limit, settings, body="rectangular"):
     """The design width of a column ``height`` (m) tall under ``record`` (with its vertical ``up``
     where there is one, :func:`pipeline.batch.vertical.design`).  With a level ``limit``: the
     level's design first, then the overturning design where it can change it (a width that
@@ -553,10 +577,11 @@ def design_width(record, up, height, cap_mass_ratio, limit, settings):
     overturning width; ``.overturning_width`` is that design's width."""
     import rocking
 
-    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings)
+    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings, body=body)
     over = None if limit is None else True
     alone = _stage("verify", rocking.required_width, height, record, limit=limit, overturning=over, **kw)
-    return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over)
+    return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over,
+                  body)
 
 
 def _check_settings(task: Task) -> dict:
@@ -583,7 +608,16 @@ def _classify(record):
 EXACT_KSECTION = 4
 
 
-def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
+def _exact_by_body(fitting, blocks, cap_mass_ratio=0.0) -> dict:
+    """:func:`_exact_by_shape` for the blocks of each body, by its own impact rule."""
+    exact = {}
+    for kind in dict.fromkeys(["rectangular"] + [b.body.kind for b in blocks]):
+        exact.update(_exact_by_shape(fitting, [b for b in blocks if b.body.kind == kind],
+                                     cap_mass_ratio, kind))
+    return exact
+
+
+def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0, body="rectangular") -> dict:
     """Exact minimum tan(alpha) of every fitting pulse for every block: ``{(shape, block): tan}``.
 
     One ``rocking.min_slenderness_batch`` call per shape covers all the blocks (the similarity law:
@@ -603,9 +637,11 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
     for c in fitting:
         p_tp = [b.p * c.tp for b in blocks]
         key = (c.shape, tuple(p_tp), abs(c.ap) / G, cap_mass_ratio)  # its every input
+        if body != "rectangular":
+            key += (body,)
         res = memo.remembered("slenderness", key, lambda: rocking.min_slenderness_batch(
             c.shape, p_tp, [abs(c.ap) / G] * len(blocks), refine="top", ksection=EXACT_KSECTION,
-            cap_mass_ratio=cap_mass_ratio))
+            cap_mass_ratio=cap_mass_ratio, body=body))
         for b, r in zip(blocks, res):
             out[(c.shape, b)] = float(r.tan_alpha)
     return out

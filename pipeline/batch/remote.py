@@ -121,13 +121,35 @@ def _next_chunk(queue, workers: int) -> list[Task]:
     return chunk
 
 
-def run_dask(tasks, client, workers: int, more=None):
+def _reconnected(client, watch) -> bool:
+    """Whether ``client`` lost its scheduler's connection and has it again (a dask client
+    cancels every future at such a loss); :class:`pipeline.batch.scheduler.ClusterLost` when
+    it gives up."""
+    import time
+
+    if client.status == "running":
+        return False
+    while client.status != "running":
+        watch.check()
+        time.sleep(0.1)
+    return True
+
+
+def run_dask(tasks, client, workers: int, more=None, watch=None):
     """Results of every task on ``client``'s cluster, in completion order; after each result
     taken, ``more()`` gives tasks to run next, ahead of those waiting (a pair's next pass,
-    pipeline.batch.executors.execute)."""
+    pipeline.batch.executors.execute).  ``watch`` (:class:`pipeline.batch.scheduler.Watch`):
+    raises :class:`~pipeline.batch.scheduler.ClusterLost` when the cluster is gone."""
+    from concurrent.futures import CancelledError
+
     from dask.distributed import as_completed
 
+    from .. import interrupts
+    from . import scheduler
     from .worker import worker_failure
+
+    watch = watch or scheduler.Watch(client, "?", False)
+    reconnections = 0
 
     queue = collections.deque(tasks)
     retries = collections.deque()  # records whose worker died once: one at a time
@@ -144,6 +166,7 @@ def run_dask(tasks, client, workers: int, more=None):
         # a vertical that cannot be read here is left to the worker, whose row then says why it
         # was not used, as a run in one process does
         blobs = {p: raw for p, raw in blobs.items() if raw is not None}
+        watch.check()  # a closed client would queue the task for ever
         fut = client.submit(work_on_bytes, chunk, blobs, pure=False,
                             key=f"record-{chunk[0].index}-{attempt}-{uuid.uuid4().hex}")
         owner[fut.key] = (chunk, attempt)
@@ -164,16 +187,27 @@ def run_dask(tasks, client, workers: int, more=None):
 
     yield from fill()
     while owner:
-        fut = next(pending)
+        fut = scheduler.next_result(pending, watch, interrupts.check)
         chunk, attempt = owner.pop(fut.key)
         if attempt == 2:
             retrying[0] = False
         try:
             results = fut.result()
-        except Exception as exc:  # the worker died (or the scheduler lost it)
-            results = [] if attempt == 1 else [worker_failure(t, exc) for t in chunk]
-            if attempt == 1:
-                retries.extend(chunk)
+        except Exception as exc:  # the worker died, or the connection to the scheduler was lost
+            if _reconnected(client, watch) or isinstance(exc, CancelledError):
+                # nothing went wrong with the records: sent again as they were, a few times
+                reconnections += 1
+                if reconnections > 3:
+                    raise watch.lost() from exc
+                if attempt == 1:
+                    queue.extendleft(reversed(chunk))
+                else:
+                    retries.appendleft(chunk[0])
+                results = []
+            else:
+                results = [] if attempt == 1 else [worker_failure(t, exc) for t in chunk]
+                if attempt == 1:
+                    retries.extend(chunk)
         fut.release()
         yield from results
         if more is not None and results:

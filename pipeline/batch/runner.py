@@ -17,11 +17,12 @@ from ..reports import design_table, figures, html_report, outfiles, report
 
 from .. import interrupts
 
-from . import joblog, outlock, passes, resume, site
+from . import joblog, outlock, passes, resume, risk, site
 from ..args import ArgumentError, output_folder
 from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
 from . import executors
 from .executors import _serial, execute
+from .scheduler import ClusterLost
 from .worker import TEST_KILL_ENV, TEXT  # noqa: F401 (tests set TEST_KILL_ENV through the runner)
 from .tasks import Column, Options, Task, expand_inputs, make_tasks, record_ids  # noqa: F401 (also the runner's names)
 
@@ -36,10 +37,12 @@ class RunSummary:
     #: the run's tables as row dicts (``design``, ``summary``, ``failures``, ``suite``): the rows the
     #: CSV reports were written from (pipeline.api.DesignRun makes DataFrames of them)
     tables: dict | None = dataclasses.field(default=None, repr=False)
+    #: the run's own figures that could not be written (a full disk): left out, exit status 1
+    n_unwritten: int = 0
 
     @property
     def exit_code(self) -> int:
-        return 0 if self.n_failed == 0 else 1
+        return 0 if self.n_failed == 0 and not self.n_unwritten else 1
 
 
 # -- the output folder -------------------------------------------------------------------------------
@@ -95,7 +98,8 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
         # the record's figure, and the barcode of the check above the search width where it
         # found failing widths; a figure not drawn this time is removed (an earlier run's)
         for name, data in ((report.record_plot_name(rid), res.get("plot")),
-                           (report.record_widths_plot_name(rid), res.get("widths_plot"))):
+                           (report.record_widths_plot_name(rid), res.get("widths_plot")),
+                           (report.record_friction_plot_name(rid), res.get("friction_plot"))):
             try:
                 if data:
                     outputs.write(name, data)
@@ -103,7 +107,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
                     outputs.remove(name)
             except OSError as exc:
                 problems.append(exc)
-    res["widths_plot"] = None
+    res["widths_plot"] = res["friction_plot"] = None
     res["plot"] = None  # thousands of records: keep only the rows in memory
     for exc in problems:
         say(f"pipeline run: {rid}: {report.display(exc)}")
@@ -170,7 +174,8 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     # per record, so that memory stays flat over a long batch
     tasks, held = passes.first_pass(tasks, options)
     plan = passes.Plan(options, held)
-    texts, keys, todo = _reusable(tasks, journal, force, options, plan, held)
+    by_pair = pairs_in_passes(tasks, options)
+    texts, keys, todo = _reusable(tasks, journal, force, options, plan, by_pair)
     plan.sent(todo)
     failures: list[dict | None] = [None] * len(tasks)
     computed = set()  # the tasks computed (in any pass); the others were reused
@@ -195,18 +200,21 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     header = report.csv_text(FIELDS, [])
     stream = _serial([])
 
-    more = _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar)
+    more = _passes(plan, tasks, journal, keys, texts, options, by_pair, force, bar)
     try:
         staged = any(passes.staged(t, options) for t in tasks)
         todo = todo or (more() if staged else [])
         # one executor for every pass: its workers started once
         stream = execute(todo, jobs=jobs, dask=dask, more=more if staged else None)
-        for res in stream:
-            computed.add(res["index"])
-            _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
-            log.record(res, tasks[res["index"]].record_id)
-            if bar is not None:
-                bar.update(1)
+        try:
+            for res in stream:
+                computed.add(res["index"])
+                _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say)
+                log.record(res, tasks[res["index"]].record_id)
+                if bar is not None:
+                    bar.update(1)
+        except ClusterLost as exc:  # the reports are written all the same, the rest listed
+            _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, say)
         stream.close()
     finally:
         with interrupts.deferred():
@@ -231,26 +239,62 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         except report.NotOurs as exc:
             say(f"pipeline run: note: {exc}")
     with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
-        design, rows = _write_tables(outputs, out, tasks, header, text, failures, failed, options, render)
-    journal.finish([t.record_id for t in tasks])
+        design, rows, problems, risk_rows = _write_tables(outputs, out, tasks, header, text, failures,
+                                                          failed, options, render, jobs=jobs, say=say)
+    journal.finish([t.record_id for t in tasks],
+                   {p: [tasks[i].record_id for i in ix] for p, ix in by_pair.items()})
     n_failed = len(failures)
-    n_reused = len(tasks) - len(computed)
-    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, n_reused,
+    summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, len(tasks) - len(computed),
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": site.suite_rows(rows) if rows else []})
+                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else []),
+                          "risk": risk_rows},
+                         problems)
     if not quiet:
-        msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
-        if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
-            groups = {site.pair_of(t) for t in tasks}
-            msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
-                   f"records or pairs processed in every direction ({summary.n_ok} of "
-                   f"{summary.n_records} tasks)")
-        msg += f" ({n_reused} reused from an earlier run, {len(computed)} computed)"
-        if n_failed:
-            msg += f", {n_failed} failed (see {report.display(out / report.FAILURES)})"
-        print(design_table.table_text(design, failures, rows), end="")
-        print(f"{msg}; reports in {report.display(out)}")
+        _print_end(summary, tasks, failed, len(computed), design, failures, rows)
     return summary
+
+
+def _as_written(fields, rows) -> list[dict]:
+    """``rows`` as their CSV file holds them (6 significant digits), read back."""
+    import csv
+    import io
+
+    text = report.csv_text(fields, rows)
+    return [{f: resume.typed(c) for f, c in zip(fields, cells)} for cells in list(csv.reader(io.StringIO(text)))[1:]]
+
+
+def _print_end(summary, tasks, failed, n_computed, design, failures, rows) -> None:
+    """The table of the answer and the run's last line."""
+    msg = f"pipeline run: {summary.n_ok} of {summary.n_records} records processed"
+    if any(t.direction is not None for t in tasks):  # a pair's directions are one task each
+        groups = {site.pair_of(t) for t in tasks}
+        msg = (f"pipeline run: {len(groups - set(failed))} of {len(groups)} "
+               f"records or pairs processed in every direction ({summary.n_ok} of "
+               f"{summary.n_records} tasks)")
+    msg += f" ({summary.n_reused} reused from an earlier run, {n_computed} computed)"
+    if summary.n_failed:
+        msg += f", {summary.n_failed} failed (see {report.display(summary.out / report.FAILURES)})"
+    print(design_table.table_text(design, failures, rows), end="")
+    print(f"{msg}; reports in {report.display(summary.out)}")
+
+
+def _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, say) -> None:
+    """Every task without a result when the dask cluster was lost (``exc``): a failure of stage
+    ``cluster``, its report of an earlier run removed; a later run computes them."""
+    reason = ClusterLost(f"{exc}; not computed: run the same command again to finish the batch")
+    left = [t for t in tasks if not texts[t.index] and failures[t.index] is None]
+    for t in left:
+        computed.add(t.index)
+        failures[t.index] = failure(t, "cluster", reason)
+        journal.drop(t.record_id)
+        for name in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id),
+                     report.record_widths_plot_name(t.record_id)):
+            with contextlib.suppress(OSError, report.NotOurs):
+                if outputs.owned(name):
+                    outputs.remove(name)
+        log.record({"failure": failures[t.index]}, t.record_id)
+    say(f"pipeline run: {exc}: {len(left)} task(s) not computed, listed in failures.csv; run the "
+        "same command again to finish the batch")
 
 
 def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, header, say) -> None:
@@ -267,59 +311,84 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
         journal.drop(task.record_id)
     else:
         journal.add(task.record_id, keys[i], (header + texts[i]).encode("utf-8"),
-                    figure if options.plots and task.plot else None)
+                    figure if options.plots and task.plot else None,
+                    resume.form_text(task) if passes.staged(task, options) else None)
     if res["failure"]:
         f = res["failure"]
         say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
 
 
-def _variants(task, options):
-    """The forms of ``task`` whose kept report may stand for it: itself, and for a pair's
-    direction computed in passes, its checked forms (a later pass of an earlier run)."""
-    if not passes.staged(task, options):
-        return [task]
-    return [task] + [dataclasses.replace(task, check=True, plot=p) for p in (False, True) if p or not task.plot]
-
-
-def _reuse(t, journal, force, options, version):
-    """``(task form, key, rows text)`` of ``t``'s kept report, or ``(t, key, "")``."""
+def _reuse(t, journal, force, version):
+    """``(key, rows text)`` of ``t``'s kept report (made by this very form of ``t``), or ``(key, "")``."""
     key = resume.task_key(t, version)
-    if not force:
-        for v in _variants(t, options):
-            k = key if v is t else resume.task_key(v, version)
-            kept = journal.reusable(v, k, options.plots and v.plot)
-            if kept is not None:
-                return v, k, kept
-    return t, key, ""
+    kept = None if force else journal.reusable(t, key, t.options.plots and t.plot)
+    return key, kept or ""
 
 
-def _reusable(tasks, journal, force: bool, options, plan, held=()):
+def pairs_in_passes(tasks, options) -> dict:
+    """``{pair: [indices]}`` of the pairs computed in passes (pipeline.batch.passes)."""
+    out: dict = {}
+    for t in tasks:
+        if passes.staged(t, options):
+            out.setdefault(site.pair_of(t), []).append(t.index)
+    return out
+
+
+def _settled_pair(tasks, indices, journal, version):
+    """``{index: (task form, key, rows text)}`` of a pair whose passes an earlier run finished
+    (pipeline.batch.resume.Journal.settle), every direction's report kept in the form it was
+    made in; empty where any is not."""
+    pair = site.pair_of(tasks[indices[0]])
+    if journal.settled(pair) is None:
+        return {}
+    out = {}
+    for i in indices:
+        form = resume.with_form(tasks[i], journal.forms.get(tasks[i].record_id))
+        if form is None:
+            return {}
+        key, text = _reuse(form, journal, False, version)
+        if not text:
+            return {}
+        out[i] = (form, key, text)
+    if journal.pair_digest([tasks[i].record_id for i in indices]) != journal.settled(pair):
+        return {}
+    return out
+
+
+def _reusable(tasks, journal, force: bool, options, plan, by_pair):
     """``(texts, keys, todo)``: each task's rows as its kept report holds them ("" where it must be
     computed), its resume key, and the tasks to compute (their journal entries dropped).
-    ``tasks`` is updated with the form of each task that was kept; the ``held`` ones (indices)
-    are left to a later pass."""
+    ``tasks`` is updated with the form of each task that was kept: a pair whose passes an earlier
+    run finished is kept whole; the held directions of the others (``plan.held``, indices) are
+    left to a later pass."""
     texts: list[str] = [""] * len(tasks)
-    version = resume.package_version()
+    version = resume.code_version()
     keys: list = [None] * len(tasks)
     todo = []
+    for indices in by_pair.values():
+        kept = {} if force else _settled_pair(tasks, indices, journal, version)
+        for i, (form, keys[i], texts[i]) in kept.items():
+            tasks[i] = form
+            plan.note(form, resume.rows_from_text(texts[i]))
+        plan.held -= set(kept)
     for t in list(tasks):
-        if t.index in held:
+        if t.index in plan.held or texts[t.index]:
             continue
-        v, keys[t.index], texts[t.index] = _reuse(t, journal, force, options, version)
+        keys[t.index], texts[t.index] = _reuse(t, journal, force, version)
         if texts[t.index]:
-            tasks[t.index] = v
-            plan.note(v, resume.rows_from_text(texts[t.index]))
+            plan.note(t, resume.rows_from_text(texts[t.index]))
         else:
             journal.drop(t.record_id)
             todo.append(t)
     return texts, keys, todo
 
 
-def _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar):
+def _passes(plan, tasks, journal, keys, texts, options, by_pair, force, bar):
     """The executor's ``more``: the tasks of the next pass (pipeline.batch.passes: a pair's
     directions, then its governing one checked, ...), counted on the progress bar."""
     def more():
-        later = _later_pass(plan, tasks, journal, keys, texts, options, outputs, force)
+        later = _later_pass(plan, tasks, journal, keys, texts, options, force)
+        _settle(plan, tasks, journal, by_pair)
         if later and bar is not None:
             bar.total += len(later)
             bar.refresh()
@@ -327,10 +396,17 @@ def _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar):
     return more
 
 
-def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
+def _settle(plan, tasks, journal, by_pair) -> None:
+    """Note in the journal the pairs whose passes are done (a later run keeps them whole)."""
+    while plan.done:
+        pair = plan.done.pop()
+        journal.settle(pair, [tasks[i].record_id for i in by_pair.get(pair, ())])
+
+
+def _later_pass(plan, tasks, journal, keys, texts, options, force):
     """The tasks of the next pass (pipeline.batch.passes) that must be computed; those an earlier run
     kept are taken as they are."""
-    version = resume.package_version()
+    version = resume.code_version()
     todo = []
     while True:
         wanted = plan.next_pass(tasks)
@@ -372,32 +448,71 @@ def _progress_bar(n_todo: int, quiet: bool, progress: bool | None):
                 ncols=min(size.columns or 100, 120), nrows=size.lines or 24)
 
 
-def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None):
+class _Figures:
+    """``outputs`` for the run's own files, where a figure that cannot be written (a full disk)
+    is said and counted (``problems``) and the run goes on to ``design.csv`` and ``report.html``;
+    a figure with no rows to draw is not drawn, and an earlier run's is removed."""
+
+    def __init__(self, outputs, say):
+        self.outputs, self.say, self.problems = outputs, say, 0
+
+    def __getattr__(self, name):
+        return getattr(self.outputs, name)
+
+    def write(self, rel, data):
+        if not str(rel).endswith(".png"):
+            return self.outputs.write(rel, data)
+        try:
+            return self.outputs.write(rel, data)
+        except OSError as exc:
+            self.problems += 1
+            self.say(f"pipeline run: {report.display(exc)}; the figure is left out")
+            self.drop(rel)  # not an earlier run's in its place
+            return None
+
+    def drop(self, rel) -> None:
+        """No figure at ``rel`` this run: an earlier run's is removed (where it is the tool's)."""
+        with contextlib.suppress(OSError, report.NotOurs):
+            if self.outputs.owned(rel):
+                self.outputs.remove(rel)
+
+
+def _write_tables(outputs, out, tasks, header, text, failures, failed, options, render=None, jobs=1,
+                  say=print):
     """Write the run's own files from every record's rows (``text``: summary.csv's rows as the records'
-    reports hold them, below ``header``); return the design rows and the rows of summary.csv."""
+    reports hold them, below ``header``); return the design rows, the rows of summary.csv, how
+    many figures could not be written and the rows of risk.csv."""
+    outputs = _Figures(outputs, say)
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
-                  + site.columns_markdown() + design_table.columns_markdown())
+                  + site.columns_markdown() + design_table.columns_markdown()
+                  + (risk.columns_markdown() if options.risk is not None else ""))
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text)
     site.write_outputs(outputs, rows, FIELDS, options, failed, render)
-    if options.plots:
+    answers, risk_rows = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
+    if options.plots and rows:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
-    design = write_answer(outputs, out, tasks, rows, failures, failed, options)
+    elif options.plots:  # every record failed: no empty figures
+        for rel in (report.SUMMARY_PLOT, report.SUITE_PLOT, report.FRAGILITY_PLOT):
+            outputs.drop(rel)
+    design = write_answer(outputs, out, tasks, rows, failures, failed, options, answers)
     outputs.finish()
-    return design, rows
+    return design, rows, outputs.problems, risk_rows
 
 
 # -- the answer in view: design.csv, report.html (pipeline.reports.design_table, pipeline.reports.html_report) --------
-def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
-    """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
-    design = design_table.design_rows(rows, failed)
+def write_answer(outputs, out, tasks, rows, failures, failed, options, answers=None) -> list[dict]:
+    """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run).
+    ``answers``: each column's risk at the site (pipeline.batch.risk.write_outputs)."""
+    design = design_table.design_rows(rows, failed, answers)
     outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.DESIGN_FIELDS, design))
     ids = [t.record_id for t in tasks]
     this_run = set(outfiles.fixed_files(options))  # a figure of an earlier run with other options is not shown
     names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", report.SUITE_PLOT),
-                                   ("fragility", report.FRAGILITY_PLOT)) if k == "summary" or rel in this_run}
+                                   ("fragility", report.FRAGILITY_PLOT), ("risk_widths", risk.RISK_WIDTHS_PLOT),
+                                   ("risk_disaggregation", risk.RISK_DISAGG_PLOT)) if k == "summary" or rel in this_run}
     figures = html_report.figures_in(out, ids, options.plots, names)
     outputs.write(html_report.REPORT_HTML, html_report.report_html(design, rows, failures, ids, figures))
     return design

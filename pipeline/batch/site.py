@@ -20,7 +20,7 @@ from . import memo, peer_inputs
 from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
 from .peer_inputs import PEER_TP
 from ..reports.pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
-from ..args import SCALE_RANGE, parse_scale
+from ..args import SCALE_RANGE, parse_cap_mass_ratio, parse_limit, parse_up_to
 from ..reports.report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
                      Columns)
 
@@ -122,19 +122,22 @@ def read_task(task):
     return record.scaled(task.scale) if task.scale != 1.0 else record
 
 
-def extra_fields(H, block, record, fitting, options, cache) -> dict:
-    """The envelope design and (``--fragility``) the critical scale of one row."""
+def extra_fields(H, block, record, fitting, options, cache, body="rectangular") -> dict:
+    """The envelope design and (``--fragility``) the critical scale of one row (a column of
+    ``body``'s shape, rocking.bodies)."""
     import rocking
 
     g = options.cap_mass_ratio
-    if ("envelope", H) not in cache:
+    key = ("envelope", H) if body == "rectangular" else ("envelope", H, body)
+    if key not in cache:
         widths = [float(rocking.required_width(H, c.pulse, rule="envelope", shape=c.shape,
-                                               cap_mass_ratio=g).width) for c in fitting]
+                                               cap_mass_ratio=g, body=body).width) for c in fitting]
         w = max(widths)
-        res = rocking.simulate(rocking.Block.from_dimensions(H, w, cap_mass_ratio=g), record)
-        cache[("envelope", H)] = ENVELOPE_COLUMNS.row({"envelope_width_m": w,
-                                                       "envelope_width_overturns": bool(res.overturned)})
-    fields = dict(cache[("envelope", H)])
+        res = rocking.simulate(rocking.Block.from_dimensions(H, w, cap_mass_ratio=g, body=body),
+                               record)
+        cache[key] = ENVELOPE_COLUMNS.row({"envelope_width_m": w,
+                                           "envelope_width_overturns": bool(res.overturned)})
+    fields = dict(cache[key])
     if not options.fragility or block is None:
         fields.update(FRAGILITY_COLUMNS.blank())
         return fields
@@ -185,26 +188,12 @@ def add_options(parser) -> None:
                              "(about as many solver runs as an overturning design; docs/design.md)")
 
 
-def _number(text, what, lo, hi) -> float:
-    try:
-        value = float(str(text))
-    except ValueError:
-        raise SiteError(f"{what}: expected a number, got {text!r}") from None
-    if not (math.isfinite(value) and lo <= value <= hi):
-        raise SiteError(f"{what} must lie between {lo:g} and {hi:g}, got {text!r}")
-    return value
-
-
 def options_from_args(args) -> dict:
-    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.record.Options`."""
-    gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
-    up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
+    """``cap_mass_ratio``, ``fragility``, ``up_to``, ``limit`` of :class:`pipeline.batch.tasks.Options`
+    (the rules of :mod:`pipeline.args`, which ``pipeline.design()`` follows too)."""
     limit = getattr(args, "limit", None)
-    if limit is not None:
-        limit = _number(limit, "--limit (max|theta|/alpha)", 0.0, 1.0)
-        if limit <= 0.0:
-            raise SiteError(f"--limit (max|theta|/alpha) must lie in (0, 1], got {args.limit!r}")
-    return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to, "limit": limit}
+    return {"cap_mass_ratio": parse_cap_mass_ratio(args.cap_mass_ratio), "fragility": bool(args.fragility),
+            "up_to": parse_up_to(args.up_to), "limit": None if limit is None else parse_limit(limit)}
 
 
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------

@@ -21,10 +21,13 @@ class Column:
 
     height: float
     width: float | None = None
+    #: the body's shape (rocking.bodies): ``"rectangular"`` or ``"cylinder"`` (``cyl:HxD``)
+    body: str = "rectangular"
 
     @property
     def label(self) -> str:
-        return f"{self.height:g}x{self.width:g}" if self.width is not None else f"{self.height:g}"
+        size = f"{self.height:g}x{self.width:g}" if self.width is not None else f"{self.height:g}"
+        return ("cyl:" if self.body == "cylinder" else "") + size
 
     @property
     def kind(self) -> str:
@@ -56,6 +59,12 @@ class Options:
     #: ``--thorough``: every direction of a pair gets the check above its search width and
     #: (with plots) its figures, as a lone record does (pipeline.batch.passes)
     thorough: bool = False
+    #: ``--hazard`` and its options (pipeline.batch.risk.RiskOptions), used after the batch only: kept
+    #: out of the records' resume keys (repr) and comparisons, so a record's work is reused whatever the curve
+    risk: object = field(default=None, compare=False, repr=False)
+    #: ``--friction MU``: the base's friction coefficient the responses are judged against (None:
+    #: the friction demand is reported, not judged; pipeline.batch.validity)
+    friction: float | None = None
 
 
 @dataclass(frozen=True)

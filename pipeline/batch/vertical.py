@@ -143,7 +143,8 @@ def scaled(task, up):
     return up.scaled(task.scale) if (up is not None and task.scale != 1.0) else up
 
 
-def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overturning=None):
+def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overturning=None,
+           body="rectangular"):
     """The design width of a column ``height`` (m) tall: ``horizontal`` (the horizontal motion's
     answer) where there is no vertical or it reaches -g, else the wider of it and the answer with
     the vertical (``rocking.required_width(..., vertical=)``, ``governed_by`` set); with a level,
@@ -158,7 +159,8 @@ def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overt
     if up is None or float(np.min(1.0 + up.acc / G)) <= 0.0:
         return horizontal
     return rocking.required_width(height, record, rule="exact", vertical=up, horizontal=horizontal,
-                                  cap_mass_ratio=cap_mass_ratio, limit=limit, overturning=overturning)
+                                  cap_mass_ratio=cap_mass_ratio, limit=limit, overturning=overturning,
+                                  body=body)
 
 
 def fields(block, record, up, shown_file, designed=None) -> dict:

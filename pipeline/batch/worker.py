@@ -6,26 +6,38 @@ from __future__ import annotations
 import os
 
 from . import joblog, memo
+from .quiet import quiet_now  # noqa: F401 (what the pools' initializers are given)
 from .record import FIELDS, failure, process_record
 from .tasks import Task
 
 
-def init_worker() -> None:
+def init_worker(quiet: bool = False) -> None:
     """Set up a worker process: one solver thread (the processes share the CPUs; the solver's
-    batches then run on one thread, with the same runs and the same results)."""
+    batches then run on one thread, with the same runs and the same results); ``quiet``: no
+    warning printed (``--quiet``: what a record's reading warns of is in its rows)."""
     global _in_worker
     _in_worker = True
     from rocking import lanes
 
     lanes.set_threads(1)
+    if quiet:
+        import warnings
+
+        warnings.simplefilter("ignore")
 
 
-def _init_pool_worker(kill_at: str | None = None) -> None:
+def _init_pool_worker(kill_at: str | None = None, line=None, quiet: bool = False) -> None:
     """Set up a pool worker: :func:`init_worker`, and Ctrl-C left to the main process, which stops
     the workers itself (a worker interrupted on its own would only print a traceback).
     ``kill_at``: :data:`TEST_KILL_ENV` as the main process has it now (the fork server that starts
-    the workers may have been started before it was set)."""
+    the workers may have been started before it was set).  ``line``: the main process's
+    :func:`pipeline.batch.lifeline.lifeline`; the worker ends when the main process does.
+    ``quiet``: :func:`quiet_now` in the main process."""
     import signal
+
+    from .lifeline import hold
+
+    hold(line)
 
     if kill_at is None:
         os.environ.pop(TEST_KILL_ENV, None)
@@ -33,7 +45,7 @@ def _init_pool_worker(kill_at: str | None = None) -> None:
         os.environ[TEST_KILL_ENV] = kill_at
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    init_worker()
+    init_worker(quiet)
 
 
 #: test-only: a record id at which a worker process (never the main one) kills itself with SIGKILL,

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 
-from ..args import ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_positive
+from ..args import ArgumentError, ShapeNames, parse_acceleration, parse_column_block, parse_positive
 
 
 def _floats(text, what):
@@ -36,7 +36,9 @@ def add_parser(subparsers):
                                       "against height for the pulse of --pulse/--ap/--tp under every rule")
     p.add_argument("--ap", help="your pulse's amplitude, e.g. 0.5g or 4.9m/s2 (with --tp)")
     p.add_argument("--tp", help="your pulse's period, s (with --ap)")
-    p.add_argument("--block", help="your column HEIGHTxWIDTH in m, e.g. 7.5x1.8: marked on the chart")
+    p.add_argument("--block", help="your column HEIGHTxWIDTH in m, e.g. 7.5x1.8 (cyl:HxD: a "
+                                   "circular one; with --heights every width is of its shape): "
+                                   "marked on the chart")
     p.add_argument("--csv", help="write the table to this CSV file")
     p.add_argument("--plot", help="write the chart to this PNG file")
     p.set_defaults(func=run)
@@ -60,7 +62,10 @@ def _your_pulse(args):
     if args.ap is None or args.tp is None:
         raise ArgumentError("--ap and --tp go together (your pulse's amplitude and period)")
     if args.pulse == "all":
-        raise ArgumentError("--ap/--tp need one pulse shape: --pulse sine, rect, ricker-sym or ricker-anti")
+        from pulses import SHAPES
+
+        names = list(SHAPES)
+        raise ArgumentError(f"--ap/--tp need one pulse shape: --pulse {', '.join(names[:-1])} or {names[-1]}")
     return args.pulse, parse_acceleration(args.ap, signed=False), parse_positive(args.tp, "--tp")
 
 
@@ -72,7 +77,7 @@ def run(args) -> int:
 
     check_file_options(args, "chart")
     pulse = _your_pulse(args)
-    column = parse_block(args.block) if args.block else None
+    column = parse_column_block(args.block) if args.block else None
     if args.heights:
         if pulse is None:
             raise ArgumentError("--heights needs your pulse: --pulse SHAPE --ap AMPLITUDE --tp PERIOD")
@@ -111,7 +116,7 @@ def _mark(pulse, column):
     from pulses import G
 
     shape, ap, tp = pulse
-    block = rocking.Block.from_dimensions(*column)
+    block = rocking.Block.from_dimensions(column[0], column[1], body=column[2])
     return shape, block.p * tp, ap / G, block.tan_alpha
 
 
@@ -123,7 +128,8 @@ def _run_heights(args, heights, pulse, column) -> int:
 
     shape, ap, tp = pulse
     start = time.perf_counter()
-    frame = widths_by_height(pulses.make_pulse(shape, ap, tp), heights)
+    body = None if column is None else column[2]
+    frame = widths_by_height(pulses.make_pulse(shape, ap, tp), heights, body=body)
     elapsed = time.perf_counter() - start
     title = f"{shape} pulse, ap = {ap / pulses.G:.3g} g, Tp = {tp:g} s: width a column needs"
     print(f"{title}, by rule, {len(heights)} heights in {elapsed:.1f} s (m)")
@@ -132,17 +138,18 @@ def _run_heights(args, heights, pulse, column) -> int:
     for h, row in table.iterrows():
         print(f"{h:>8.4g} " + " ".join(f"{v:>9.3f}" for v in row))
     if column is not None:
-        h, b = column
+        h, b, _ = column
         import rocking
 
-        need = rocking.required_width(h, pulses.make_pulse(shape, ap, tp), rule="exact").width
+        need = rocking.required_width(h, pulses.make_pulse(shape, ap, tp), rule="exact",
+                                      body=body).width
         print(f"your column {h:g} x {b:g} m: the exact rule asks for {need:.3f} m "
               + ("(it is wide enough)" if b >= need else "(it is too narrow)"))
     if args.csv:
         write_output(args.csv, frame.to_csv(index=False), "csv")
         print(f"wrote {args.csv}")
     if args.plot:
-        fig = width_figure(frame, title, column)
+        fig = width_figure(frame, title, None if column is None else column[:2])
         write_output(args.plot, figure_png(lambda buf: fig.savefig(buf, format="png", dpi=110)), "png")
         print(f"wrote {args.plot}")
     return 0

@@ -9,8 +9,8 @@ import json
 import math
 import sys
 
-from ..args import (ArgumentError, ShapeNames, parse_acceleration, parse_block, parse_length,
-                   parse_positive)
+from ..args import (ArgumentError, ShapeNames, parse_acceleration, parse_column_block,
+                   parse_column_height, parse_friction, parse_positive)
 
 
 
@@ -22,8 +22,10 @@ def add_parser(subparsers):
                     "is adequate by each; and the width its height requires (a fixed point, "
                     "since p depends on the width).")
     size = p.add_mutually_exclusive_group(required=True)
-    size.add_argument("--block", help="HEIGHTxWIDTH in m, e.g. 7.5x1.8")
-    size.add_argument("--height", help="full height in m: report the required widths only")
+    size.add_argument("--block", help="HEIGHTxWIDTH in m, e.g. 7.5x1.8; cyl:HxD for a solid "
+                                      "circular column of diameter D rocking in a plane")
+    size.add_argument("--height", help="full height in m: report the required widths only "
+                                       "(cyl:H for a circular column)")
     p.add_argument("--pulse", default="sine", choices=ShapeNames(), metavar="SHAPE",
                    help="pulse shape: %(choices)s (default sine)")
     p.add_argument("--ap", help="pulse amplitude, e.g. 0.71g or 6.96m/s2")
@@ -37,6 +39,9 @@ def add_parser(subparsers):
     p.add_argument("--limit", metavar="R", default=None,
                    help="also the exact width for the performance level max|theta|/alpha <= R, "
                         "0 < R <= 1 (docs/design.md)")
+    p.add_argument("--friction", metavar="MU",
+                   help="judge the friction the column (and the exact design) needs under the "
+                        "pulse against the base's coefficient MU; default: reported, not judged")
     p.add_argument("--json", action="store_true", help="print the results as JSON")
     p.set_defaults(func=run)
 
@@ -74,6 +79,48 @@ def _pulse(args):
     return pulses.make_pulse(args.pulse, ap, tp), "given pulse"
 
 
+def _friction(block, height, width, body, pulse, mu) -> dict:
+    """The friction the column as it stands and the exact design need under the pulse; with
+    ``mu``, the verdicts and the narrowest width from the exact design up that does not slide."""
+    import rocking
+    from rocking.sliding import sliding_width
+
+    out = {"mu": mu}
+    design = rocking.Block.from_dimensions(height, width, body=body)
+    for name, blk in (("block", block), ("exact_width", design)):
+        if blk is None:
+            continue
+        need = rocking.friction_demand(rocking.simulate(blk, pulse), pulse)
+        entry = need.as_dict()
+        if mu is not None:
+            check = need.judge(mu)
+            entry.update(slides=check.slides, t_slide_s=check.t_slide if check.slides else None)
+        out[name] = entry
+    if mu is not None and out["exact_width"]["slides"]:
+        found = sliding_width(height, pulse, width, mu, body=body)
+        out["exact_width"].update(valid_width_m=found.width, reason=found.reason)
+    return out
+
+
+def _print_friction(friction, mu) -> None:
+    for name, label in (("block", "the column as it stands"), ("exact_width", "the exact design")):
+        f = friction.get(name)
+        if f is None:
+            continue
+        line = (f"friction needed by {label}: up to {f['max_demand']:.4g} at t = "
+                f"{f['t_max']:.3f} s")
+        if f.get("uplift_demand") is not None:
+            line += f" (at uplift {f['uplift_demand']:.4g})"
+        if mu is not None:
+            line += (f"; with friction {mu:g}: " + ("no sliding" if not f["slides"] else
+                     f"SLIDES at t = {f['t_slide_s']:.3f} s, outside the rocking model"))
+        print(line)
+        if f.get("slides") and "valid_width_m" in f:
+            w = f["valid_width_m"]
+            print(f"  narrowest width from the exact design up that does not slide: {w:.4f} m"
+                  if w is not None else f"  {f['reason']}")
+
+
 def run(args) -> int:
     import rocking
     from pulses import G
@@ -81,21 +128,23 @@ def run(args) -> int:
     pulse, origin = _pulse(args)
     lam = parse_positive(args.lam, "--lam")
     limit = _limit(args)
+    mu = parse_friction(args.friction)
     if args.block is not None:
-        height, width = parse_block(args.block)
-        block = rocking.Block.from_dimensions(height, width)
+        height, width, body = parse_column_block(args.block)
+        block = rocking.Block.from_dimensions(height, width, body=body)
     else:
-        height, width, block = parse_length(args.height, "--height (m)"), None, None
+        (height, body), width, block = parse_column_height(args.height), None, None
     ap_g = abs(pulse.ap) / G
     out = {
         "pulse": {"shape": pulse.shape, "ap_g": ap_g, "ap_m_s2": abs(pulse.ap), "tp_s": pulse.tp,
                   "origin": origin},
         "height_m": height, "criterion": args.criterion,
+        "body": rocking.Body.parse(body).describe(),
     }
     rules = {}
     if block is not None:
         p = block.p
-        exact = rocking.min_slenderness(pulse, p, criterion=args.criterion)
+        exact = rocking.min_slenderness(pulse, p, criterion=args.criterion, body=body)
         values = {
             "eq31": rocking.eq31(pulse.ap, pulse.tp, p),
             "eq20": rocking.eq20(pulse.ap, pulse.tp, p, lam),
@@ -112,19 +161,20 @@ def run(args) -> int:
             rules[name] = {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
     for name in ("eq31", "eq20", "envelope", "exact"):
         w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=args.criterion,
-                                   shape=pulse.shape)
+                                   shape=pulse.shape, body=body)
         rules.setdefault(name, {})
         rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
                             "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
     names = ["eq31", "eq20", "envelope", "exact"]
     if limit is not None:
-        w = rocking.required_width(height, pulse, rule="exact", limit=limit)
+        w = rocking.required_width(height, pulse, rule="exact", limit=limit, body=body)
         rules["level"] = {"limit": limit, "required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
                           "p_at_width": w.p, "iterations": w.iterations, "method": w.method}
         if block is not None:
             rules["level"].update(min_tan_alpha=w.tan_alpha, adequate=bool(width >= w.width))
         names.append("level")
     out["rules"] = rules
+    out["friction"] = _friction(block, height, rules["exact"]["required_width_m"], body, pulse, mu)
     if args.json:
         json.dump(out, sys.stdout, indent=2)
         print()
@@ -152,6 +202,7 @@ def run(args) -> int:
             line += f"{r['min_tan_alpha']:>15.4f}  {'yes' if r['adequate'] else 'NO':>8}"
         line += f"  {r['required_width_m']:>19.4f}"
         print(line)
+    _print_friction(out["friction"], mu)
     if block is not None and out["exact_safe_islands"]:
         isl = ", ".join(f"{lo:.4f}-{hi:.4f}" for lo, hi in out["exact_safe_islands"])
         print(f"safe islands below the exact minimum (tan alpha): {isl}")

@@ -116,7 +116,7 @@ def format_fit(record, fit) -> str:
 
 def plot_fit(record, fit, folder, inputs=()) -> str:
     """Record with every fitted pulse over it, like the paper's Fig. 4: acceleration (g) above,
-    velocity below (the record's after the baseline correction of :mod:`pulses.baseline`)."""
+    velocity below (the record's after the baseline correction of :mod:`pulses.fit.baseline`)."""
     import pathlib
 
     import matplotlib
@@ -126,7 +126,7 @@ def plot_fit(record, fit, folder, inputs=()) -> str:
 
     from pulses import G
 
-    from pulses.baseline import corrected_velocity, velocity
+    from pulses.fit.baseline import corrected_velocity, velocity
 
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

@@ -3,9 +3,10 @@ from __future__ import annotations
 
 import argparse
 
-from ..batch import peer_inputs, site, vertical
-from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, jobs_count, parse_block,
-                   parse_length, parse_shapes, record_options)
+from ..batch import peer_inputs, risk, site, vertical
+from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, jobs_count,
+                   parse_column_block, parse_column_height, parse_friction, parse_shapes,
+                   record_options)
 
 DEFAULT_OUT = "pipeline-output"
 
@@ -58,9 +59,17 @@ def add_parser(subparsers) -> None:
                         "(e.g. '*.AT2'); by default every file but those plainly not records "
                         "(README, documents, images), which are named in one line")
     p.add_argument("--block", action="append", default=[], metavar="HxW",
-                   help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); repeatable")
+                   help="a column as it stands, full height x full width in m (e.g. 7.5x1.8); "
+                        "cyl:HxD for a solid circular column of diameter D rocking in a plane "
+                        "(e.g. cyl:7.5x1.8); repeatable")
     p.add_argument("--height", action="append", default=[], metavar="H",
-                   help="only the width a column of this height (m) needs; repeatable")
+                   help="only the width a column of this height (m) needs (cyl:H: the diameter "
+                        "of a circular one); repeatable")
+    p.add_argument("--friction", metavar="MU", default=None,
+                   help="the base's friction coefficient: every response is judged against it "
+                        "(a column needing more slides, outside the rocking model; a design width "
+                        "is valid only where the column does not slide). Default: the friction "
+                        "each response needs is reported, not judged")
     shapes = p.add_argument("--shapes", nargs="+", metavar="SHAPE",
                    help="pulse shapes to fit: %(shapes)s or all (default: "
                         "the fitter's default set)")
@@ -80,6 +89,7 @@ def add_parser(subparsers) -> None:
     site.add_options(p)
     peer_inputs.add_options(p)
     vertical.add_options(p)
+    risk.add_options(p)
     add_common(p, DEFAULT_OUT)
     p.set_defaults(func=main)
 
@@ -101,8 +111,8 @@ def parse_jobs(text) -> int | None:
 def build_columns(blocks, heights):
     from ..batch.tasks import Column
 
-    columns = [Column(*parse_block(b)) for b in blocks]
-    columns += [Column(parse_length(h, "--height (m)")) for h in heights]
+    columns = [Column(*parse_column_block(b)) for b in blocks]
+    columns += [Column(h, None, kind) for h, kind in map(parse_column_height, heights)]
     if not columns:
         raise ArgumentError("give at least one column: --block HxW (e.g. --block 7.5x1.8) or --height H")
     return tuple(dict.fromkeys(columns))
@@ -125,7 +135,9 @@ def main(args) -> int:
     columns = build_columns(args.block, args.height)
     jobs = parse_jobs(args.jobs)
     options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
-                           vertical=args.vertical, **record_options(args), **site.options_from_args(args))
+                           friction=parse_friction(getattr(args, "friction", None)),
+                           vertical=args.vertical, **record_options(args), **site.options_from_args(args),
+                           risk=risk.options_from_args(args))
     plan = api.Plan(records=list(args.records), columns=columns, options=options, record_opts=record_options(args),
                     pairs=args.pairs, pair=list(args.pair),
                     triplets={(str(a), str(b)): str(v) for a, b, v in args.triplet},

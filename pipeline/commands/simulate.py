@@ -13,8 +13,8 @@ import json
 import math
 import sys
 
-from ..args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration, parse_block,
-                   parse_positive, record_options)
+from ..args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration,
+                   parse_column_block, parse_friction, parse_positive, record_options)
 
 
 def add_parser(subparsers) -> None:
@@ -22,7 +22,8 @@ def add_parser(subparsers) -> None:
         "simulate", help="rocking response of one column to a pulse or a record",
         description="Solve Housner's rocking block (docs/theory.md section 2) under a pulse or a full record "
                     "and report overturning, max|theta|/alpha, impacts and the model that answered.")
-    p.add_argument("--block", required=True, help="HEIGHTxWIDTH in m, e.g. 7.5x1.8")
+    p.add_argument("--block", required=True, help="HEIGHTxWIDTH in m, e.g. 7.5x1.8; cyl:HxD for a "
+                                                  "solid circular column rocking in a plane")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--pulse", choices=ShapeNames(), metavar="SHAPE",
                         help="pulse shape: %(choices)s (with --ap and --tp)")
@@ -37,6 +38,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--duration", help="length of history in s (default: the excitation; longer "
                                       "adds the free rocking after it)")
     p.add_argument("--eta", help="coefficient of restitution (default Eq. 5)")
+    p.add_argument("--friction", metavar="MU",
+                   help="judge the friction the response needs against the base's coefficient MU "
+                        "(default: the demand is reported, not judged)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--csv", help="write the history t, theta, omega to this CSV file")
     p.add_argument("--plot", help="draw the rotation and angular velocity histories to this PNG")
@@ -69,13 +73,14 @@ def run(args) -> int:
 
     check_file_options(args, "simulate", inputs=[getattr(args, "record", None)])
 
-    height, width = parse_block(args.block)
+    height, width, body = parse_column_block(args.block)
+    mu = parse_friction(args.friction)
     eta = None
     if args.eta is not None:
         eta = float(args.eta) if args.eta.replace(".", "", 1).isdigit() else math.nan
         if not (0.0 <= eta <= 1.0):
             raise ArgumentError(f"--eta must lie in [0, 1], got {args.eta!r}")
-    block = rocking.Block.from_dimensions(height, width, eta)
+    block = rocking.Block.from_dimensions(height, width, eta, body=body)
     excitation, label = _excitation(args)
     tol = parse_positive(args.tol, "--tol")
     duration = parse_positive(args.duration, "--duration (s)") if args.duration else None
@@ -87,6 +92,13 @@ def run(args) -> int:
         **res.summary(),
         "impact_times_s": [float(x) for x in res.impacts[:1000]],
     }
+    need = rocking.friction_demand(res, excitation)
+    out["block"]["body"] = block.body.describe()
+    out["friction"] = need.as_dict()
+    check = None if mu is None else need.judge(mu)
+    if check is not None:
+        out["friction"].update(mu=mu, slides=check.slides,
+                               t_slide_s=None if not check.slides else check.t_slide, how=check.how)
     if args.csv:
         _write_history(args.csv, res)
     if args.plot:
@@ -102,7 +114,15 @@ def run(args) -> int:
     print(f"  {verdict}{when}; max|theta|/alpha = {res.max_rotation_ratio:.4g} "
           f"(max|theta| = {res.max_rotation:.4g} rad)"
           + ("; |theta| exceeded alpha" if res.exceeded_alpha and not res.overturned else ""))
-    print(f"  impacts: {res.n_impacts}; model: {res.model} (verdict by {res.verdict_by})")
+    print(f"  impacts: {res.n_impacts}; model: {res.model} (verdict by {res.verdict_by}); "
+          f"body: {block.body.describe()}, eta = {block.eta:.4g}")
+    print(f"  friction needed: up to {need.max_demand:.4g} at t = {need.t_max:.3f} s"
+          + (f" (at uplift {need.uplift_demand:.4g})" if math.isfinite(need.uplift_demand) else "")
+          + (f", impulse ratio at impacts {need.impulse_ratio:.4g}" if need.impacts.size else "")
+          + f"; smallest normal force {need.min_normal:.4g} of the weight")
+    if check is not None:
+        print(f"  with friction {mu:g}: " + ("no sliding" if not check.slides else
+              f"SLIDES at t = {check.t_slide:.3f} s ({check.how}): outside the rocking model"))
     return 0
 
 

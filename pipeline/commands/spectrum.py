@@ -9,7 +9,8 @@ import math
 import re
 import time
 
-from ..args import ArgumentError, ShapeNames, parse_acceleration, parse_angle, parse_block, parse_positive
+from ..args import (ArgumentError, ShapeNames, parse_acceleration, parse_angle, parse_column_block,
+                    parse_positive)
 
 
 
@@ -39,7 +40,8 @@ def add_parser(subparsers):
                     "solver and the similarity law.")
     p.add_argument("--alpha", help="slenderness: 14deg, 0.244rad or tan0.25 (default: --block's)")
     p.add_argument("--block", help="your column HEIGHTxWIDTH in m, e.g. 7.5x1.8 (its slenderness; "
-                                    "with --ap and --tp, marked on the plot)")
+                                    "cyl:HxD a circular one, with its impact rule; with --ap and "
+                                    "--tp, marked on the plot)")
     p.add_argument("--ap", help="your pulse's amplitude, e.g. 0.5g (with --block and --tp)")
     p.add_argument("--tp", help="your pulse's period, s (with --block and --ap)")
     p.add_argument("--pulse", default="sine", choices=ShapeNames(), metavar="SHAPE",
@@ -62,15 +64,20 @@ def run(args) -> int:
     check_file_options(args, "spectrum")
     if args.alpha is None and args.block is None:
         raise ArgumentError("give the slenderness: --alpha 14deg, or your column with --block 7.5x1.8")
-    block = rocking.Block.from_dimensions(*parse_block(args.block)) if args.block else None
+    block = None
+    if args.block:
+        height, width, body = parse_column_block(args.block)
+        block = rocking.Block.from_dimensions(height, width, body=body)
     alpha = parse_angle(args.alpha) if args.alpha else block.alpha
     mark = _mark(args, block)
     nw, na = _grid(args.grid)
     w0, w1 = _range(args.wp_range, "--wp-range")
     a0, a1 = _range(args.ap_range, "--ap-range")
     start = time.perf_counter()
+    # a circular column's impact rule differs from Eq. 5: its own eta at its alpha
+    eta = None if block is None or block.body.is_rectangular or args.alpha else block.eta
     spec = rocking.overturning_spectrum(alpha, args.pulse, np.linspace(w0, w1, nw),
-                                        np.linspace(a0, a1, na))
+                                        np.linspace(a0, a1, na), eta=eta)
     elapsed = time.perf_counter() - start
     n = spec.overturned.size
     islands = spec.safe_islands()

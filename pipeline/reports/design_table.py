@@ -69,7 +69,29 @@ DESIGN_COLUMNS = Columns(
                                  "the directions: the block leaves the ground, which the rocking model "
                                  "does not describe (its own verdict, `lifts off at t s`); blank when "
                                  "it never does."),
+    ("body", "-", "The body that rocks: `rectangular` or `cylinder (planar rocking)` (`cyl:`)."),
+    ("friction_demand", "-", "The largest friction coefficient the rocking needs, over the "
+                             "directions, of the column as it stands and at its design width "
+                             "(max |F_x|/F_z, docs/theory.md \"Friction\")."),
+    ("slides", "-", "With `--friction MU`: the column as it stands or at its design width needs more "
+                    "than MU in some direction: it slides, outside the rocking model (`validity` "
+                    "says where and when); blank without `--friction`."),
+    ("validity", "-", "Which model answered and its checks in the governing direction (body, "
+                      "restitution, friction, lift-off with the vertical; `summary.csv` has "
+                      "every direction's)."),
 )
+#: with ``--hazard`` (pipeline.batch.risk): each column's answer at the site, in each of its rows
+RISK_COLUMNS = Columns(
+    ("site_rate_per_year", "1/yr", "`--hazard`: the column as it stands: annual rate of overturning "
+                                   "at the site (the suite's fragility against the hazard curve; "
+                                   "with `--limit`, of exceeding the level; `risk.csv`), the same in "
+                                   "every row of the column."),
+    ("target_width_m", "m", "`--target-rate`/`--target-poe`: the narrowest width whose rate at the "
+                            "site meets the target (`risk.csv`), beside the record-by-record "
+                            "`design_width_m`; the same in every row of the column (the target "
+                            "is in `risk.csv`)."),
+)
+DESIGN_COLUMNS = Columns(*DESIGN_COLUMNS.columns, *RISK_COLUMNS.columns)
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
 
 
@@ -120,9 +142,10 @@ def _meets(r, limit):
     return (not r["overturns"]) and (limit is None or (ratio is not None and ratio <= limit))
 
 
-def design_rows(rows, failed=None) -> list[dict]:
+def design_rows(rows, failed=None, risk=None) -> list[dict]:
     """The rows of ``design.csv`` from the rows of ``summary.csv`` (dicts of typed values) and
-    ``failed`` (``{pair: directions that failed}``)."""
+    ``failed`` (``{pair: directions that failed}``); ``risk``: ``{column: its answer at the site}``
+    (pipeline.batch.risk.answer_fields), blank without."""
     out = []
     for (pair, column), group in _groups(rows).items():
         gov = max(group, key=lambda r: number(r.get("design_width_m")) or -math.inf)  # first of equals
@@ -161,9 +184,23 @@ def design_rows(rows, failed=None) -> list[dict]:
             "vertical_lift_off_s": (None if not block else min(
                 [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
                  if t is not None], default=None)),
+            **{k: (risk or {}).get(column, {}).get(k) for k in RISK_COLUMNS.names},
+            **_validity(group, gov),
         })
         out.append(row)
     return out
+
+
+def _validity(group, gov) -> dict:
+    """The design row's ``body``, ``friction_demand``, ``slides`` and ``validity``."""
+    demands = [number(r.get(k)) for r in group for k in ("friction_demand", "design_friction_demand")]
+    demands = [d for d in demands if d is not None]
+    judged = [r for r in group if number(r.get("friction_mu")) is not None]
+    slides = None
+    if judged:
+        slides = any(bool(r.get("slides")) or bool(r.get("design_slides")) for r in judged)
+    return {"body": gov.get("body"), "friction_demand": max(demands) if demands else None,
+            "slides": slides, "validity": gov.get("validity")}
 
 
 def design_csv(rows, failed=None) -> str:
@@ -355,7 +392,7 @@ def table_text(rows, failures=(), summary=()) -> str:
     lines += [line(c) for c in body]
     for f in failures:
         lines.append(f"{display(f['record'])}  failed ({f['stage']}): {' '.join(display(f['reason']).split())}")
-    lines += [""] + verdict_lines(rows) + [t for t in (fine_print(rows),) if t]
+    lines += [""] + verdict_lines(rows) + [t for t in (governing_print(rows, summary), fine_print(rows)) if t]
     seen = {}
     for r in summary:
         text = metadata_text(r)
@@ -396,12 +433,66 @@ def verdict_lines(rows) -> list[str]:
                      + ("passes: it survives every record" if not (safe or fails) and top <= number(gov["width_m"])
                         else f"FAILS: {fails} record(s) overturn it" + ("" if limit is None else " or exceed the level")
                         + f", {safe} leave it on a safe island"))
-        out.append(line)
-        below = _count(group, "eq31_below_design")
-        over = _count(group, "eq31_width_overturns")
-        out.append(f"Eq. 31 is below the design width on {below} of {n} record(s); its design "
-                   f"overturns under {over}.")
+        out.append(line + risk_words(gov))
+        out.append(eq31_line(group))
+        out += _friction_line(column, group)
     return out
+
+
+def eq31_line(group) -> str:
+    """The Eq. 31 line of one column's design rows: how often its width is below the design width,
+    and how often a column of that width overturns under its record."""
+    n = len(group)
+    below = _count(group, "eq31_below_design")
+    over = _count(group, "eq31_width_overturns")
+    return (f"Eq. 31 is below the design width on {below} of {n} record(s); a column of Eq. 31's width "
+            f"overturns under {'none' if not over else f'{over} of them'}.")
+
+
+def governing_print(rows, summary) -> str | None:
+    """Why the governing pulse is not the best fit, where it is not on some record: the rule, and
+    the records (``rows``: design rows, ``summary``: summary.csv's, whose ``pulse_shape`` is the
+    best fit)."""
+    best = {}
+    for r in summary:
+        key = (r.get("pair") or r.get("record"), r.get("column"), r.get("direction_deg"))
+        best.setdefault(key, r.get("pulse_shape"))
+    others = []
+    for r in rows:
+        shape = best.get((r.get("record"), r.get("column"), r.get("direction_deg")))
+        if shape and r.get("governing_shape") and shape != r["governing_shape"]:
+            others.append(f"{display(r['record'])} fits {shape} best")
+    if not others:
+        return None
+    shown = "; ".join(dict.fromkeys(others[:3])) + ("; ..." if len(others) > 3 else "")
+    return ("Governing pulse: of the shapes that fit almost as well as the best (a score at least 0.7 "
+            "of its), the one whose Eq. 31 width is widest, since shapes that fit almost equally well "
+            "can ask for very different columns; so it is not always the best fit "
+            f"({len(others)} of {len(rows)} row(s) here: {shown}).")
+
+
+def risk_words(row) -> str:
+    """``; at the site it fails at 2.1e-04/yr; the width for the site's target rate is 2.140 m``
+    from a design row's risk columns ("" without ``--hazard``; risk.csv says more)."""
+    rate, width = (number(row.get(k)) for k in RISK_COLUMNS.names)
+    text = ""
+    if rate is not None:
+        text += f"; at the site it fails at {rate:.2e}/yr"
+    if width is not None:
+        text += f"; the width for the site's target rate is {width:.3f} m"
+    return text
+
+
+def _friction_line(column, group) -> list[str]:
+    """With ``--friction``: how many records make the column slide (outside the model)."""
+    judged = [r for r in group if r.get("slides") is not None]
+    if not judged:
+        return []
+    demand = max((number(r.get("friction_demand")) or 0.0) for r in judged)
+    n = _count(judged, "slides")
+    return [f"Friction, column {display(column)}: {n} of {len(judged)} record(s) make it slide "
+            f"(as it stands or at its design width: outside the rocking model, see validity); "
+            f"the rocking needs up to {demand:.3g}."]
 
 
 def check_reach_words() -> str:

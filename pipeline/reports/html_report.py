@@ -17,7 +17,7 @@ import urllib.parse
 
 from . import report
 from .design_table import (check_reach_words, eq31_text, failing_text, metadata_text, pulse_text, search_text,
-                           survives_text, verdict_lines, fine_print, vertical_text)
+                           survives_text, verdict_lines, fine_print, governing_print, vertical_text)
 from .design_table import number as _num
 from .report import FIT_TOLERANCE
 
@@ -160,7 +160,7 @@ def _batch_table(design, anchors) -> list[str]:
     return out
 
 
-def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
+def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str]:
     first = rows[0] if rows else {}
     out = [f'<section class="rec" id="{anchor}"><h3>{_e(rid)}</h3>']
     if first:
@@ -174,7 +174,9 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
         if _num(first.get("scale")) not in (None, 1.0):
             facts.append(("scale", first.get("scale")))
         facts += [
-            ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s"),
+            ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s "
+                         "(peaks of the record's acceleration and of its velocity after the fitter's "
+                         "baseline correction)"),
             ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
                            f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
                            f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"
@@ -201,8 +203,7 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                      f"design width {_fixed(r.get('design_width_m')) or '-'} m"
                      + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
                      + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else "")
-                     + (f", at least the overturning design width {_fixed(r['overturning_width_m'])} m"
-                        if _num(r.get("overturning_width_m")) else ""),
+                     + _overturning_words(r),
                      f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
@@ -227,14 +228,30 @@ def _record_section(rid, rows, failure, plot, anchor) -> list[str]:
                             "model stops there, no verdict)")
                     parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): {said}"
                                  + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}")
+            if r.get("validity"):
+                parts.append(f"model: {r['validity']}")
             out.append(f"<li>{_e('; '.join(parts))}</li>")
         out.append("</ul>")
     if failure:
         out.append(f'<p class="muted">failed ({_e(failure["stage"])}): {_e(failure["reason"])}</p>')
     if plot:
         out.append(f'<p><img src="{_href(plot)}" alt="{_e(rid)}: record, pulses and rotation histories"></p>')
+    if friction:
+        out.append(f'<p><a href="{_href(friction)}">the friction its responses need against time</a></p>')
     out.append("</section>")
     return out
+
+
+def _overturning_words(r) -> str:
+    """Under ``--limit``: what the overturning design width in the row is (in full where it sets
+    the design width, else the part established: it is refined only where it can change it)."""
+    over, design = _num(r.get("overturning_width_m")), _num(r.get("design_width_m"))
+    if over is None:
+        return ""
+    if design is None or over >= design:
+        return f", set by the overturning design width {_fixed(over)} m (a width that overturns fails every level)"
+    return (f", above the overturning design width (at least {_fixed(over)} m: refined only as far as "
+            "it could change the design width)")
 
 
 def report_html(design, rows, failures, record_ids, figures, title="pipeline run") -> str:
@@ -269,7 +286,7 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
            f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
            f"<h1>{_e(title)}</h1>"]
     out += [f'<p class="verdict"><b>{_e(line)}</b></p>' for line in verdict_lines(design)]
-    out += [f'<p class="muted">{_e(t)}</p>' for t in (fine_print(design),) if t]
+    out += [f'<p class="muted">{_e(t)}</p>' for t in (governing_print(design, rows), fine_print(design)) if t]
     out += [
            f"<p>{len(record_ids)} records, {len(failures)} failed. Files: "
            + ", ".join(f'<a href="{_href(f)}">{_e(f)}</a>' for f in
@@ -289,15 +306,19 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
         out.append("</tbody></table>")
     site = [(k, label) for k, label in (("summary", "Required against actual slenderness"),
                                         ("suite", "Suite: share of records whose design width a column of width B reaches"),
-                                        ("fragility", "Collapse fragility")) if figures.get(k)]
+                                        ("fragility", "Collapse fragility"),
+                                        ("risk_widths", "Risk at the site: annual rate of failure against the width"),
+                                        ("risk_disaggregation", "Risk at the site: where the rate comes from"))
+            if figures.get(k)]
     if site:
         out.append("<h2>Batch figures</h2>")
         for k, label in site:
             out.append(f"<h3>{_e(label)}</h3><p><img src=\"{_href(figures[k])}\" alt=\"{_e(label)}\"></p>")
+    out += _validity_section(rows, figures)
     out.append(f"<h2>Records ({n_ok} processed)</h2>")
     for rid in record_ids:
         out += _record_section(rid, by_record.get(rid, []), failed.get(rid), figures.get(("record", rid)),
-                               anchors[rid])
+                               anchors[rid], friction=figures.get(("friction", rid)))
     out.append(f"<script>{_JS}</script></body></html>")
     return "\n".join(out) + "\n"
 
@@ -316,5 +337,29 @@ def figures_in(out, record_ids, plots: bool, names: dict) -> dict:
         rel = report.record_plot_name(rid)
         if (out / rel).is_file():
             found[("record", rid)] = rel
+        rel = report.record_friction_plot_name(rid)
+        if (out / rel).is_file():
+            found[("friction", rid)] = rel
     return found
+
+
+def _validity_section(rows, figures) -> list[str]:
+    """Where the model holds: the governing record's (the widest design width's) checks and the
+    friction its responses need against time."""
+    judged = [r for r in rows if r.get("validity")]
+    if not judged:
+        return []
+    gov = max(judged, key=lambda r: _num(r.get("design_width_m")) or 0.0)   # first of the widest
+    rid = gov["record"]
+    out = ['<h2 id="validity">Where the rocking model holds</h2>',
+           f"<p>Governing record {_e(rid)} (column {_e(gov.get('column'))}, the widest design "
+           f"width, {_fixed(gov.get('design_width_m')) or '-'} m): {_e(gov['validity'])}.</p>"]
+    failed = [r for r in judged if "FAILED" in str(r.get("validity"))]
+    if failed:
+        out.append(f"<p><b>{len(failed)} of {len(judged)} rows leave the model</b> (friction or "
+                   "lift-off; their `validity` says which and when).</p>")
+    if figures.get(("friction", rid)):
+        out.append(f'<p><img src="{_href(figures[("friction", rid)])}" alt="{_e(rid)}: friction '
+                   'needed against time"></p>')
+    return out
 

@@ -20,11 +20,22 @@ import pathlib
 import stat
 import tempfile
 
-from pulses.shapes import AntisymmetricRicker, OneSine, Rectangular, SymmetricRicker
+from pulses.shapes import SHAPES
 from rocking.governing import FIT_TOLERANCE  # a shape "fits" a record: rocking.governing_pulse's rule
 
-#: shapes that get their own group of columns, in this order (``pulses.SHAPES`` names)
-SHAPE_NAMES = tuple(cls.shape for cls in (OneSine, SymmetricRicker, AntisymmetricRicker, Rectangular))
+#: shapes that get their own group of columns, in this order: every shape of ``pulses.SHAPES``, the
+#: realisable ones first (the registry's order kept within each group)
+SHAPE_NAMES = tuple(sorted(SHAPES, key=lambda shape: not SHAPES[shape].realisable))
+
+
+def shape_list() -> str:
+    """The shapes of :data:`SHAPE_NAMES` in words, for the columns' descriptions:
+    ``"`sine` (one-sine, Eq. 9), ... or `rect` (rectangular)"``."""
+    words = []
+    for name in SHAPE_NAMES:
+        cls = SHAPES[name]
+        words.append(f"`{name}` ({cls.label}{', ' + cls.equation if cls.equation else ''})")
+    return ", ".join(words[:-1]) + " or " + words[-1] if len(words) > 1 else words[0]
 
 
 GOVERNING_RULE = (
@@ -412,6 +423,11 @@ def record_widths_plot_name(record_id: str) -> str:
     return f"plots/widths/{record_id}.png"
 
 
+def record_friction_plot_name(record_id: str) -> str:
+    """Path of a record's figure of the friction its responses need (a folder of its own)."""
+    return f"plots/friction/{record_id}.png"
+
+
 def columns_markdown(columns, failure_columns) -> str:
     """``columns.md``: the files of the output folder and every column of the reports.
 
@@ -439,10 +455,11 @@ def columns_markdown(columns, failure_columns) -> str:
         "run into this folder replaces or removes only those, and only while their content is still "
         "what it wrote; any other file in its way is left as it is, and the run says so.",
         f"- `{RESUME}`: for each record computed, a key of its file content, options and "
-        "package version and a hash of its report: a later run into this folder with the same "
+        "the package's code (version, installed files, solver settings) and a hash of its report: a later run into this folder with the same "
         "command keeps those records and computes only the others (`--force`: all).",
         "",
-        "Accelerations are in g (g = 9.81 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
+        "Accelerations are in g (g = 9.81 m/s^2, the value of the paper the design rules come from, "
+        "in every conversion; standard gravity is 9.80665 m/s^2), lengths in m, times in s. Numbers carry 6 significant "
         "digits; a blank cell means the value does not apply (or, in `<shape>_*` columns, that the shape "
         "does not fit or was not tried). Booleans are `True`/`False`.",
         "",

@@ -24,7 +24,7 @@ import numpy as np
 import pulses
 import rocking
 from pulses import G, make_pulse
-from pulses.synthetic import synthetic_record
+from pulses.fit.synthetic import synthetic_record
 from rocking import Block
 
 HERE = pathlib.Path(__file__).resolve().parent
