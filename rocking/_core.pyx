@@ -66,7 +66,7 @@ cdef enum:
     LOW_RUN_FIXED = 8
     #: intervals in a row in which a lower order sufficed for every rocking lane before it is
     #: lowered (rocking.lanes.LOW_RUN)
-    LOW_RUN = 64
+    LOW_RUN = 2
 
 cdef long MAX_EVENTS_PER_STEP = 1000000
 #: a Taylor series is cut once two consecutive terms of theta and of ``h * omega`` fall below

@@ -38,7 +38,7 @@ from .engine import NODAL, TAYLOR, as_input, check_kind
 #: the first ``n_rocking`` lanes steps them all); compiled into ``rocking/_core.pyx``
 LANES = 32
 #: intervals in a row in which a lower order sufficed for every rocking lane before it is lowered
-LOW_RUN = 64
+LOW_RUN = 2
 #: counts a batch in lanes keeps (``stats`` of :func:`run_batch`), in this order: rocking steps
 #: kept in lanes, turning points and impacts taken in lanes (``rocking_events_N``), intervals
 #: handed to the engine for rocking lanes, for lanes at rest, and for rocking lanes whose order
