@@ -13,8 +13,8 @@ The unrolled Taylor steps are generated: ``_taylor_fixed.pxi`` by ``rocking/_mak
 """
 from libc.stdint cimport int64_t
 from libc.string cimport memset
-from libc.math cimport (acos, copysign, cos, exp, fabs, isnan, sin, sinh, sqrt, tan, INFINITY,
-                        NAN)
+from libc.math cimport (acos, copysign, cos, exp, fabs, fmax, isnan, sin, sinh, sqrt, tan,
+                        INFINITY, NAN)
 
 import numpy as np
 
@@ -54,6 +54,7 @@ cdef enum:
     ROCKING = 1
     OVERTURNED = 2
     LIFTOFF = 3  # g + av < 0: the block leaves the ground (the model stops there)
+    FINAL = 4    # a lane of a batch stopped once its verdict and peak are final (_finals)
 
 cdef enum:
     #: highest order of a Taylor step (rocking.engine.NMAX)
@@ -67,6 +68,8 @@ cdef enum:
     #: intervals in a row in which a lower order sufficed for every rocking lane before it is
     #: lowered (rocking.lanes.LOW_RUN)
     LOW_RUN = 2
+    #: intervals between the checks of which lanes of a batch run until final are final
+    FINAL_EVERY = 16
 
 cdef long MAX_EVENTS_PER_STEP = 1000000
 #: a Taylor series is cut once two consecutive terms of theta and of ``h * omega`` fall below
@@ -1588,10 +1591,10 @@ cdef (long, long) _partition(Chunk* L, long n_live) noexcept nogil:
     ``(n_rocking, n_live)``.  Two-pointer partitions: only lanes out of place move (a few per
     call: a lane changes state at an uplift, a return to rest or an overturning)."""
     cdef long i = 0, m = n_live, k
-    while True:  # overturned lanes to the end
-        while i < m and L.i[I_STATUS][i] != OVERTURNED:
+    while True:  # overturned (and final) lanes to the end
+        while i < m and L.i[I_STATUS][i] != OVERTURNED and L.i[I_STATUS][i] != FINAL:
             i += 1
-        while m > i and L.i[I_STATUS][m - 1] == OVERTURNED:
+        while m > i and (L.i[I_STATUS][m - 1] == OVERTURNED or L.i[I_STATUS][m - 1] == FINAL):
             m -= 1
         if i >= m:
             break
@@ -1617,12 +1620,49 @@ cdef long _wake(const double* uval, long j, long n_int, double a, double tan_a) 
     return j
 
 
+#: the energy bound of a lane's finality must lie below its peak's energy by this share (the
+#: bound holds for the exact solution; the steps agree with it to rounding)
+cdef double FINAL_MARGIN = 1e-9
+
+
+cdef long _finals(Chunk* L, long n_live, double rest_u) noexcept nogil:
+    """Mark FINAL the live lanes whose verdict and peak can no longer change: with
+    ``E = omega^2/2 + p^2 (cos(alpha - |theta|) - cos alpha)`` (0 at rest), the ground can raise
+    ``sqrt(E)`` by at most ``p^2 / sqrt(2)`` times ``rest_u``, the integral of ``|ug''/g|`` (the
+    lane's amplitude aside) over the rest of the record (``|dE/dt| = p^2 |u cos(.) omega| <= p^2
+    |u| sqrt(2 E)``; impacts only lower ``E``, and so does the free rocking after the record); a
+    lane whose bound stays below the energy of its peak so far, ``p^2 (cos(alpha - max|theta|) -
+    cos alpha)``, never again reaches its peak: it neither overturns nor rocks any higher.
+    Returns how many were marked."""
+    cdef long i, st, m = 0
+    cdef double p2, e, b, top
+    for i in range(n_live):
+        st = L.i[I_STATUS][i]
+        if (st != ROCKING and st != REST) or not L.f[R_MX][i] > 0.0:
+            continue
+        p2 = L.f[R_P][i] * L.f[R_P][i]
+        e = 0.0
+        if st == ROCKING:
+            e = 0.5 * L.f[R_OM][i] * L.f[R_OM][i] + p2 * (L.f[R_CPHI][i] - L.f[R_CA][i])
+            e = fmax(e, 0.0)
+        b = sqrt(e) + p2 * 0.7071067811865476 * fabs(L.f[R_A][i]) * rest_u
+        top = p2 * (cos(L.f[R_ALPHA][i] - L.f[R_MX][i]) - L.f[R_CA][i])
+        if b * b < top * (1.0 - FINAL_MARGIN):
+            L.i[I_STATUS][i] = FINAL
+            m += 1
+    return m
+
+
 cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double t_start,
                  double h, long n_int, const double* p, const double* alpha, const double* eta,
                  double zeno_tol, unsigned char* overturned, double* max_abs,
-                 int64_t* n_impacts, unsigned char* uplifted, int64_t* stats) noexcept nogil:
+                 int64_t* n_impacts, unsigned char* uplifted, int64_t* stats,
+                 const double* rest_u) noexcept nogil:
     """Runs ``i0 .. i1-1`` (at most :data:`LANES`) from rest over the whole record; results
-    (after the energy rule at the end of the record) written at their indices.
+    (after the energy rule at the end of the record) written at their indices.  ``rest_u``
+    (or NULL): the integral of ``|ug''/g|`` from each node to the end of the record; each lane is
+    then stopped once its verdict and its peak are final (:func:`_finals`, every
+    :data:`FINAL_EVERY` intervals; its impacts are counted up to there).
 
     ``stats`` (:data:`N_STATS` integers, the ``ST_*`` counts) is incremented by what was done
     in lanes and what was handed to the engine.
@@ -1664,6 +1704,9 @@ cdef void _chunk(long i0, long i1, const double* amp, const double* uval, double
     for j in range(n_int):
         if n_live == 0:
             break
+        if rest_u != NULL and j % FINAL_EVERY == 0 and j > 0:
+            if _finals(&L, n_live, rest_u[j]) > 0:
+                n_rocking, n_live = _partition(&L, n_live)
         if n_rocking == 0 and j < next_wake:
             continue
         ta = t_start + j * h
@@ -1822,14 +1865,17 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
            const double[::1] eta, bint linear, double zeno_tol, int method,
            unsigned char[::1] overturned, double[::1] max_abs, int64_t[::1] n_impacts,
            unsigned char[::1] uplifted, int64_t[::1] stats, const double[::1] vval=None,
-           double[::1] t_lift=None):
+           double[::1] t_lift=None, const double[::1] rest_u=None):
     """Runs ``i0 .. i1-1`` of a batch from rest, then the energy rule; results written at their
     indices (``overturned`` and ``uplifted`` as bytes 0 or 1).  ``lanes``: stepped together (at
     most :data:`LANES` runs; a record on a uniform grid, one Taylor step per sample), else one by
     one with :func:`run_core`.  Runs without the GIL: :func:`rocking.lanes.run_batch` spreads
     calls over threads.  ``vval``: the vertical ground motion's node values (one by one only,
     records on a uniform grid, Taylor steps; scaled as the record), with ``t_lift`` the lift-off
-    time of each run (nan if none)."""
+    time of each run (nan if none).  ``rest_u`` (lanes only): the integral of ``|ug''/g|`` from
+    each node to the end of the record, to stop each run once its verdict and peak are final
+    (``_finals``; ``n_impacts`` then counts the impacts up to there)."""
+    cdef const double* rest_u_p = NULL
     cdef const double* vval_p = NULL
     cdef double* t_lift_p = NULL
     cdef const double* uval_p = _ptr(uval)
@@ -1856,6 +1902,10 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
                              "room for the lift-off times")
         vval_p = &vval[0]
         t_lift_p = &t_lift[0]
+    if rest_u is not None:
+        if not lanes or rest_u.shape[0] < n_int + 1:
+            raise ValueError("rest_u: lanes only, a value at every node")
+        rest_u_p = &rest_u[0]
     if i1 <= i0:
         return
     with nogil:
@@ -1863,7 +1913,8 @@ def kernel(bint lanes, long i0, long i1, int kind, const double[::1] amp, double
             for k in range(N_STATS):
                 counts[k] = 0
             _chunk(i0, i1, &amp[0], uval_p, t_start, h, n_int, &p[0], &alpha[0], &eta[0],
-                   zeno_tol, &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0], counts)
+                   zeno_tol, &overturned[0], &max_abs[0], &n_impacts[0], &uplifted[0], counts,
+                   rest_u_p)
             for k in range(min(N_STATS, stats.shape[0])):
                 stats[k] += counts[k]
         else:

@@ -83,7 +83,8 @@ def _pool(threads):
 
 
 def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p, alpha, eta,
-              linear, zeno_tol, method=TAYLOR, threads=None, stats=None, vval=None):
+              linear, zeno_tol, method=TAYLOR, threads=None, stats=None, vval=None,
+              until_final=False):
     """Runs from rest of blocks ``p``, ``alpha``, ``eta`` (arrays) scaled by ``amp`` (array), then
     the energy rule; no histories.  ``lanes``: stepped together (records on a uniform grid with one
     Taylor step per sample, ``n_sub == 1``), else one by one (any grid, model or method).
@@ -96,6 +97,11 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
     ``vval``: node values of the vertical ground motion, scaled as the record (``1 + amp * vval`` =
     ``1 + av/g``; one by one only, docs/theory.md section 10); then a fifth array is returned, the
     lift-off time of each run (nan where none).
+
+    ``until_final`` (lanes only): each run stops once its verdict and its peak ``max|theta|``
+    can no longer change (an energy bound on what the rest of the record can give it,
+    ``rocking._core._finals``): the same verdicts and peaks as run to the end, less work, and
+    ``n_impacts`` counts the impacts up to where it stopped (what a design search needs).
 
     Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted``.
     """
@@ -119,7 +125,9 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
             float(h), int(n_int), np.ascontiguousarray(n_sub, dtype=np.int64), f64(p), f64(alpha),
             f64(eta), bool(linear), float(zeno_tol), int(method)) + results
 
-    extra = ()
+    extra, kw = (), {}
+    if until_final and lanes:
+        kw["rest_u"] = rest_of_record(uval, h, n_int)
     if vval is not None:
         t_lift = np.full(n, np.nan)
         extra = (f64(vval), t_lift)
@@ -127,7 +135,7 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
 
     def task(k):
         i0 = starts[k]
-        _core.kernel(bool(lanes), i0, min(n, i0 + size), *args, counts[k], *extra)
+        _core.kernel(bool(lanes), i0, min(n, i0 + size), *args, counts[k], *extra, **kw)
 
     if threads == 1 or len(starts) <= 1:
         for k in range(len(starts)):
@@ -139,16 +147,30 @@ def run_batch(lanes, kind, amp, tp, t0, uval, nodes, t_start, h, n_int, n_sub, p
     return out
 
 
-def run_lanes(amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, threads=None, stats=None):
+def rest_of_record(uval, h, n_int):
+    """The integral of ``|u|`` from each node ``j`` to the end (``n_int`` intervals of ``h`` s,
+    ``u`` linear between the node values ``uval``: at most the trapezoid of ``|u|``), rounded
+    up by a part in 1e12 (the sum's own rounding)."""
+    a = np.abs(np.asarray(uval[:n_int + 1], dtype=float))
+    out = np.zeros(n_int + 1)
+    out[:-1] = np.cumsum((0.5 * h * (a[:-1] + a[1:]))[::-1])[::-1]
+    return out * (1.0 + 1e-12)
+
+
+def run_lanes(amp, uval, t_start, h, n_int, p, alpha, eta, zeno_tol, threads=None, stats=None,
+              until_final=False):
     """Runs from rest of blocks ``p``, ``alpha``, ``eta`` (arrays) under the record ``amp * uval``
     (node values of ``ug''/g`` every ``h`` s from ``t_start``, ``n_int`` intervals), one Taylor
     step per interval, then the energy rule; no histories (:func:`run_batch` in lanes).
+
+    ``until_final``: each run stops once its verdict and peak are final (:func:`run_batch`).
 
     Returns arrays ``overturned, max_abs_theta, n_impacts, uplifted`` (as :func:`run_many`).
     """
     n_sub = np.ones(np.shape(p)[0], dtype=np.int64)
     return run_batch(True, NODAL, amp, 1.0, 0.0, uval, np.zeros(0), t_start, h, n_int, n_sub, p,
-                     alpha, eta, False, zeno_tol, TAYLOR, threads, stats)
+                     alpha, eta, False, zeno_tol, TAYLOR, threads, stats,
+                     until_final=until_final)
 
 
 def run_many(kind, amp, tp, t0, uval, nodes, t_start, h_uniform, n_int, n_sub, p, alpha, eta,

@@ -220,12 +220,14 @@ class SearchSettings:
 DEFAULT_SETTINGS = SearchSettings()
 
 
-def _batch(blocks, excitation, scales=None, *, grid=False, model="fast"):
-    """Call :func:`rocking.simulate_many` (looked up at call time: the solver is a sibling module)."""
+def _batch(blocks, excitation, scales=None, *, grid=False, model="fast", until_final=False):
+    """Call :func:`rocking.simulate_many` (looked up at call time: the solver is a sibling module);
+    ``until_final``: its runs stop once their verdicts and peaks are final."""
     import rocking
 
     if model in ("fast", "linear"):
-        return rocking.simulate_many(blocks, excitation, scales, grid=grid, model=model)
+        return rocking.simulate_many(blocks, excitation, scales, grid=grid, model=model,
+                                     until_final=until_final)
     # any other model (the slow "reference" yardstick): one simulate() per run
     blocks = [blocks] if isinstance(blocks, Block) else list(blocks)
     scales = np.atleast_1d(np.asarray(1.0 if scales is None else scales, dtype=float))

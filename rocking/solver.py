@@ -563,7 +563,8 @@ def _simulate_vertical(block, record, vertical, duration, history, zeno_tol, ph_
 LANES_MIN_RUNS = 4
 
 
-def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lanes=True):
+def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lanes=True,
+               until_final=False):
     """The engine over a batch: runs under a record with one Taylor step per sample go through the
     batch engine in lanes (:mod:`rocking.lanes`, several runs per core at once), the rest run one
     by one (:func:`rocking.lanes.run_many`); the same model either way."""
@@ -573,7 +574,7 @@ def _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads=None, lane
 
     def in_lanes(m):
         return run_lanes(amp[m], g.uval, g.t_start, g.h, g.n_int, p[m], alpha[m], eta[m], ZENO_TOL,
-                         threads)
+                         threads, until_final=until_final)
 
     use = np.zeros(p.size, dtype=bool)
     if (lanes and g.kind == engine.NODAL and g.nodes.size == 0 and not linear
@@ -616,7 +617,7 @@ def _block_arrays(blocks):
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor",
                   threads: int | None = None, lanes: bool = True,
-                  vertical: Record | None = None) -> BatchResult:
+                  vertical: Record | None = None, until_final: bool = False) -> BatchResult:
     """Run one excitation against many blocks and/or many amplitude scalings, in compiled code.
 
     Parameters
@@ -640,6 +641,11 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
         Upward ground acceleration (m/s^2) on the record's time axis, scaled with it (docs/theory.md
         section 10): runs one by one in the compiled engine (model ``"fast-vertical"``), with
         ``lifts_off`` and ``t_lift_off``; a zero vertical is no vertical (bit for bit).
+    until_final : bool
+        Stop each run of the batch engine's lanes once its verdict and ``max|theta|`` can no
+        longer change (what the ground can still give it, bounded by its energy; the design
+        searches): the same ``overturned``, ``exceeded_alpha``, ``max_rotation`` and
+        ``uplifted``, in less time; ``n_impacts`` then counts the impacts up to the stop.
 
     Returns
     -------
@@ -706,7 +712,7 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                            n_imp.reshape(shape), up.reshape(shape), "fast-vertical",
                            lifts.reshape(shape), t_lift.reshape(shape))
     over, max_abs, n_imp, up = _run_batch(g, amp, n_sub, p, alpha, eta, linear, stepper, threads,
-                                          lanes)
+                                          lanes, until_final)
     ratio = max_abs / alpha
     return BatchResult(over.reshape(shape), (max_abs > alpha).reshape(shape),
                        max_abs.reshape(shape), ratio.reshape(shape), n_imp.reshape(shape),

@@ -384,7 +384,8 @@ def _exact_width(height, excitation, *, criterion, eta, n_scan, rtol, model, n_z
             import rocking
 
             return rocking.simulate_many(blocks, excitation, vertical=vertical)
-        return _batch(blocks, excitation, None, model=model)
+        # verdicts and peaks only: each run stops once they are final (the same answers)
+        return _batch(blocks, excitation, None, model=model, until_final=True)
 
     is_pulse = getattr(excitation, "shape", "record") in SHAPES
     if not is_pulse:

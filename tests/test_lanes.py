@@ -192,3 +192,20 @@ def test_a_run_is_the_same_whatever_batch_it_is_run_in(record):
     assert alone.n_impacts.max() > 20 and mixed.overturned.any()
     for name in ("overturned", "max_rotation", "n_impacts", "uplifted"):
         np.testing.assert_array_equal(getattr(mixed, name)[back], getattr(alone, name), err_msg=name)
+
+
+def test_runs_stopped_once_final_keep_their_verdicts_and_peaks(record):
+    """``until_final`` (the design searches) stops a run once the energy the rest of the record
+    can give it cannot take it back to its peak: every verdict and peak are those of the runs
+    to the end, bit for bit (the bound holds for the exact solution, with a margin of 1e-9 of
+    the peak's energy for the steps' rounding); only the impacts after the stop go uncounted."""
+    height = 6.0
+    top = height * record.pga / G
+    blocks = [Block.from_dimensions(height, float(w)) for w in top * np.linspace(0.2, 1.1, 96)]
+    full = simulate_many(blocks, record)
+    cut = simulate_many(blocks, record, until_final=True)
+    assert full.overturned.any() and not full.overturned.all()
+    for name in ("overturned", "exceeded_alpha", "max_rotation", "uplifted"):
+        np.testing.assert_array_equal(getattr(cut, name), getattr(full, name), err_msg=name)
+    assert (cut.n_impacts <= full.n_impacts).all()
+    assert (cut.n_impacts < full.n_impacts).sum() >= 10     # stopped before the record's end
