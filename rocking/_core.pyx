@@ -1650,6 +1650,13 @@ cdef long _finals(Chunk* L, long n_live, double rest_u) noexcept nogil:
         if b * b < top * (1.0 - FINAL_MARGIN):
             L.i[I_STATUS][i] = FINAL
             m += 1
+            # still, as a lane at rest (a lane past the rocking ones may be stepped with them:
+            # omega 0 keeps it as it is)
+            L.f[R_TH][i] = 0.0
+            L.f[R_OM][i] = 0.0
+            L.f[R_SIDE][i] = 0.0
+            L.f[R_SPHI][i] = 0.0
+            L.f[R_CPHI][i] = 1.0
     return m
 
 

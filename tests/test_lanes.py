@@ -209,3 +209,20 @@ def test_runs_stopped_once_final_keep_their_verdicts_and_peaks(record):
         np.testing.assert_array_equal(getattr(cut, name), getattr(full, name), err_msg=name)
     assert (cut.n_impacts <= full.n_impacts).all()
     assert (cut.n_impacts < full.n_impacts).sum() >= 10     # stopped before the record's end
+
+
+def test_runs_stopped_once_final_on_a_slender_column_under_a_real_record():
+    """The same on the 7.5 m column's widths near 0.0135 m under Lytle Creek (alpha 0.0018):
+    a stopped run sits past the rocking lanes of its chunk, which the lanes' step takes along
+    as padding; it must stay still there (omega 0), or the step's count of the lanes left
+    misses one and another lane's event goes untaken (a run that overturns was reported as
+    surviving before it did)."""
+    from tests.conftest import shared_record
+
+    record = pulses.read_record(str(shared_record("../peer_download/RSN41_LYTLECR_ORR021.AT2")))
+    blocks = [Block.from_dimensions(7.5, float(w)) for w in np.linspace(0.0098, 0.0136, 400)]
+    full = simulate_many(blocks, record)
+    cut = simulate_many(blocks, record, until_final=True)
+    assert 0 < full.overturned.sum() < 400
+    for name in ("overturned", "max_rotation", "uplifted"):
+        np.testing.assert_array_equal(getattr(cut, name), getattr(full, name), err_msg=name)
