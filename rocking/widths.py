@@ -113,6 +113,14 @@ class RequiredWidth:
     #: what the runs depend on (record and vertical hashed, height, restitution, frame, model):
     #: a level may reuse only the runs of the same inputs
     inputs: tuple | None = field(default=None, repr=False, compare=False)
+    #: a restitution band (``eta=`` a band :class:`rocking.restitution.Restitution`;
+    #: :mod:`rocking.band`): the single values run (ends included), the design width of each (m),
+    #: the value whose design width governs (the widest; ties: the lowest restitution), and each
+    #: value's whole design (this answer's other fields are the governing value's)
+    restitution_values: tuple = ()
+    restitution_widths: tuple = ()
+    restitution_governing: object = None
+    band_designs: tuple = field(default=(), repr=False, compare=False)
 
     @property
     def total_runs(self) -> int:
@@ -178,7 +186,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
                    shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
                    settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None, limit=None,
-                   horizontal=None, overturning=None):
+                   horizontal=None, overturning=None, band_values=None):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -194,8 +202,13 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         *design width*, see :class:`RequiredWidth`); works for pulses and records.
     criterion : {"overturn", "exceed"}
         Failure criterion of ``rule="exact"`` (``limit`` takes precedence).
-    eta : float, optional
-        Restitution for the exact rule (default Eq. 5 at each width).
+    eta : float or rocking.restitution.Restitution, optional
+        Restitution for the exact rule: a velocity ratio ``eta``, or a
+        :class:`~rocking.restitution.Restitution` (a factor of Eq. 5 at each width, an ``eta`` or
+        an ``r``; default Eq. 5 at each width).  A band (``Restitution.parse("0.95:1.05")``)
+        gives the design covering it: ``band_values`` values (default
+        :data:`rocking.band.BAND_VALUES`), ends included, each designed, the widest governing
+        (``.restitution_values``, ``.restitution_widths``, ``.restitution_governing``).
     limit : float, optional
         ``rule="exact"``: the performance level R in (0, 1]: the design keeps ``max|theta|/alpha
         <= R`` (a width fails where it exceeds R or the column overturns); None (default):
@@ -234,6 +247,22 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     >>> [round(rocking.required_width(7.5, pulse, rule=r).width, 3) for r in ("eq31", "exact")]
     [2.17, 1.736]
     """
+    from . import band
+
+    eta = band.plain(eta)
+    if band.is_band(eta):
+        if rule != "exact":
+            raise ValueError(f"rule={rule!r} does not depend on the restitution: a band goes with "
+                             "rule='exact'")
+        kw = dict(rule=rule, criterion=criterion, shape=shape, lam=lam, n_scan=n_scan,
+                  n_zone=n_zone, rtol=rtol, model=model, settings=settings,
+                  cap_mass_ratio=cap_mass_ratio, vertical=vertical, limit=limit)
+        index = {v: k for k, v in enumerate(band.singles(eta, band_values))}
+        return band.band_width(lambda v: required_width(
+            height, excitation, eta=v, horizontal=None if horizontal is None else band.band_of(horizontal, index[v]),
+            overturning=(overturning if overturning is None or overturning is True
+                         else band.band_of(overturning, index[v])),
+            **kw), eta, band_values)
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
     height = _check_arguments(height, rule, overturning, limit, vertical, excitation)
     if rule == "exact":
