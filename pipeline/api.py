@@ -197,16 +197,17 @@ class DesignRun:
     @property
     def design(self):
         """``design.csv`` as a DataFrame (columns in the file's order)."""
-        from .reports.design_table import DESIGN_FIELDS
+        from .reports.design_table import design_fields
 
-        return _frame(self.design_rows, DESIGN_FIELDS)
+        return _frame(self.design_rows, design_fields(self.summary_rows))
 
     @property
     def summary(self):
         """``summary.csv`` as a DataFrame."""
         from .batch.record import FIELDS
 
-        return _frame(self.summary_rows, FIELDS)
+        # the columns of the run's options (a level's margin, a restitution), as summary.csv's
+        return _frame(self.summary_rows, list(self.summary_rows[0]) if self.summary_rows else FIELDS)
 
     @property
     def failures(self):
@@ -250,7 +251,7 @@ def _frame(rows, columns):
 
 
 def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 0, vertical: str = "auto",
-           limit=None, jobs: int = 1, out=None, shapes=None, weighting: str = "background", units=None,
+           limit=0.5, restitution=None, jobs: int = 1, out=None, shapes=None, weighting: str = "background", units=None,
            dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True, **more) -> DesignRun:
     """Design columns for a batch of records, as ``pipeline run`` does, and return the tables.
 
@@ -272,9 +273,16 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         Evenly spaced directions added for a pair (``--directions``).
     vertical : {"auto", "none"}
         Use a pair's known vertical component (``--vertical``).
-    limit : float, optional
-        A performance level R, ``0 < R <= 1`` (``--limit``): design widths for max|theta|/alpha
-        <= R instead of for not overturning.
+    limit : float or None
+        The performance level R, ``0 < R <= 1`` (``--limit``) of the design width, the width the
+        run quotes first: max|theta|/alpha <= R, at least the overturning design width; default
+        0.5, the paper's dependable design (peaks at or below alpha/2).  The overturning design
+        width, the verge (no margin), is reported beside it (``overturning_width_m``).  None (or
+        ``"none"``): the verge alone, as the design width.
+    restitution : str, float or rocking.restitution.Restitution, optional
+        The restitution at impact every block of the run is made with (``--restitution``): a
+        factor of Eq. 5 (``0.97``), ``"eta=0.9"`` (the velocity ratio), ``"r=0.81"`` (the energy
+        ratio), or a band ``"0.95:1.05"`` whose design covers it; default Eq. 5.
     jobs : int
         Worker processes (0: one per CPU); the tables do not depend on it.
     out : path, optional
@@ -325,7 +333,7 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     TypeError: blocks: expected a rocking.Block, a 'HxW' string in m (e.g. '7.5x1.8') or a (height, width) pair of numbers in m; got float 7.5
     """
     plan = _plan(records, blocks=blocks, heights=heights, pairs=pairs, directions=directions,
-                 vertical=vertical, limit=limit, jobs=jobs, out=out, shapes=shapes, weighting=weighting,
+                 vertical=vertical, limit=limit, restitution=restitution, jobs=jobs, out=out, shapes=shapes, weighting=weighting,
                  units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet, **more)
     return run_plan(plan)
 
@@ -334,7 +342,7 @@ _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_sc
          "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None}
 
 
-def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
+def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, restitution, jobs, out, shapes, weighting,
           units, dt, scale, plots, force, quiet, **more) -> Plan:
     """Every argument of :func:`design` checked and in the forms the runner takes."""
     from .args import parse_units
@@ -359,16 +367,37 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
               vertical=_choice(vertical, "vertical", ("auto", "none")),
               cap_mass_ratio=_number_option(more["cap_mass_ratio"], "cap_mass_ratio"),
               fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"), **opts)
-    if limit is not None:
-        kw["limit"] = _number_option(limit, "limit")
-        if not 0.0 < kw["limit"] <= 1.0:
-            raise ValueError(f"limit (max|theta|/alpha) must lie in (0, 1], got {limit!r}")
+    kw["limit"] = _limit(limit)
+    kw["restitution"] = _restitution(restitution)
     return Plan(
         records=_records(records), columns=columns_from(blocks, heights), options=Options(**kw),
         record_opts=opts, pairs=mode, pair=explicit, triplets=triplets, directions=str(directions),
         scale=None if scale is None else repr(_number_option(scale, "scale")), scales=more["scales"],
         peer_scales=bool(more["peer_scales"]), jobs=_jobs(jobs), out=out, force=bool(force),
         quiet=bool(quiet), dask=more["dask"], log=more["log"], glob=more["glob"])
+
+
+def _limit(limit):
+    """``limit=``: None or "none" (the verge alone), else a number in (0, 1]."""
+    if limit is None or (isinstance(limit, str) and limit.strip().lower() == "none"):
+        return None
+    value = _number_option(limit, "limit")
+    if not 0.0 < value <= 1.0:
+        raise ValueError(f"limit (max|theta|/alpha) must lie in (0, 1], or be None, got {limit!r}")
+    return value
+
+
+def _restitution(restitution):
+    """``restitution=``: None (Eq. 5), or a :class:`rocking.restitution.Restitution` from one, a
+    number (a factor of Eq. 5) or the text ``--restitution`` takes."""
+    from rocking.restitution import Restitution
+
+    if restitution is None:
+        return None
+    if isinstance(restitution, bool) or not isinstance(restitution, (str, int, float, Restitution)):
+        raise TypeError("restitution: expected a factor of Eq. 5, 'eta=V', 'r=V', 'LOW:HIGH' or a "
+                        f"rocking.restitution.Restitution; got {type(restitution).__name__}")
+    return Restitution.parse(restitution)
 
 
 @dataclass

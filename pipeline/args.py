@@ -291,6 +291,49 @@ def output_folder(path, what: str = "--out") -> pathlib.Path:
     return out
 
 
+def parse_limit(text, what: str = "--limit"):
+    """A performance level: ``none`` (the verge of overturning alone) -> None, else a number R in
+    (0, 1] (max|theta|/alpha <= R)."""
+    if text is None:
+        return None
+    if str(text).strip().lower() == "none":
+        return None
+    try:
+        value = float(str(text).strip())
+    except ValueError:
+        raise ArgumentError(f"{what}: expected a number in (0, 1] (max|theta|/alpha) or none, "
+                            f"got {text!r}") from None
+    if not (math.isfinite(value) and 0.0 < value <= 1.0):
+        raise ArgumentError(f"{what} (max|theta|/alpha) must lie in (0, 1], or be none, got {text!r}")
+    return value
+
+
+def parse_restitution(text, what: str = "--restitution"):
+    """A :class:`rocking.restitution.Restitution` from ``0.97``, ``0.95:1.05`` (factors of Eq. 5),
+    ``eta=0.9`` (the velocity ratio) or ``r=0.81`` (the energy ratio); None when not given."""
+    if text is None:
+        return None
+    from rocking.restitution import Restitution
+
+    try:
+        return Restitution.parse(text)
+    except ValueError as exc:
+        raise ArgumentError(f"{what}: {exc}") from None
+
+
+#: what ``--restitution`` says in every command's help
+RESTITUTION_HELP = ("the restitution at impact: a factor of Eq. 5 (0.97: 0.97 times Housner's eta at "
+                    "each width; tests find 0.67 on rubber, 0.95-0.97 on concrete), eta=V (the "
+                    "velocity ratio, the same at every width) or r=V (the energy ratio, eta squared); "
+                    "LOW:HIGH a band, whose answer covers it (every one of 5 values, ends included, "
+                    "run; the most demanding governs). Default: Eq. 5")
+
+
+def add_restitution_option(parser) -> None:
+    """``--restitution``: read back with :func:`parse_restitution`."""
+    parser.add_argument("--restitution", metavar="SPEC", default=None, help=RESTITUTION_HELP)
+
+
 def add_weighting_option(p) -> None:
     """``--weighting``: the least squares of the pulse fit (:func:`pulses.fit_pulse`'s ``weighting``)."""
     p.add_argument("--weighting", choices=("background", "plain"), default="background",

@@ -15,7 +15,7 @@ import time
 
 from pulses.shapes import AntisymmetricRicker
 
-from . import memo, peer_inputs, site, vertical
+from . import margin, memo, peer_inputs, site, vertical
 from ..reports.design_table import check_bin_words, check_reach_words
 from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
@@ -32,12 +32,6 @@ def _g(x):
     from pulses import G
 
     return None if x is None else float(x) / G
-
-
-def _sim(block, record, history):
-    import rocking
-
-    return rocking.simulate(block, record, history=history)
 
 
 def process_record(task: Task) -> dict:
@@ -442,14 +436,28 @@ def _check_fields(ver) -> dict:
     })
 
 
-#: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
-COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
-           + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
-           + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
-           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + DESIGN_WIDTH_COLUMNS.columns
-           + CHECK_COLUMNS.columns
-           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns + vertical.VERTICAL_COLUMNS.columns)
+_TO_DESIGN_WIDTH = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
+                    + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
+                    + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
+                    + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + DESIGN_WIDTH_COLUMNS.columns)
+_FROM_CHECK = (CHECK_COLUMNS.columns + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns
+               + vertical.VERTICAL_COLUMNS.columns)
+#: the columns every run's per-record reports and ``summary.csv`` have, in order: (name, unit,
+#: meaning); :func:`columns_for` adds those of a run's options
+COLUMNS = _TO_DESIGN_WIDTH + _FROM_CHECK
 FIELDS = [name for name, _, _ in COLUMNS]
+
+
+def columns_for(options) -> tuple:
+    """The columns of the reports of a run with ``options``: :data:`COLUMNS` with, after the design
+    width's, the margin's under a level and the restitution's with ``--restitution``
+    (:func:`pipeline.batch.margin.extra_columns`)."""
+    return _TO_DESIGN_WIDTH + margin.extra_columns(options) + _FROM_CHECK
+
+
+def fields_for(options) -> list:
+    """The names of :func:`columns_for`."""
+    return [name for name, _, _ in columns_for(options)]
 
 
 def _process(task: Task):
@@ -482,13 +490,15 @@ def _process(task: Task):
     gamma = opts.cap_mass_ratio
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma)
               for col in task.columns if col.width is not None}
-    exact = _stage("design", _exact_by_shape, fitting, list(blocks.values()), gamma)
+    exact = _stage("design", _exact_by_shape, fitting, list(blocks.values()), gamma, opts.restitution)
     extra_cache = {}
 
     rows = []
     histories = []
     design_cache = {}
+    margin_cache = {}
     eq31_cache = {}
+    fields = fields_for(opts)
     for col in task.columns:
         H = col.height
         block = blocks.get(col)
@@ -509,25 +519,25 @@ def _process(task: Task):
 
         designed = _stage("design", design)
         res = None
-        if block is not None:
-            res = _stage("verify", _sim, block, record, draw)
+        if block is not None:   # (with a restitution band: its most demanding value, margin.simulate)
+            block_s, res = _stage("verify", margin.simulate, H, col.width, record, opts, draw)
             if draw:
-                curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
+                curves.append((f"as it stands, {col.width:.3g} m wide", block_s, res))
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
-        block31 = rocking.Block.from_dimensions(H, w31, cap_mass_ratio=gamma)
-        res31 = _stage("verify", _sim, block31, record, draw)
+        block31, res31 = _stage("verify", margin.simulate, H, w31, record, opts, draw)
         if draw:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
 
         # -- design width: smallest width surviving the full record (islands respected), above
-        #    every width found to fail, with the vertical where there is one ----------------------
+        #    every width found to fail, with the vertical where there is one; under a level, the
+        #    verge beside it (its overturning design) ----------------------------------------------
         if H not in design_cache:
-            design_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col])
-        if draw:  # the column at its design width, for the figure
-            wv = float(design_cache[H].width)
-            block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma)
-            curves.append((f"design width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
+            design_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col],
+                                           opts.restitution)
+        if draw or (opts.limit is not None and H not in margin_cache):
+            curves += _stage("verify", _design_curves, H, design_cache[H], record, up, opts, margin_cache, draw)
+        if draw:
             histories.append((col.label, curves))
 
         row = dict(base)
@@ -536,27 +546,54 @@ def _process(task: Task):
         row.update(_as_stands_fields(block, designed, res))
         row.update(_eq31_design_fields(H, w31, res31))
         row.update(_design_width_fields(col, design_cache[H]))
+        row.update(margin_cache.get(H, margin.MARGIN_COLUMNS.blank()))
+        if opts.restitution is not None:
+            row.update(margin.restitution_fields(H, design_cache[H], opts))
         row.update(_check_fields(design_cache[H]))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, design_cache[H]))
-        rows.append(row)
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, design_cache[H], opts))
+        rows.append({k: row[k] for k in fields})
 
     return rows, (record, fit, fitting, histories, velocity), design_cache
 
 
-def design_width(record, up, height, cap_mass_ratio, limit, settings):
+def _design_curves(H, designed, record, up, opts, margin_cache, draw) -> list:
+    """The figure's curves of the design width (and under a level, of the verge beside it), and
+    under a level the row's :data:`pipeline.batch.margin.MARGIN_COLUMNS` into ``margin_cache``
+    (by height): max|theta|/alpha at both widths, each in a run of its own."""
+    wv = float(designed.width)
+    curves = []
+    ratio = None
+    if wv > 0 and (draw or up is None):
+        block_v, res_v = margin.simulate(H, wv, record, opts, draw)
+        curves.append((f"design width, {wv:.3g} m", block_v, res_v))
+        ratio = float(res_v.max_rotation_ratio)
+    if opts.limit is None:
+        return curves if draw else []
+    if H not in margin_cache:
+        margin_cache[H] = margin.margin_fields(H, designed, record, up, opts, ratio)
+    verge = designed.overturning_width
+    if draw and verge is not None and verge > 0:
+        curves.append((f"verge (no margin), {verge:.3g} m",) + margin.simulate(H, float(verge), record, opts, True))
+    return curves if draw else []
+
+
+def design_width(record, up, height, cap_mass_ratio, limit, settings, restitution=None):
     """The design width of a column ``height`` (m) tall under ``record`` (with its vertical ``up``
     where there is one, :func:`pipeline.batch.vertical.design`).  With a level ``limit``: the
     level's design first, then the overturning design where it can change it (a width that
     overturns fails every level; ``rocking.required_width(..., overturning=True)``: its search, its
     check above the level's width), the level with each motion at least that motion's
-    overturning width; ``.overturning_width`` is that design's width."""
+    overturning width; ``.overturning_width`` is that design's width.  ``restitution``: a
+    :class:`rocking.restitution.Restitution` (a band: the design covering it, each value designed
+    so) or None (Eq. 5)."""
     import rocking
 
-    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings)
+    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings, eta=restitution)
     over = None if limit is None else True
     alone = _stage("verify", rocking.required_width, height, record, limit=limit, overturning=over, **kw)
-    return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over)
+    return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over,
+                  restitution)
 
 
 def _check_settings(task: Task) -> dict:
@@ -583,7 +620,7 @@ def _classify(record):
 EXACT_KSECTION = 4
 
 
-def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
+def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0, restitution=None) -> dict:
     """Exact minimum tan(alpha) of every fitting pulse for every block: ``{(shape, block): tan}``.
 
     One ``rocking.min_slenderness_batch`` call per shape covers all the blocks (the similarity law:
@@ -592,7 +629,7 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
     step (three runs a solver call: a pulse run is short, and a call's own cost, not the runs,
     decides; measured, 10 % less CPU than bisection on the pulses fitted to a real pair's
     directions, 40 % at pTp 2-4, answers within 1e-9 relative of it; the safe islands below it
-    are not reported here).
+    are not reported here).  ``restitution``: as the run's (a band: the answer covering it).
     """
     import rocking
     from pulses import G
@@ -603,9 +640,11 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0) -> dict:
     for c in fitting:
         p_tp = [b.p * c.tp for b in blocks]
         key = (c.shape, tuple(p_tp), abs(c.ap) / G, cap_mass_ratio)  # its every input
+        if restitution is not None:
+            key += (str(restitution),)
         res = memo.remembered("slenderness", key, lambda: rocking.min_slenderness_batch(
             c.shape, p_tp, [abs(c.ap) / G] * len(blocks), refine="top", ksection=EXACT_KSECTION,
-            cap_mass_ratio=cap_mass_ratio))
+            cap_mass_ratio=cap_mass_ratio, eta=restitution))
         for b, r in zip(blocks, res):
             out[(c.shape, b)] = float(r.tan_alpha)
     return out

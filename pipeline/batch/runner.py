@@ -19,7 +19,7 @@ from .. import interrupts
 
 from . import joblog, outlock, passes, resume, site
 from ..args import ArgumentError, output_folder
-from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
+from .record import FAILURE_COLUMNS, FAILURE_FIELDS, columns_for, failure, fields_for
 from . import executors
 from .executors import _serial, execute
 from .worker import TEST_KILL_ENV, TEXT  # noqa: F401 (tests set TEST_KILL_ENV through the runner)
@@ -86,7 +86,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
     problems = []
     try:
         if res["rows"]:
-            outputs.write(report.record_csv_name(rid), res.get(TEXT) or report.csv_text(FIELDS, res["rows"]))
+            outputs.write(report.record_csv_name(rid), res.get(TEXT) or report.csv_text(fields_for(task.options), res["rows"]))
         else:  # a report from an earlier run would look like this record's
             outputs.remove(report.record_csv_name(rid))
     except OSError as exc:
@@ -192,7 +192,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         else:
             print(msg, file=sys.stderr)
 
-    header = report.csv_text(FIELDS, [])
+    header = report.csv_text(fields_for(options), [])
     stream = _serial([])
 
     more = _passes(plan, tasks, journal, keys, texts, options, outputs, force, bar)
@@ -260,7 +260,7 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
     task = tasks[i]
     figure = res.get("plot")
     _write_record(outputs, task, res, options.plots and task.plot, say)
-    texts[i] = (res.get(TEXT) or report.csv_text(FIELDS, res["rows"]))[len(header):]  # made by the worker
+    texts[i] = (res.get(TEXT) or report.csv_text(fields_for(task.options), res["rows"]))[len(header):]  # made by the worker
     failures[i] = res["failure"]
     plan.note(task, res["rows"])
     if res["failure"] or not res["rows"] or keys[i] is None:
@@ -308,7 +308,7 @@ def _reusable(tasks, journal, force: bool, options, plan, held=()):
         v, keys[t.index], texts[t.index] = _reuse(t, journal, force, options, version)
         if texts[t.index]:
             tasks[t.index] = v
-            plan.note(v, resume.rows_from_text(texts[t.index]))
+            plan.note(v, resume.rows_from_text(texts[t.index], fields_for(options)))
         else:
             journal.drop(t.record_id)
             todo.append(t)
@@ -349,7 +349,7 @@ def _later_pass(plan, tasks, journal, keys, texts, options, outputs, force):
             else:
                 tasks[t.index] = t
                 texts[t.index] = kept
-                plan.note(t, resume.rows_from_text(kept))
+                plan.note(t, resume.rows_from_text(kept, fields_for(options)))
                 found = True
         if todo or not found:
             plan.sent(todo)
@@ -377,11 +377,12 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     reports hold them, below ``header``); return the design rows and the rows of summary.csv."""
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
-    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
-                  + site.columns_markdown() + design_table.columns_markdown())
+    outputs.write(report.COLUMNS_MD, report.columns_markdown(columns_for(options), FAILURE_COLUMNS.columns)
+                  + site.columns_markdown() + design_table.columns_markdown(options.limit is not None,
+                                                                           options.restitution is not None))
     # the rows as the reports hold them, so that a resumed run writes the same files
-    rows = resume.rows_from_text(text)
-    site.write_outputs(outputs, rows, FIELDS, options, failed, render)
+    rows = resume.rows_from_text(text, fields_for(options))
+    site.write_outputs(outputs, rows, fields_for(options), options, failed, render)
     if options.plots:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
     design = write_answer(outputs, out, tasks, rows, failures, failed, options)
@@ -393,7 +394,7 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
 def write_answer(outputs, out, tasks, rows, failures, failed, options) -> list[dict]:
     """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run)."""
     design = design_table.design_rows(rows, failed)
-    outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.DESIGN_FIELDS, design))
+    outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.design_fields(rows), design))
     ids = [t.record_id for t in tasks]
     this_run = set(outfiles.fixed_files(options))  # a figure of an earlier run with other options is not shown
     names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", report.SUITE_PLOT),

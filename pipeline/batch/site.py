@@ -126,12 +126,14 @@ def extra_fields(H, block, record, fitting, options, cache) -> dict:
     """The envelope design and (``--fragility``) the critical scale of one row."""
     import rocking
 
+    from . import margin
+
     g = options.cap_mass_ratio
     if ("envelope", H) not in cache:
         widths = [float(rocking.required_width(H, c.pulse, rule="envelope", shape=c.shape,
                                                cap_mass_ratio=g).width) for c in fitting]
         w = max(widths)
-        res = rocking.simulate(rocking.Block.from_dimensions(H, w, cap_mass_ratio=g), record)
+        res = margin.simulate(H, w, record, options)[1]
         cache[("envelope", H)] = ENVELOPE_COLUMNS.row({"envelope_width_m": w,
                                                        "envelope_width_overturns": bool(res.overturned)})
     fields = dict(cache[("envelope", H)])
@@ -140,7 +142,10 @@ def extra_fields(H, block, record, fitting, options, cache) -> dict:
         return fields
     from pulses import G
 
-    cs = rocking.critical_scale(block, record, up_to=options.up_to, limit=options.limit)
+    # with a restitution band, the weakest of its values (the smallest critical scale)
+    scales = [rocking.critical_scale(b, record, up_to=options.up_to, limit=options.limit)
+              for b in margin.blocks(H, block.width, options)]
+    cs = min(scales, key=lambda s: math.inf if s.scale is None else s.scale)
     fields.update(FRAGILITY_COLUMNS.row({
         "critical_scale": cs.scale,
         "critical_pga_g": None if cs.critical_pga is None else cs.critical_pga / G,
@@ -176,13 +181,6 @@ def add_options(parser) -> None:
                              "scale factor per record and direction, the suite's lognormal curve")
     parser.add_argument("--up-to", metavar="K", default="10",
                         help="--fragility: largest scale factor examined (default 10)")
-    parser.add_argument("--limit", metavar="R", default=None,
-                        help="performance level: design widths for max|theta|/alpha <= R and "
-                             "critical scales at which it first exceeds R, 0 < R <= 1 (default: "
-                             "overturning). Each column's design width is at least its "
-                             "overturning design width, computed where it can change the level's "
-                             "(overturning_width_m): a width that overturns fails every level "
-                             "(about as many solver runs as an overturning design; docs/design.md)")
 
 
 def _number(text, what, lo, hi) -> float:
@@ -196,15 +194,11 @@ def _number(text, what, lo, hi) -> float:
 
 
 def options_from_args(args) -> dict:
-    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.record.Options`."""
+    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.record.Options`
+    (``--limit`` and ``--restitution``: :func:`pipeline.commands.run.options_from`)."""
     gamma = _number(args.cap_mass_ratio, "--cap-mass-ratio", 0.0, 1e3)
     up_to = parse_scale(args.up_to, "--up-to", low=1.0 + 1e-9)
-    limit = getattr(args, "limit", None)
-    if limit is not None:
-        limit = _number(limit, "--limit (max|theta|/alpha)", 0.0, 1.0)
-        if limit <= 0.0:
-            raise SiteError(f"--limit (max|theta|/alpha) must lie in (0, 1], got {args.limit!r}")
-    return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to, "limit": limit}
+    return {"cap_mass_ratio": gamma, "fragility": bool(args.fragility), "up_to": up_to}
 
 
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------

@@ -4,8 +4,9 @@ from __future__ import annotations
 import argparse
 
 from ..batch import peer_inputs, site, vertical
-from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, jobs_count, parse_block,
-                   parse_length, parse_shapes, record_options)
+from ..args import (ArgumentError, ShapeNames, add_record_options, add_restitution_option, add_weighting_option,
+                   jobs_count, parse_block, parse_length, parse_limit, parse_restitution, parse_shapes,
+                   record_options)
 
 DEFAULT_OUT = "pipeline-output"
 
@@ -34,6 +35,15 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
                         help="write no figures")
     parser.add_argument("--quiet", "-q", action="store_true",
                         help="no progress bar and no messages (the exit status tells)")
+    parser.add_argument("--limit", metavar="R", default=None,
+                        help="performance level of the design width, the width quoted first: "
+                             "max|theta|/alpha <= R, 0 < R <= 1 (default 0.5, the paper's "
+                             "dependable design: peaks at or below alpha/2), at least the "
+                             "overturning design width; that width, the verge (no margin), is "
+                             "reported beside it (overturning_width_m). `none`: the verge alone, "
+                             "as the design width. With --fragility, critical scales at which "
+                             "max|theta|/alpha first exceeds R (docs/design.md)")
+    add_restitution_option(parser)
 
 
 def add_parser(subparsers) -> None:
@@ -109,10 +119,13 @@ def build_columns(blocks, heights):
 
 
 def options_from(args, **overrides):
+    from ..batch.margin import DEFAULT_LIMIT
     from ..batch.tasks import Options
 
+    limit = DEFAULT_LIMIT if args.limit is None else parse_limit(args.limit)
     kw = dict(plots=args.plots != "none", plots_all=args.plots == "all",
-              thorough=bool(getattr(args, "thorough", False)))
+              thorough=bool(getattr(args, "thorough", False)), limit=limit,
+              restitution=parse_restitution(args.restitution))
     kw.update(overrides)
     return Options(**kw)
 
