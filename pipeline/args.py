@@ -318,7 +318,7 @@ def parse_restitution(text, what: str = "--restitution"):
     try:
         return Restitution.parse(text)
     except ValueError as exc:
-        raise ArgumentError(f"{what}: {exc}") from None
+        raise ArgumentError(f"{what}: {str(exc).removeprefix('restitution: ')}") from None
 
 
 #: what ``--restitution`` says in every command's help
