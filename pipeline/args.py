@@ -331,7 +331,7 @@ RESTITUTION_HELP = ("the restitution at impact: a factor of Eq. 5 (0.97: 0.97 ti
 
 def add_restitution_option(parser) -> None:
     """``--restitution``: read back with :func:`parse_restitution`."""
-    parser.add_argument("--restitution", metavar="SPEC", default=None, help=RESTITUTION_HELP)
+    parser.add_argument("--restitution", metavar="VALUE", default=None, help=RESTITUTION_HELP)
 
 
 def add_weighting_option(p) -> None:

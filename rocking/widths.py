@@ -164,8 +164,9 @@ class RequiredWidth:
 
     @property
     def block(self) -> Block:
-        return Block.from_dimensions(self.height, self.width, self.eta,
-                                     cap_mass_ratio=self.cap_mass_ratio)
+        """The column at the design width (under a restitution band, with the value that governed)."""
+        eta = self.restitution_governing if self.restitution_values else self.eta
+        return Block.from_dimensions(self.height, self.width, eta, cap_mass_ratio=self.cap_mass_ratio)
 
     @property
     def p(self) -> float:
@@ -257,12 +258,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         kw = dict(rule=rule, criterion=criterion, shape=shape, lam=lam, n_scan=n_scan,
                   n_zone=n_zone, rtol=rtol, model=model, settings=settings,
                   cap_mass_ratio=cap_mass_ratio, vertical=vertical, limit=limit)
-        index = {v: k for k, v in enumerate(band.singles(eta, band_values))}
-        return band.band_width(lambda v: required_width(
-            height, excitation, eta=v, horizontal=None if horizontal is None else band.band_of(horizontal, index[v]),
-            overturning=(overturning if overturning is None or overturning is True
-                         else band.band_of(overturning, index[v])),
-            **kw), eta, band_values)
+        return _band_width(height, excitation, eta, band_values, horizontal, overturning, kw)
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
     height = _check_arguments(height, rule, overturning, limit, vertical, excitation)
     if rule == "exact":
@@ -278,6 +274,11 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     if not hasattr(excitation, "tp") or not hasattr(excitation, "ap"):
         raise ValueError(f"rule={rule!r} needs a pulse (ap, Tp); for a whole record fit its pulse "
                          "first or use rule='exact'")
+    return _closed_form(height, excitation, rule, shape, lam, gamma, eta)
+
+
+def _closed_form(height, excitation, rule, shape, lam, gamma, eta):
+    """A closed-form rule's width (:func:`required_width`): the fixed point in the width."""
     ap, tp = abs(excitation.ap), excitation.tp
     if rule == "eq31":
         f = lambda p: eq31(ap, tp, p)
@@ -304,6 +305,22 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     return RequiredWidth(width=float(width), height=height, rule=rule, iterations=it,
                          method=f"fixed point of {rule} in B (p depends on B): "
                                 f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
+
+
+def _band_width(height, excitation, eta, band_values, horizontal, overturning, kw):
+    """:func:`required_width` under the restitution band ``eta`` (:func:`rocking.band.band_width`):
+    each value designed with its own horizontal answer and overturning design where given (those
+    of the band designs ``horizontal`` and ``overturning``)."""
+    from . import band
+
+    index = {v: k for k, v in enumerate(band.singles(eta, band_values))}
+
+    def one(v):
+        over = overturning if overturning is None or overturning is True else band.band_of(overturning, index[v])
+        hor = None if horizontal is None else band.band_of(horizontal, index[v])
+        return required_width(height, excitation, eta=v, horizontal=hor, overturning=over, **kw)
+
+    return band.band_width(one, eta, band_values)
 
 
 def _check_arguments(height, rule, overturning, limit, vertical, excitation) -> float:

@@ -22,8 +22,9 @@ ROUNDS = DEFAULT_SETTINGS.replace(check_layout="rounds")
 #: what the check decides besides its own columns: the direction's design width (the search's
 #: width where it found no failing width above it)
 DESIGN = CHECK + ["design_width_m", "design_tan_alpha", "design_adequate"]
-#: and with ``--limit``, the overturning design's width (its check runs where the level's does)
-LEVEL_DESIGN = DESIGN + ["overturning_width_m"]
+#: and under a level (the default), the overturning design's width (its check runs where the
+#: level's does) and max|theta|/alpha at both widths (the margin's columns)
+LEVEL_DESIGN = DESIGN + ["overturning_width_m", "design_max_theta_ratio", "overturning_max_theta_ratio"]
 
 
 def _rows(out):

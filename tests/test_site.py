@@ -245,8 +245,10 @@ def test_frame_reports(pairs, tmp_path):
     assert _run(out, a1, "--height", H, "--cap-mass-ratio", "2") == 0
     (r,) = _read(out / "summary.csv")
     assert r["cap_mass_ratio"] == "2"
-    ref = rocking.required_width(H, pulses.read_record(a1), rule="exact", cap_mass_ratio=2.0).width
-    lone = rocking.required_width(H, pulses.read_record(a1), rule="exact").width
+    # the run's headline: the level 0.5 with its overturning design (pipeline run's default)
+    level = dict(rule="exact", limit=0.5, overturning=True)
+    ref = rocking.required_width(H, pulses.read_record(a1), cap_mass_ratio=2.0, **level).width
+    lone = rocking.required_width(H, pulses.read_record(a1), **level).width
     assert _f(r["design_width_m"]) == pytest.approx(ref, rel=1e-5)
     assert abs(ref - lone) > 1e-3 * lone  # the frame is not the lone column here
     assert _run(tmp_path / "bad", a1, "--height", H, "--cap-mass-ratio", "-1") == 2

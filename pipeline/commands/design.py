@@ -54,6 +54,17 @@ def _limit(args):
     return value
 
 
+def _print_restitution(eta, rules) -> None:
+    """The line that says which restitution the exact rules used (none for Eq. 5)."""
+    if eta is None:
+        return
+    print(f"Restitution: {eta.describe()} (eta the velocity ratio at impact, r = eta^2 the energy "
+          "ratio); the exact rules use it, Eq. 31, Eq. 20 and the envelope do not depend on it"
+          + (f"; a band: {rules['exact']['restitution_values_run']} values run, "
+             f"{rules['exact']['restitution_governing']} governed the exact width"
+             if "restitution_values_run" in rules["exact"] else ""))
+
+
 def _eta_of(height, width, eta):
     """The block's velocity ratio at impact (a number), or ``"LOW-HIGH"`` over a band's ends."""
     import rocking
@@ -69,11 +80,20 @@ def _eta_text(eta) -> str:
     return eta if isinstance(eta, str) else f"{eta:.3f}"
 
 
-def _p_at(height, width):
-    """``p`` (rad/s) of a column ``height`` x ``width`` (m): a band design has no single block."""
+def _required_widths(rules, height, pulse, lam, criterion, eta) -> None:
+    """Each rule's required width for the column's height into ``rules`` (the exact rule with the
+    restitution ``eta``; a band: how many values ran, which governed)."""
     import rocking
 
-    return rocking.Block.from_dimensions(height, width).p if width > 0 else None
+    for name in ("eq31", "eq20", "envelope", "exact"):
+        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=criterion,
+                                   shape=pulse.shape, eta=eta if name == "exact" else None)
+        rules.setdefault(name, {})
+        rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
+                            "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
+        if w.restitution_values:
+            rules[name].update(restitution_values_run=len(w.restitution_values),
+                               restitution_governing=str(w.restitution_governing))
 
 
 def _pulse(args):
@@ -137,21 +157,12 @@ def run(args) -> int:
         out["exact_safe_islands"] = [list(s) for s in exact.safe_islands]
         for name, value in values.items():
             rules[name] = {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
-    for name in ("eq31", "eq20", "envelope", "exact"):
-        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=args.criterion,
-                                   shape=pulse.shape, eta=eta if name == "exact" else None)
-        rules.setdefault(name, {})
-        rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
-                            "p_at_width": _p_at(height, w.width), "iterations": w.iterations,
-                            "method": w.method})
-        if w.restitution_values:
-            rules[name].update(restitution_values_run=len(w.restitution_values),
-                               restitution_governing=str(w.restitution_governing))
+    _required_widths(rules, height, pulse, lam, args.criterion, eta)
     names = ["eq31", "eq20", "envelope", "exact"]
     if limit is not None:
         w = rocking.required_width(height, pulse, rule="exact", limit=limit, eta=eta)
         rules["level"] = {"limit": limit, "required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
-                          "p_at_width": _p_at(height, w.width), "iterations": w.iterations, "method": w.method}
+                          "p_at_width": w.p, "iterations": w.iterations, "method": w.method}
         if block is not None:
             rules["level"].update(min_tan_alpha=w.tan_alpha, adequate=bool(width >= w.width))
         names.append("level")
@@ -167,12 +178,7 @@ def run(args) -> int:
         print(f"Block: {height:g} x {width:g} m, p = {b['p_rad_s']:.4g} rad/s, tan(alpha) = "
               f"{b['tan_alpha']:.4g} (alpha = {b['alpha_deg']:.3g} deg), eta = {_eta_text(b['eta'])}, "
               f"pTp = {b['pTp']:.4g}")
-    if eta is not None:
-        print(f"Restitution: {eta.describe()} (eta the velocity ratio at impact, r = eta^2 the energy "
-              "ratio); the exact rules use it, Eq. 31, Eq. 20 and the envelope do not depend on it"
-              + (f"; a band: {rules['exact']['restitution_values_run']} values run, "
-                 f"{rules['exact']['restitution_governing']} governed the exact width"
-                 if "restitution_values_run" in rules["exact"] else ""))
+    _print_restitution(eta, rules)
     labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})",
               "envelope": f"envelope ({pulse.shape})",
               "exact": f"exact ({args.criterion})",
