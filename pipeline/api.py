@@ -305,7 +305,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``.
+        ``glob``; and ``fragility_limit``, the level R of ``fragility``'s critical scales (None,
+        the default: collapse; ``pipeline run --fragility --limit R`` sets both to R).
 
     Returns
     -------
@@ -339,7 +340,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
 
 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
-         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None}
+         "cap_mass_ratio": 0.0, "fragility": False, "fragility_limit": None, "up_to": 10.0, "dask": None,
+         "log": None, "glob": None}
 
 
 def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, restitution, jobs, out, shapes, weighting,
@@ -366,7 +368,8 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, resti
               weighting=_choice(weighting, "weighting", ("background", "plain")),
               vertical=_choice(vertical, "vertical", ("auto", "none")),
               cap_mass_ratio=_number_option(more["cap_mass_ratio"], "cap_mass_ratio"),
-              fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"), **opts)
+              fragility=bool(more["fragility"]), up_to=_number_option(more["up_to"], "up_to"),
+              fragility_limit=_limit(more["fragility_limit"]), **opts)
     kw["limit"] = _limit(limit)
     kw["restitution"] = _restitution(restitution)
     return Plan(

@@ -178,7 +178,7 @@ def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
                 for k, s in enumerate((1.2, 1.8, 2.5, None))]
 
     (over,), _, _ = fragility_tables(rows(None))
-    (level,), _, _ = fragility_tables(rows(0.5))
+    (level,), _, _ = fragility_tables(rows(0.5), limit=0.5)
     assert over["n_overturned"] == 3 and over["n_failed_at_level"] is None
     assert level["n_overturned"] is None and level["n_failed_at_level"] == 3
     assert over["n_records"] == level["n_records"] == 4

@@ -252,3 +252,19 @@ def test_the_printed_cells_of_the_margin():
     assert "passes its slenderness angle on 1 of 1 row(s)" in text
     calm, = design_rows([dict(row, overturning_max_theta_ratio=0.97, max_theta_ratio=0.7)])
     assert "passes alpha" not in table_text([calm]).splitlines()[2]
+
+
+def test_the_fragility_stays_collapse_unless_a_level_is_named(tmp_path):
+    """The margin is the design width's: ``--fragility`` without ``--limit`` is the collapse
+    fragility as before (critical scales of overturning); ``--limit R`` named asks for R's."""
+    with bundled_records() as paths:
+        path = paths[3]
+        for name, extra in (("collapse", []), ("level", ["--limit", "0.5"])):
+            assert main(["run", path, "--block", "7.5x1.8", "--shapes", "sine", "--no-plots", "--quiet",
+                         "--fragility", "--up-to", "3", "--out", str(tmp_path / name), *extra]) == 0
+    rec, block = pulses.read_record(path), rocking.Block.from_dimensions(7.5, 1.8)
+    for name, limit in (("collapse", None), ("level", 0.5)):
+        (row,) = _rows(tmp_path / name / "summary.csv")
+        assert row["design_limit"] == "0.5"           # the design width is the level's either way
+        want = rocking.critical_scale(block, rec, up_to=3.0, limit=limit).scale
+        assert float(row["critical_scale"]) == pytest.approx(want, rel=REPORT_RTOL), name

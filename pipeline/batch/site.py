@@ -143,7 +143,7 @@ def extra_fields(H, block, record, fitting, options, cache) -> dict:
     from pulses import G
 
     # with a restitution band, the weakest of its values (the smallest critical scale)
-    scales = [rocking.critical_scale(b, record, up_to=options.up_to, limit=options.limit)
+    scales = [rocking.critical_scale(b, record, up_to=options.up_to, limit=options.fragility_limit)
               for b in margin.blocks(H, block.width, options)]
     cs = min(scales, key=lambda s: math.inf if s.scale is None else s.scale)
     fields.update(FRAGILITY_COLUMNS.row({
@@ -178,7 +178,8 @@ def add_options(parser) -> None:
                              "lone columns)")
     parser.add_argument("--fragility", action=argparse.BooleanOptionalAction, default=False,
                         help="collapse fragility of each --block column as it stands: the critical "
-                             "scale factor per record and direction, the suite's lognormal curve")
+                             "scale factor per record and direction, the suite's lognormal curve "
+                             "(with --limit R given, the fragility of exceeding max|theta|/alpha = R)")
     parser.add_argument("--up-to", metavar="K", default="10",
                         help="--fragility: largest scale factor examined (default 10)")
 
@@ -339,9 +340,10 @@ FRAGILITY_CURVE_COLUMNS = Columns(
 CURVE_POINTS = 60
 
 
-def _critical(group):
+def _critical(group, limit=None):
     """The weakest direction of one record: a :class:`rocking.CriticalScale`-like entry for
-    :func:`rocking.fragility` (scale, PGA and the largest factor examined)."""
+    :func:`rocking.fragility` (scale, PGA and the largest factor examined; ``limit`` the level of
+    the critical scales, None: overturning)."""
     from pulses import G
     from rocking.fragility import CriticalScale
 
@@ -352,12 +354,13 @@ def _critical(group):
     pga = r["pga_g"] * G
     return CriticalScale(scale=r["critical_scale"], islands=[], up_to=r["fragility_up_to"],
                          uplift_scale=r["uplift_scale"], pga=pga, n_scan=0, step=0.0, resolution=0.0,
-                         near=0.0, rtol=0.0, runs=0, calls=0, limit=r.get("design_limit"))
+                         near=0.0, rtol=0.0, runs=0, calls=0, limit=limit)
 
 
-def fragility_tables(rows):
+def fragility_tables(rows, limit=None):
     """``(summary rows, curve rows, fits)`` of ``--fragility``; ``fits`` maps a column to
-    ``(Fragility by scale, Fragility by PGA, critical entries)`` for the plot."""
+    ``(Fragility by scale, Fragility by PGA, critical entries)`` for the plot; ``limit``: the level
+    of the critical scales (``Options.fragility_limit``; None: collapse, overturning)."""
     import numpy as np
     import rocking
 
@@ -367,7 +370,7 @@ def fragility_tables(rows):
             by_column.setdefault(r["column"], []).append(r)
     summary, curve, fits = [], [], {}
     for label, crows in by_column.items():
-        entries = [_critical(g) for g in _groups(crows).values()]
+        entries = [_critical(g, limit) for g in _groups(crows).values()]
         n_failed = sum(e.scale is not None for e in entries)
         level = entries[0].limit if entries else None
         # a critical scale under a level is where max|theta|/alpha first exceeds it: it does not
@@ -415,7 +418,7 @@ def write_outputs(outputs, rows, fields, options, failed=None, render=None) -> N
     if options.plots and rows:
         outputs.write(SUITE_PLOT, render("plot_site:suite_figure_png", rows, suite))
     if options.fragility:
-        summary, curve, fits = fragility_tables(rows)
+        summary, curve, fits = fragility_tables(rows, options.fragility_limit)
         outputs.write(FRAGILITY_CSV, report.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
         outputs.write(FRAGILITY_CURVE_CSV, report.csv_text(list(FRAGILITY_CURVE_COLUMNS.names), curve))
         if options.plots and fits:

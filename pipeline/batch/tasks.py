@@ -53,6 +53,9 @@ class Options:
     #: the performance level (``--limit`` R: max|theta|/alpha <= R; default 0.5, the paper's
     #: dependable design); None (``--limit none``): the verge of overturning alone
     limit: float | None = DEFAULT_LIMIT
+    #: the level of ``--fragility``'s critical scales: ``--limit R`` given (R); None: collapse
+    #: (overturning), also where the design's level is the default one
+    fragility_limit: float | None = None
     #: ``--restitution``: a :class:`rocking.restitution.Restitution` (a factor of Eq. 5, an eta or an
     #: r; one value or a band) every block of the run is made with; None: Eq. 5
     restitution: object = None

@@ -41,8 +41,9 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
                              "dependable design: peaks at or below alpha/2), at least the "
                              "overturning design width; that width, the verge (no margin), is "
                              "reported beside it (overturning_width_m). `none`: the verge alone, "
-                             "as the design width. With --fragility, critical scales at which "
-                             "max|theta|/alpha first exceeds R (docs/design.md)")
+                             "as the design width. With --fragility and R given, critical scales "
+                             "at which max|theta|/alpha first exceeds R (without --limit: collapse; "
+                             "docs/design.md)")
     add_restitution_option(parser)
 
 
@@ -123,8 +124,10 @@ def options_from(args, **overrides):
     from ..batch.tasks import Options
 
     limit = DEFAULT_LIMIT if args.limit is None else parse_limit(args.limit)
+    # the fragility stays collapse unless a level is asked for by name (--limit R)
     kw = dict(plots=args.plots != "none", plots_all=args.plots == "all",
               thorough=bool(getattr(args, "thorough", False)), limit=limit,
+              fragility_limit=None if args.limit is None else limit,
               restitution=parse_restitution(args.restitution))
     kw.update(overrides)
     return Options(**kw)
