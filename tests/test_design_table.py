@@ -129,7 +129,7 @@ def test_a_levels_overturning_width_is_the_widest_over_directions_and_in_the_fin
     assert d["overturning_width_m"] == 0.8 and d["design_width_m"] == 1.0
     text = table_text([d])
     assert "1.000 m for max theta/alpha <= 0.5" in text
-    assert "the verge (no margin) is 0.800 m" in text and "and at least the verge" in text
+    assert "the verge (no margin) is 0.800 m" in text and "is at least the verge" in text
     plain, = design_rows([_row(0, 1.0, None, search=0.95)])
     assert plain["overturning_width_m"] is None
     assert "overturning design width" not in table_text([plain])

@@ -127,7 +127,7 @@ def test_the_table_shows_the_verge_and_where_a_width_passes_alpha(demo_runs, cap
     main(["demo", "--jobs", "1", "--no-plots", "--limit", "none", "--out", str(none)])
     text = capsys.readouterr().out
     assert "verge (no margin)" not in text.splitlines()[0]
-    assert "the verge of overturning (--limit none, no margin)" in text
+    assert "Margin: none, the design width is the verge of overturning (--limit none)" in text
     page = (default / "report.html").read_text(encoding="utf-8")
     assert "verge, no margin (m)" in page and "passes alpha" in page
 
@@ -249,7 +249,7 @@ def test_the_printed_cells_of_the_margin():
     text = table_text([d])
     line = text.splitlines()[2]
     assert "1.700 m, passes alpha" in line and line.rstrip().endswith("NO: passes alpha")
-    assert "passes its slenderness angle on 1 of 1 row(s)" in text
+    assert "the column passes its slenderness angle on 1 of 1 row(s)" in text
     calm, = design_rows([dict(row, overturning_max_theta_ratio=0.97, max_theta_ratio=0.7)])
     assert "passes alpha" not in table_text([calm]).splitlines()[2]
 

@@ -560,18 +560,17 @@ def margin_print(rows) -> str:
     if not limits:
         return ""
     if limits == {None}:
-        return ("Design width here: the verge of overturning (--limit none, no margin): at it a "
-                "column may pass its slenderness angle (max theta/alpha >= 1) and come back; without "
-                "--limit the design width keeps max theta/alpha <= 0.5 (docs/design.md). ")
+        return ("Margin: none, the design width is the verge of overturning (--limit none): at it "
+                "a column may pass its slenderness angle (max theta/alpha >= 1) and come back; "
+                "without --limit the design width keeps max theta/alpha <= 0.5 (docs/design.md). ")
     shown = ", ".join(f"{v:g}" for v in sorted(v for v in limits if v is not None))
     passes = sum(1 for r in rows if passes_text(r.get("overturning_max_theta_ratio")))
-    return (f"Design width: max theta/alpha <= {shown} under the record (0.5: the dependable "
-            "design, peaks at or below alpha/2), and at least the verge. Verge (no margin): the "
-            "overturning design width, the narrowest that does not overturn; where the level "
-            "governs, the overturning design's search width and its check above the design width "
-            "(--limit none checks it in full; it lies between the two)"
-            + (f"; at it the column passes its slenderness angle on {passes} of {len(rows)} row(s) "
-               "(passes alpha)" if passes else "") + ". ")
+    return (f"Margin: the design width keeps max theta/alpha <= {shown} under the record (0.5: the "
+            "dependable design, peaks at or below alpha/2) and is at least the verge. Verge (no "
+            "margin): the narrowest width found not to overturn; where the level governs it is "
+            "checked only above the design width (--limit none checks it in full: it lies between "
+            "the two)" + (f"; at the verge the column passes its slenderness angle on {passes} of "
+                          f"{len(rows)} row(s) (passes alpha)" if passes else "") + ". ")
 
 
 def fine_print(rows) -> str | None:
