@@ -574,7 +574,7 @@ def _design_curves(H, designed, record, up, opts, margin_cache, draw) -> list:
         margin_cache[H] = margin.margin_fields(H, designed, record, up, opts, ratio)
     verge = designed.overturning_width
     if draw and verge is not None and verge > 0:
-        curves.append((f"verge (no margin), {verge:.3g} m",) + margin.simulate(H, float(verge), record, opts, True))
+        curves.append((f"verge, {verge:.3g} m",) + margin.simulate(H, float(verge), record, opts, True))
     return curves if draw else []
 
 

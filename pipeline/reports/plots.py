@@ -163,12 +163,12 @@ def record_figure_png(record_id, record, fit, fitting, histories, velocity=None)
 
 
 def verdict_words(res) -> str:
-    """A run's outcome in a legend: ``overturns``, ``passes alpha, max 1.06 alpha`` (it passes its
+    """A run's outcome in a legend: ``overturns``, ``passes alpha, max 1.005 alpha`` (it passes its
     slenderness angle and comes back) or ``max 0.74 alpha``."""
     if res.overturned:
         return "overturns"
     ratio = float(res.max_rotation_ratio)
-    return ("passes alpha, " if ratio >= 1.0 else "") + f"max {ratio:.3g} alpha"
+    return f"passes alpha, max {ratio:.4g} alpha" if ratio >= 1.0 else f"max {ratio:.3g} alpha"
 
 
 def run_figure_png(record_id, record, fit, fitting, histories, velocity=None) -> bytes:
