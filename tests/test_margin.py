@@ -268,3 +268,10 @@ def test_the_fragility_stays_collapse_unless_a_level_is_named(tmp_path):
         assert row["design_limit"] == "0.5"           # the design width is the level's either way
         want = rocking.critical_scale(block, rec, up_to=3.0, limit=limit).scale
         assert float(row["critical_scale"]) == pytest.approx(want, rel=REPORT_RTOL), name
+
+
+def test_the_help_states_the_number_of_band_values():
+    from pipeline.args import RESTITUTION_HELP
+
+    # the help is written without importing rocking (the command line starts fast): said once here
+    assert f"every one of {BAND_VALUES} values" in RESTITUTION_HELP
