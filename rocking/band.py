@@ -93,3 +93,19 @@ def band_slenderness(solve, band, n=None):
         out.append(dataclasses.replace(gov, band=band, band_runs=len(values),
                                        runs=sum(a.runs for a in point)))
     return out
+
+
+def required_width(height, excitation, eta, band_values, horizontal, overturning, kw):
+    """:func:`rocking.required_width` under the restitution band ``eta`` (:func:`band_width`):
+    each value designed with its own horizontal answer and overturning design where given (those
+    of the band designs ``horizontal`` and ``overturning``)."""
+    from .widths import required_width as design
+
+    index = {v: k for k, v in enumerate(singles(eta, band_values))}
+
+    def one(v):
+        over = overturning if overturning is None or overturning is True else band_of(overturning, index[v])
+        hor = None if horizontal is None else band_of(horizontal, index[v])
+        return design(height, excitation, eta=v, horizontal=hor, overturning=over, **kw)
+
+    return band_width(one, eta, band_values)

@@ -258,7 +258,7 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         kw = dict(rule=rule, criterion=criterion, shape=shape, lam=lam, n_scan=n_scan,
                   n_zone=n_zone, rtol=rtol, model=model, settings=settings,
                   cap_mass_ratio=cap_mass_ratio, vertical=vertical, limit=limit)
-        return _band_width(height, excitation, eta, band_values, horizontal, overturning, kw)
+        return band.required_width(height, excitation, eta, band_values, horizontal, overturning, kw)
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
     height = _check_arguments(height, rule, overturning, limit, vertical, excitation)
     if rule == "exact":
@@ -305,22 +305,6 @@ def _closed_form(height, excitation, rule, shape, lam, gamma, eta):
     return RequiredWidth(width=float(width), height=height, rule=rule, iterations=it,
                          method=f"fixed point of {rule} in B (p depends on B): "
                                 f"{it} iterations", eta=eta, cap_mass_ratio=gamma)
-
-
-def _band_width(height, excitation, eta, band_values, horizontal, overturning, kw):
-    """:func:`required_width` under the restitution band ``eta`` (:func:`rocking.band.band_width`):
-    each value designed with its own horizontal answer and overturning design where given (those
-    of the band designs ``horizontal`` and ``overturning``)."""
-    from . import band
-
-    index = {v: k for k, v in enumerate(band.singles(eta, band_values))}
-
-    def one(v):
-        over = overturning if overturning is None or overturning is True else band.band_of(overturning, index[v])
-        hor = None if horizontal is None else band.band_of(horizontal, index[v])
-        return required_width(height, excitation, eta=v, horizontal=hor, overturning=over, **kw)
-
-    return band.band_width(one, eta, band_values)
 
 
 def _check_arguments(height, rule, overturning, limit, vertical, excitation) -> float:

@@ -141,3 +141,24 @@ def restitution_fields(height, designed, options) -> dict:
         "restitution_design_widths_m": "; ".join(f"{v}={w:.6g}" for v, w in zip(values, widths)),
         "design_eta": eta, "design_r": None if eta is None else eta * eta,
     })
+
+
+def design_curves(H, designed, record, up, opts, margin_cache, draw) -> list:
+    """The figure's curves of the design width (and under a level, of the verge beside it), and
+    under a level the row's :data:`MARGIN_COLUMNS` into ``margin_cache``
+    (by height): max|theta|/alpha at both widths, each in a run of its own."""
+    wv = float(designed.width)
+    curves = []
+    ratio = None
+    if wv > 0 and (draw or up is None):
+        block_v, res_v = simulate(H, wv, record, opts, draw)
+        curves.append((f"design width, {wv:.3g} m", block_v, res_v))
+        ratio = float(res_v.max_rotation_ratio)
+    if opts.limit is None:
+        return curves if draw else []
+    if H not in margin_cache:
+        margin_cache[H] = margin_fields(H, designed, record, up, opts, ratio)
+    verge = designed.overturning_width
+    if draw and verge is not None and verge > 0:
+        curves.append((f"verge, {verge:.3g} m",) + simulate(H, float(verge), record, opts, True))
+    return curves if draw else []

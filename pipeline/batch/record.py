@@ -536,7 +536,7 @@ def _process(task: Task):
             design_cache[H] = design_width(record, up, H, gamma, opts.limit, settings[col],
                                            opts.restitution)
         if draw or (opts.limit is not None and H not in margin_cache):
-            curves += _stage("verify", _design_curves, H, design_cache[H], record, up, opts, margin_cache, draw)
+            curves += _stage("verify", margin.design_curves, H, design_cache[H], record, up, opts, margin_cache, draw)
         if draw:
             histories.append((col.label, curves))
 
@@ -555,27 +555,6 @@ def _process(task: Task):
         rows.append({k: row[k] for k in fields})
 
     return rows, (record, fit, fitting, histories, velocity), design_cache
-
-
-def _design_curves(H, designed, record, up, opts, margin_cache, draw) -> list:
-    """The figure's curves of the design width (and under a level, of the verge beside it), and
-    under a level the row's :data:`pipeline.batch.margin.MARGIN_COLUMNS` into ``margin_cache``
-    (by height): max|theta|/alpha at both widths, each in a run of its own."""
-    wv = float(designed.width)
-    curves = []
-    ratio = None
-    if wv > 0 and (draw or up is None):
-        block_v, res_v = margin.simulate(H, wv, record, opts, draw)
-        curves.append((f"design width, {wv:.3g} m", block_v, res_v))
-        ratio = float(res_v.max_rotation_ratio)
-    if opts.limit is None:
-        return curves if draw else []
-    if H not in margin_cache:
-        margin_cache[H] = margin.margin_fields(H, designed, record, up, opts, ratio)
-    verge = designed.overturning_width
-    if draw and verge is not None and verge > 0:
-        curves.append((f"verge, {verge:.3g} m",) + margin.simulate(H, float(verge), record, opts, True))
-    return curves if draw else []
 
 
 def design_width(record, up, height, cap_mass_ratio, limit, settings, restitution=None):

@@ -417,8 +417,6 @@ def metadata_text(row) -> str | None:
     return display(parts[0] + (": " + ", ".join(site) if site else ""))
 
 
-#: the index of "search width" in :data:`HEADERS` (one more with the verge)
-FAILS_COLUMN = HEADERS.index("search width")
 #: the printed columns right-aligned (widths, aligned on the decimal point)
 _RIGHT = ("Eq.31 width", "design width", VERGE_HEADER, "search width")
 
@@ -434,8 +432,8 @@ def _align_failing(body, col):
 
 
 def _key(row, record="record"):
-    return (row.get(record) if record == "record" else (row.get("pair") or row.get("record")),
-            row.get("column"), number(row.get("direction_deg")))
+    return row.get(record) if record == "record" else (row.get("pair") or row.get("record")), row.get("column"), \
+        number(row.get("direction_deg"))
 
 
 def eq31_ratios(summary) -> dict:
