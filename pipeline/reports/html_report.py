@@ -292,8 +292,8 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
            + ", ".join(f'<a href="{_href(f)}">{_e(f)}</a>' for f in
                        ("design.csv", "summary.csv", "failures.csv", "columns.md"))
            + ". Click a heading to sort the table. Rows in red: the column as it stands overturns; "
-             "in yellow: it survives only on a safe island (a slightly wider column overturns), flagged "
-             "like a failure.</p>",
+             "in yellow: it survives only on a safe island (a slightly wider column overturns) or rocks "
+             "past the level, flagged like a failure.</p>",
            "<h2>Designs</h2>"]
     out += _batch_table(design, pair_anchor, eq31_ratios(rows))
     if failures:
