@@ -254,16 +254,17 @@ class DesignRun:
     @property
     def design(self):
         """``design.csv`` as a DataFrame (columns in the file's order)."""
-        from .reports.design_table import DESIGN_FIELDS
+        from .reports.design_table import design_fields
 
-        return _frame(self.design_rows, DESIGN_FIELDS)
+        return _frame(self.design_rows, design_fields(self.summary_rows))
 
     @property
     def summary(self):
         """``summary.csv`` as a DataFrame."""
         from .batch.record import FIELDS
 
-        return _frame(self.summary_rows, FIELDS)
+        # the columns of the run's options (a level's margin, a restitution), as summary.csv's
+        return _frame(self.summary_rows, list(self.summary_rows[0]) if self.summary_rows else FIELDS)
 
     @property
     def failures(self):
@@ -314,9 +315,9 @@ def _frame(rows, columns):
 
 
 def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 0, vertical: str = "auto",
-           limit=None, jobs: int = 1, out=None, shapes=None, weighting: str = "background", units=None,
-           dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True, thorough: bool = False,
-           **more) -> DesignRun:
+           limit=0.5, restitution=None, jobs: int = 1, out=None, shapes=None, weighting: str = "background",
+           units=None, dt=None, scale=None, plots=None, force: bool = False, quiet: bool = True,
+           thorough: bool = False, **more) -> DesignRun:
     """Design columns for a batch of records, as ``pipeline run`` does, and return the tables.
 
     Parameters
@@ -338,9 +339,13 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         Evenly spaced directions added for a pair (``--directions``).
     vertical : {"auto", "none"}
         Use a pair's known vertical component (``--vertical``).
-    limit : float, optional
-        A performance level R, ``0 < R <= 1`` (``--limit``): design widths for max|theta|/alpha
-        <= R instead of for not overturning.
+    limit : float or None
+        The level R of the design width (``--limit``): max|theta|/alpha <= R, at least the verge
+        (no margin, ``overturning_width_m``); default 0.5, the paper's dependable design.  None
+        (or ``"none"``): the verge alone.
+    restitution : str, float or rocking.restitution.Restitution, optional
+        ``--restitution``: a factor of Eq. 5 (``0.97``), ``"eta=0.9"``, ``"r=0.81"`` or a band
+        ``"0.95:1.05"`` whose design covers it; default Eq. 5.
     jobs : int
         Worker processes (0: one per CPU); the tables do not depend on it.
     out : path, optional
@@ -369,7 +374,8 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     **more
         The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
         ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``, ``friction`` (docs/validity.md); risk at a site (docs/risk.md): ``hazard`` (a file
+        ``glob``, ``friction`` (docs/validity.md), ``fragility_limit`` (the level R of ``fragility``'s
+        critical scales; None, the default: collapse); risk at a site (docs/risk.md): ``hazard`` (a file
         or a :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)), ``site_row``, ``imt``,
         ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe`` (``"2%/50"``), ``risk_seed``.
 
@@ -386,14 +392,9 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
         A value out of range (a negative height, an unknown shape ...), refused with the words
         ``pipeline run`` uses for it.
     RuntimeError
-        ``jobs > 1`` (or ``dask="local"``) called at the top level of a script without the
-        ``if __name__ == "__main__":`` guard: the worker processes import the script again,
-        and would run the call again (see Notes).
-
-    Notes
-    -----
-    With ``jobs > 1`` the workers import the calling script again: in a script, call
-    :func:`design` under ``if __name__ == "__main__":`` (docs/notebook.md); a notebook needs nothing.
+        ``jobs > 1`` (or ``dask="local"``) at the top level of a script without the ``if __name__
+        == "__main__":`` guard: the workers import the script again (docs/notebook.md; a notebook
+        needs nothing).
 
     Examples
     --------
@@ -409,24 +410,25 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     TypeError: blocks: expected a rocking.Block, a 'HxW' string in m (e.g. '7.5x1.8') or a (height, width) pair of numbers in m; got float 7.5
     """
     plan = _plan(records, blocks=blocks, heights=heights, pairs=pairs, directions=directions,
-                 vertical=vertical, limit=limit, jobs=jobs, out=out, shapes=shapes, weighting=weighting,
-                 units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet, thorough=thorough,
-                 **more)
+                 vertical=vertical, limit=limit, restitution=restitution, jobs=jobs, out=out, shapes=shapes,
+                 weighting=weighting, units=units, dt=dt, scale=scale, plots=plots, force=force, quiet=quiet,
+                 thorough=thorough, **more)
     return run_plan(plan)
 
 
 _MORE = {"column": None, "format": None, "trace": None, "scales": None, "peer_scales": False,
-         "cap_mass_ratio": 0.0, "fragility": False, "up_to": 10.0, "dask": None, "log": None, "glob": None,
+         "cap_mass_ratio": 0.0, "fragility": False, "fragility_limit": None, "up_to": 10.0, "dask": None,
+         "log": None, "glob": None,
          "hazard": None, "site": None, "site_row": None, "imt": None, "hazard_units": None, "years": 50,
          "age": None, "target_rate": None, "target_poe": None, "risk_seed": 0, "friction": None}
 
 
-def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs, out, shapes, weighting,
-          units, dt, scale, plots, force, quiet, thorough, **more) -> Plan:
+def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, restitution, jobs, out, shapes,
+          weighting, units, dt, scale, plots, force, quiet, thorough, **more) -> Plan:
     """Every argument of :func:`design` checked and in the forms the runner takes: each value by
     the rule ``pipeline run`` applies to its option (:mod:`pipeline.args`), named as here."""
-    from .args import (parse_cap_mass_ratio, parse_column, parse_directions, parse_dt, parse_limit,
-                       parse_scale, parse_units, parse_up_to)
+    from .args import (parse_cap_mass_ratio, parse_column, parse_directions, parse_dt, parse_scale,
+                       parse_units, parse_up_to)
     from .batch.tasks import Options
 
     unknown = sorted(set(more) - set(_MORE))
@@ -454,9 +456,10 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
               cap_mass_ratio=parse_cap_mass_ratio(number(more["cap_mass_ratio"], "cap_mass_ratio"), "cap_mass_ratio"),
               fragility=_flag(more["fragility"], "fragility"),
               up_to=parse_up_to(number(more["up_to"], "up_to"), "up_to"),
-              limit=None if limit is None else parse_limit(number(limit, "limit"), "limit"),
+              fragility_limit=_limit(more["fragility_limit"], "fragility_limit"),
+              limit=_limit(limit), restitution=_restitution(restitution),
               friction=_friction(more["friction"]), **opts)
-    kw["risk"] = _risk(more)
+    kw["risk"] = _risk(more, kw["restitution"])
     if more["dask"] is not None and not isinstance(more["dask"], str):
         raise TypeError(f"dask: expected 'local' or a scheduler address such as 'tcp://HOST:8786', "
                         f"got {type(more['dask']).__name__}")
@@ -470,7 +473,7 @@ def _plan(records, *, blocks, heights, pairs, directions, vertical, limit, jobs,
         dask=more["dask"], log=_path_option(more["log"], "log"), glob=_text_option(more["glob"], "glob"))
 
 
-def _risk(more):
+def _risk(more, restitution=None):
     """``hazard=`` and its options, checked (pipeline.batch.risk.RiskOptions), or None."""
     from .batch import risk
 
@@ -485,9 +488,31 @@ def _risk(more):
                                  imt=more["imt"], units=more["hazard_units"], years=more["years"],
                                  age=more["age"], target_rate=more["target_rate"],
                                  target_poe=more["target_poe"], seed=more["risk_seed"],
-                                 restitution=more.get("restitution"))
+                                 restitution=restitution)
     except ArgumentError as exc:
         raise ValueError(str(exc)) from None
+
+
+def _limit(limit, name="limit"):
+    """``limit=``: None or "none" (the verge alone), else a level by ``--limit``'s rule."""
+    from .args import parse_limit
+
+    if limit is None or (isinstance(limit, str) and limit.strip().lower() == "none"):
+        return None
+    return parse_limit(_number_option(limit, name), name)
+
+
+def _restitution(restitution):
+    """``restitution=``: None (Eq. 5), or a :class:`rocking.restitution.Restitution` from one, a
+    number (a factor of Eq. 5) or the text ``--restitution`` takes."""
+    from rocking.restitution import Restitution
+
+    if restitution is None:
+        return None
+    if isinstance(restitution, bool) or not isinstance(restitution, (str, int, float, Restitution)):
+        raise TypeError("restitution: expected a factor of Eq. 5, 'eta=V', 'r=V', 'LOW:HIGH' or a "
+                        f"rocking.restitution.Restitution; got {type(restitution).__name__}")
+    return Restitution.parse(restitution)
 
 
 @dataclass

@@ -163,9 +163,12 @@ def _float(text, what: str, rule: str) -> float:
         raise ArgumentError(f"{what} {rule}, got {text!r}") from None
 
 
-def parse_limit(text, what: str = "--limit") -> float:
-    """``--limit R``: a performance level max|theta|/alpha, ``0 < R <= 1``."""
-    rule = "(max|theta|/alpha) must be a number in (0, 1]"
+def parse_limit(text, what: str = "--limit"):
+    """``--limit R``: a performance level max|theta|/alpha, ``0 < R <= 1``; ``none`` (or None: not
+    given) -> None, the verge of overturning alone."""
+    if text is None or str(text).strip().lower() == "none":
+        return None
+    rule = "(max|theta|/alpha) must be a number in (0, 1] or none"
     value = _float(text, what, rule)
     if not (math.isfinite(value) and 0.0 < value <= 1.0):
         raise ArgumentError(f"{what} {rule}, got {text!r}")
@@ -381,6 +384,32 @@ def output_folder(path, what: str = "--out") -> pathlib.Path:
         raise ArgumentError(f"{what} {display(out)} is not a folder this command can write to: "
                             f"{exc.strerror or exc}") from None
     return out
+
+
+def parse_restitution(text, what: str = "--restitution"):
+    """A :class:`rocking.restitution.Restitution` from ``0.97``, ``0.95:1.05`` (factors of Eq. 5),
+    ``eta=0.9`` (the velocity ratio) or ``r=0.81`` (the energy ratio); None when not given."""
+    if text is None:
+        return None
+    from rocking.restitution import Restitution
+
+    try:
+        return Restitution.parse(text)
+    except ValueError as exc:
+        raise ArgumentError(f"{what}: {str(exc).removeprefix('restitution: ')}") from None
+
+
+#: what ``--restitution`` says in every command's help
+RESTITUTION_HELP = ("the restitution at impact: a factor of Eq. 5 (0.97: 0.97 times Housner's eta at "
+                    "each width; tests find 0.67 on rubber, 0.95-0.97 on concrete), eta=V (the "
+                    "velocity ratio, the same at every width) or r=V (the energy ratio, eta squared); "
+                    "LOW:HIGH a band, whose answer covers it (every one of 5 values, ends included, "
+                    "run; the most demanding governs). Default: Eq. 5")
+
+
+def add_restitution_option(parser) -> None:
+    """``--restitution``: read back with :func:`parse_restitution`."""
+    parser.add_argument("--restitution", metavar="VALUE", default=None, help=RESTITUTION_HELP)
 
 
 def add_weighting_option(p) -> None:

@@ -11,7 +11,7 @@ from pulses.lazy import lazy_names
 
 #: public name -> the module of this package that defines it
 _WHERE = {
-    "ALPHA_PLASTIC": "block", "Block": "block", "Blocks": "block", "eta_housner": "block",
+    "ALPHA_PLASTIC": "block", "Block": "block", "Restitution": "restitution", "Blocks": "block", "eta_housner": "block",
     "CriticalAmplitudes": "design", "MinSlenderness": "design", "RequiredWidth": "design",
     "critical_amplitudes": "design", "envelope_rule": "design", "eq20": "design", "eq31": "design",
     "min_slenderness": "design", "min_slenderness_batch": "design", "required_width": "design",

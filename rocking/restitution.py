@@ -52,6 +52,16 @@ class Restitution:
         The band's upper end; None (or ``low``): a single value.
     kind : {"factor", "eta", "r"}
         How ``low`` and ``high`` are stated (module docstring).
+
+    Examples
+    --------
+    >>> import rocking
+    >>> concrete = rocking.Restitution.parse("0.95:0.97")       # a band of factors of Eq. 5
+    >>> column = rocking.Block.from_dimensions(7.5, 1.8, rocking.Restitution(0.97))
+    >>> round(column.eta, 4), round(column.r, 4)                 # velocity and energy ratios
+    (0.8908, 0.7934)
+    >>> concrete.is_band, [str(v) for v in concrete.values(3)]
+    (True, ['0.95', '0.96', '0.97'])
     """
 
     low: float

@@ -58,6 +58,12 @@ class MinSlenderness:
     excitation: object = field(default=None, repr=False)
     #: for each transition: does the block fail just above it?
     fails_above: tuple = ()
+    #: the restitution (None: Eq. 5); under a band, the single value whose answer governs (the
+    #: largest ``tan_alpha`` of the band's values, :mod:`rocking.band`)
+    eta: object = None
+    #: under a band: the band, and the number of its values run (0: no band)
+    band: object = None
+    band_runs: int = 0
 
     @property
     def alpha(self) -> float:
@@ -71,8 +77,8 @@ class MinSlenderness:
         --------
         >>> import rocking, pulses
         >>> m = rocking.min_slenderness(pulses.make_pulse("sine", 3.0, 1.0), p=1.5)
-        >>> sorted(m.as_dict())[:3]
-        ['alpha', 'criterion', 'eq31']
+        >>> sorted(m.as_dict())[:4]
+        ['alpha', 'band', 'band_runs', 'criterion']
         """
         from pulses.export import fields_dict
 
@@ -91,7 +97,7 @@ def _unit_pulse(shape, tp):
 
 def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_scan=None,
                           n_zone=None, rtol=None, model="fast", refine="all", ksection=None,
-                          settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, body=None):
+                          settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, body=None, eta=None):
     """Exact minimum slenderness for many ``(pTp, ap/g)`` points of one pulse shape at once.
 
     By the similarity law (docs/theory.md section 4) the answer depends only on ``pTp`` and ``ap/g``, so
@@ -104,6 +110,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     ``pipeline run`` needs for a few blocks per record.  ``n_scan``, ``n_zone``, ``rtol`` and
     ``ksection`` override the fields of ``settings`` (:class:`rocking.search.SearchSettings`).
     ``body`` (:mod:`rocking.bodies`): the impact rule at each slenderness is that body's.
+    ``eta``: the restitution, as :func:`min_slenderness`'s.
 
     Examples
     --------
@@ -112,6 +119,14 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     >>> [round(r.tan_alpha, 4) for r in res]
     [0.1221, 0.3383]
     """
+    from . import band
+
+    eta = band.plain(eta)
+    if band.is_band(eta):
+        kw = dict(criterion=criterion, n_scan=n_scan, n_zone=n_zone, rtol=rtol, model=model,
+                  refine=refine, ksection=ksection, settings=settings, cap_mass_ratio=cap_mass_ratio,
+                  body=body)
+        return band.band_slenderness(lambda v: min_slenderness_batch(shape, p_tp, ap_over_g, eta=v, **kw), eta)
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
     settings = settings.replace(n_scan=n_scan, zone_points=n_zone, rtol=rtol, ksection=ksection)
@@ -128,7 +143,7 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
     known[:, -1] = True            # tan(alpha) = ap/g: never uplifts
 
     def evaluate(idx, tans):
-        blocks = Blocks.from_tan_alpha(p_tp[idx], tans, cap_mass_ratio=gamma, body=body)
+        blocks = Blocks.from_tan_alpha(p_tp[idx], tans, eta, cap_mass_ratio=gamma, body=body)
         return _failed(_batch(blocks, pulse, scales[idx], model=model), criterion)
 
     scan = _scan_refine(evaluate, x, settings, known=known, zone=settings.zone_points != 0,
@@ -145,12 +160,12 @@ def min_slenderness_batch(shape, p_tp, ap_over_g, *, criterion="overturn", n_sca
             tan_alpha=tan_alpha, transitions=transitions, p=float(p_tp[i]), criterion=criterion,
             eq31=float(eq31(scales[i], 1.0, p_tp[i])), uplift=float(top[i]),
             runs=scan.runs if p_tp.size == 1 else 0, excitation=None,
-            fails_above=tuple(fhi for _, _, _, fhi in br)))
+            fails_above=tuple(fhi for _, _, _, fhi in br), eta=eta))
     return out
 
 
 def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None, rtol=None,
-                    model="fast", settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, body=None):
+                    model="fast", settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, body=None, eta=None):
     """Exact minimum slenderness (docs/theory.md section 5, the paper's Fig. 8).
 
     The smallest ``tan(alpha)`` for which a block of frequency parameter ``p`` survives
@@ -183,6 +198,12 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
         frame's at each slenderness; 0, the lone column.
     body : rocking.bodies.Body or str, optional
         The body's shape (default rectangular): ``eta`` at each slenderness is its impact rule.
+    eta : float or rocking.restitution.Restitution, optional
+        The restitution at impact: a velocity ratio, or a
+        :class:`~rocking.restitution.Restitution` (a factor of Eq. 5 at each slenderness, an
+        ``eta``, an ``r``); default Eq. 5.  A band gives the answer covering it (the largest
+        ``tan_alpha`` of its :data:`rocking.band.BAND_VALUES` values; ``.eta`` the value that
+        governed, ``.band_runs`` how many were run).
 
     Returns
     -------
@@ -196,8 +217,15 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     >>> round(ms.tan_alpha, 4)                 # exact; Eq. 31 asks for 0.3727
     0.1989
     """
+    from . import band
+
     _check_criterion(criterion)
     gamma = check_cap_mass_ratio(cap_mass_ratio)
+    eta = band.plain(eta)
+    if band.is_band(eta) and getattr(pulse, "shape", "record") not in SHAPES:
+        kw = dict(criterion=criterion, n_scan=n_scan, n_zone=n_zone, rtol=rtol, model=model,
+                  settings=settings, cap_mass_ratio=cap_mass_ratio, body=body)
+        return band.band_slenderness(lambda v: [min_slenderness(pulse, p, eta=v, **kw)], eta)[0]
     p = float(p)
     if not (math.isfinite(p) and p > 0):
         raise ValueError(f"p must be positive, got {p!r}")
@@ -207,7 +235,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
         res = min_slenderness_batch(pulse.shape, p * pulse.tp, abs(pulse.ap) / G,
                                     criterion=criterion, n_scan=n_scan, n_zone=n_zone, rtol=rtol,
                                     model=model, settings=settings,
-                                    cap_mass_ratio=cap_mass_ratio, body=body)[0]
+                                    cap_mass_ratio=cap_mass_ratio, body=body, eta=eta)[0]
         res.p, res.excitation = p, pulse
         return res
     # a record (or any excitation the solver accepts): scan tan(alpha) directly
@@ -219,7 +247,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
     known[:, -1] = True
 
     def evaluate(idx, tans):
-        blocks = Blocks.from_tan_alpha(np.full(len(tans), p), tans, cap_mass_ratio=gamma,
+        blocks = Blocks.from_tan_alpha(np.full(len(tans), p), tans, eta, cap_mass_ratio=gamma,
                                        body=body)
         return _failed(_batch(blocks, pulse, None, model=model), criterion)
 
@@ -232,7 +260,7 @@ def min_slenderness(pulse, p, *, criterion="overturn", n_scan=None, n_zone=None,
             tan_alpha = hi
     return MinSlenderness(tan_alpha, tuple(0.5 * (lo + hi) for lo, hi, _, _ in br), p, criterion,
                           None, float(top[0]), scan.runs, pulse,
-                          fails_above=tuple(fhi for _, _, _, fhi in br))
+                          fails_above=tuple(fhi for _, _, _, fhi in br), eta=eta)
 
 
 # ---------------------------------------------------------------------------------------------

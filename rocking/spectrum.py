@@ -41,7 +41,12 @@ class OverturningSpectrum:
     overturned: np.ndarray
     exceeded_alpha: np.ndarray
     max_rotation_ratio: np.ndarray
-    eta: float
+    #: the restitution: ``eta`` (velocity ratio) at ``alpha``, or the band (a
+    #: :class:`rocking.restitution.Restitution`) whose values were all run: a point then overturns
+    #: (passes alpha) where any value's does, ``max_rotation_ratio`` the largest of them
+    eta: object
+    #: under a band, the number of its values run (0: no band)
+    band_runs: int = 0
 
     def minimum_overturning(self) -> np.ndarray:
         """For each ``omega_p/p``: the smallest ``ap/(g tan alpha)`` on the grid that overturns (NaN if none)."""
@@ -121,8 +126,11 @@ def overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, *, eta=None, mod
         Frequency ratios ``omega_p / p`` (x axis of Fig. 5).
     ap_over_gtan : array_like
         Amplitude ratios ``ap / (g tan alpha)`` (y axis; 1 is the uplift limit).
-    eta : float, optional
-        Restitution (default Eq. 5 for ``alpha``).
+    eta : float or rocking.restitution.Restitution, optional
+        Restitution (default Eq. 5 for ``alpha``): a velocity ratio, or a
+        :class:`~rocking.restitution.Restitution` (a factor of Eq. 5, an ``eta``, an ``r``).  A
+        band gives the spectrum covering it: each of its :data:`rocking.band.BAND_VALUES` values
+        run, a point overturning where any of them overturns.
 
     Returns
     -------
@@ -139,8 +147,21 @@ def overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, *, eta=None, mod
     >>> spec.overturned.tolist()           # [omega_p/p][ap/(g tan alpha)]
     [[False, True], [False, True]]
     """
+    from . import band
+
     if shape not in SHAPES:
         raise ValueError(f"unknown pulse shape {shape!r}; choose one of {', '.join(SHAPES)}")
+    eta = band.plain(eta)
+    if band.is_band(eta):
+        specs = [overturning_spectrum(alpha, shape, wp_over_p, ap_over_gtan, eta=v, model=model)
+                 for v in band.singles(eta)]
+        first = specs[0]
+        return OverturningSpectrum(
+            alpha=first.alpha, shape=shape, wp_over_p=first.wp_over_p, ap_over_gtan=first.ap_over_gtan,
+            overturned=np.logical_or.reduce([s.overturned for s in specs]),
+            exceeded_alpha=np.logical_or.reduce([s.exceeded_alpha for s in specs]),
+            max_rotation_ratio=np.maximum.reduce([s.max_rotation_ratio for s in specs]),
+            eta=eta, band_runs=len(specs))
     alpha = float(alpha)
     wp = np.atleast_1d(np.asarray(wp_over_p, dtype=float)).ravel()
     ratio = np.atleast_1d(np.asarray(ap_over_gtan, dtype=float)).ravel()
@@ -171,13 +192,15 @@ CHART_APG = tuple(np.round(np.linspace(0.075, 1.5, 20), 6))
 
 def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
                       ap_over_g=CHART_APG, *, criterion="overturn", n_scan=None, rtol=None,
-                      model="fast", settings=DEFAULT_SETTINGS):
+                      model="fast", settings=DEFAULT_SETTINGS, eta=None):
     """Fig. 8: exact minimum ``tan(alpha)`` against ``ap/g`` for several ``pTp``, beside Eq. 31.
 
     Returns a :class:`pandas.DataFrame` with columns ``shape, pTp, ap_over_g, exact, eq31,
     ratio`` (``exact / eq31``; above 1 where Eq. 31 is unconservative), ``transitions`` (how
     many verdict changes the scan found) and ``islands`` (how many safe islands lie below the
-    answer).
+    answer).  ``eta``: the restitution (:func:`rocking.min_slenderness`'s; a band gives the
+    answer covering it, with the columns ``restitution`` and, for a band, ``restitution_governing``:
+    the value whose answer governs at that point).
 
     Examples
     --------
@@ -197,12 +220,17 @@ def slenderness_chart(shapes=tuple(SHAPES), p_tp=CHART_PTP,
     for shape in shapes:
         results = min_slenderness_batch(shape, pt.ravel(), ag.ravel(), criterion=criterion,
                                         n_scan=n_scan, rtol=rtol, model=model,
-                                        settings=settings)
+                                        settings=settings, eta=eta)
         for x, a, r in zip(pt.ravel(), ag.ravel(), results):
             e31 = float(eq31(a * G, 1.0, x))
-            rows.append({"shape": shape, "pTp": float(x), "ap_over_g": float(a),
-                         "exact": r.tan_alpha, "eq31": e31, "ratio": r.tan_alpha / e31,
-                         "transitions": len(r.transitions), "islands": len(r.safe_islands)})
+            row = {"shape": shape, "pTp": float(x), "ap_over_g": float(a),
+                   "exact": r.tan_alpha, "eq31": e31, "ratio": r.tan_alpha / e31,
+                   "transitions": len(r.transitions), "islands": len(r.safe_islands)}
+            if eta is not None:   # the columns of the default chart stay as they were
+                row["restitution"] = str(eta)
+                if r.band is not None:
+                    row["restitution_governing"] = str(r.eta)
+            rows.append(row)
     return pd.DataFrame(rows)
 
 

@@ -116,6 +116,14 @@ class RequiredWidth:
     inputs: tuple | None = field(default=None, repr=False, compare=False)
     #: the column's shape (:mod:`rocking.bodies`): the width is a cylinder's diameter
     body: Body = field(default=RECTANGULAR, compare=False)
+    #: a restitution band (``eta=`` a band :class:`rocking.restitution.Restitution`;
+    #: :mod:`rocking.band`): the single values run (ends included), the design width of each (m),
+    #: the value whose design width governs (the widest; ties: the lowest restitution), and each
+    #: value's whole design (this answer's other fields are the governing value's)
+    restitution_values: tuple = ()
+    restitution_widths: tuple = ()
+    restitution_governing: object = None
+    band_designs: tuple = field(default=(), repr=False, compare=False)
 
     @property
     def total_runs(self) -> int:
@@ -159,8 +167,10 @@ class RequiredWidth:
 
     @property
     def block(self) -> Block:
-        return Block.from_dimensions(self.height, self.width, self.eta,
-                                     cap_mass_ratio=self.cap_mass_ratio, body=self.body)
+        """The column at the design width (under a restitution band, with the value that governed)."""
+        eta = self.restitution_governing if self.restitution_values else self.eta
+        return Block.from_dimensions(self.height, self.width, eta, cap_mass_ratio=self.cap_mass_ratio,
+                                     body=self.body)
 
     @property
     def p(self) -> float:
@@ -183,7 +193,7 @@ RULES = ("eq31", "envelope", "eq20", "exact")
 def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta=None,
                    shape=None, lam=1.0, n_scan=None, n_zone=None, rtol=None, model="fast",
                    settings=DEFAULT_SETTINGS, cap_mass_ratio=0.0, vertical=None, limit=None,
-                   horizontal=None, overturning=None, body=None):
+                   horizontal=None, overturning=None, body=None, band_values=None):
     """The width (m) a column of full ``height`` (m) needs against ``excitation``.
 
     Parameters
@@ -199,8 +209,13 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
         *design width*, see :class:`RequiredWidth`); works for pulses and records.
     criterion : {"overturn", "exceed"}
         Failure criterion of ``rule="exact"`` (``limit`` takes precedence).
-    eta : float, optional
-        Restitution for the exact rule (default Eq. 5 at each width).
+    eta : float or rocking.restitution.Restitution, optional
+        Restitution for the exact rule: a velocity ratio ``eta``, or a
+        :class:`~rocking.restitution.Restitution` (a factor of Eq. 5 at each width, an ``eta`` or
+        an ``r``; default Eq. 5 at each width).  A band (``Restitution.parse("0.95:1.05")``)
+        gives the design covering it: ``band_values`` values (default
+        :data:`rocking.band.BAND_VALUES`), ends included, each designed, the widest governing
+        (``.restitution_values``, ``.restitution_widths``, ``.restitution_governing``).
     limit : float, optional
         ``rule="exact"``: the performance level R in (0, 1]: the design keeps ``max|theta|/alpha
         <= R`` (a width fails where it exceeds R or the column overturns); None (default):
@@ -242,6 +257,17 @@ def required_width(height, excitation, *, rule="eq31", criterion="overturn", eta
     >>> [round(rocking.required_width(7.5, pulse, rule=r).width, 3) for r in ("eq31", "exact")]
     [2.17, 1.736]
     """
+    from . import band
+
+    eta = band.plain(eta)
+    if band.is_band(eta):
+        if rule != "exact":
+            raise ValueError(f"rule={rule!r} does not depend on the restitution: a band goes with "
+                             "rule='exact'")
+        kw = dict(rule=rule, criterion=criterion, shape=shape, lam=lam, n_scan=n_scan,
+                  n_zone=n_zone, rtol=rtol, model=model, settings=settings,
+                  cap_mass_ratio=cap_mass_ratio, vertical=vertical, limit=limit, body=body)
+        return band.required_width(height, excitation, eta, band_values, horizontal, overturning, kw)
     gamma, limit = check_cap_mass_ratio(cap_mass_ratio), check_limit(limit)
     body = Body.parse(body)
     check_frame(body, gamma)

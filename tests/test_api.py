@@ -11,10 +11,13 @@ import pytest
 import pipeline
 import rocking
 from pipeline.reports import report
-from pipeline.batch.record import FIELDS
+from pipeline import api
+from pipeline.batch.margin import DEFAULT_LIMIT
+from pipeline.batch.record import FIELDS, fields_for
+from pipeline.batch.tasks import Options
 from pipeline.cli import main
 from pipeline.commands.demo import bundled_records
-from pipeline.reports.design_table import DESIGN_FIELDS
+from pipeline.reports.design_table import DESIGN_FIELDS, design_columns
 
 from .vertical_cases import DOWNLOAD
 
@@ -46,8 +49,12 @@ def _same_as_cli(tmp_path, inputs, cli_args, **kw):
     code = main(["run", *map(str, inputs), *cli_args, "--out", str(out)])
     run = pipeline.design(inputs, **kw)
     assert run.exit_code == code
-    assert _frame_cells(run.design, DESIGN_FIELDS) == _cells(out / "design.csv")
-    assert _frame_cells(run.summary, FIELDS) == _cells(out / "summary.csv")
+    # the columns of the run's options: a level's margin (the default), a restitution's
+    opts = Options(limit=api._limit(kw.get("limit", DEFAULT_LIMIT)),
+                   restitution=api._restitution(kw.get("restitution")))
+    design_fields = [n for n, _, _ in design_columns(opts.limit is not None, opts.restitution is not None)]
+    assert _frame_cells(run.design, design_fields) == _cells(out / "design.csv")
+    assert _frame_cells(run.summary, fields_for(opts)) == _cells(out / "summary.csv")
     assert len(run.failures) == len(_cells(out / "failures.csv")) - 1
     return run
 
@@ -65,6 +72,31 @@ def test_a_performance_level_flows_through(tmp_path):
         run = _same_as_cli(tmp_path, paths[2:4], ["--height", "7.5", "--limit", "0.5", *CHEAP],
                            heights=7.5, limit=0.5, shapes="sine")
     assert list(run.design["design_limit"]) == [0.5, 0.5]
+
+
+def test_the_verge_alone_has_the_columns_of_every_run(tmp_path):
+    with bundled_records() as paths:
+        run = _same_as_cli(tmp_path, paths[2:4], ["--height", "7.5", "--limit", "none", *CHEAP],
+                           heights=7.5, limit=None, shapes="sine")
+    assert list(run.summary.columns) == FIELDS and list(run.design.columns) == DESIGN_FIELDS
+    assert run.design["design_limit"].isna().all() and run.design["overturning_width_m"].isna().all()
+
+
+def test_a_restitution_band_flows_through(tmp_path):
+    from rocking.band import BAND_VALUES
+    from rocking.restitution import Restitution
+
+    with bundled_records() as paths:
+        run = _same_as_cli(tmp_path, paths[3:4], ["--height", "7.5", "--restitution", "0.95:1.05", *CHEAP],
+                           heights=7.5, restitution="0.95:1.05", shapes="sine")
+    row = run.summary_rows[0]
+    assert row["restitution"] == "0.95:1.05" and row["restitution_values_run"] == BAND_VALUES
+    widths = [float(p.split("=")[1]) for p in row["restitution_design_widths_m"].split("; ")]
+    assert len(widths) == BAND_VALUES and row["design_width_m"] == max(widths)
+    assert api._plan([], blocks=None, heights=7.5, pairs=None, directions=0, vertical="auto", limit=0.5,
+                     restitution="eta=0.9", jobs=1, out=None, shapes=None, weighting="background",
+                     units=None, dt=None, scale=None, plots=None, force=False, thorough=False,
+                     quiet=True).options.restitution == Restitution(0.9, kind="eta")
 
 
 @pytest.mark.slow

@@ -92,10 +92,14 @@ def test_eq31_safe_island_and_the_suite_answer():
     assert ("Suite, column 7.5x1.8: the design width covering all 3 record(s) is 2.200 m (set by b); "
             "as it stands (1.800 m) it FAILS: 0 record(s) overturn it, 1 leave it on a safe island") in text
     assert "Eq. 31 is below the design width on 1 of 3 record(s); a column of Eq. 31's width overturns under 1 of them." in text
-    # a level: a column that stands but exceeds R fails it
+    # a level: a column that stands but exceeds R fails it, said as such (it does not overturn)
     lv = design_rows([dict(base, record="a", pair="a", design_limit=0.4)])[0]
-    assert lv["survives"] is False and lv["verdict"] == "NO"
+    assert lv["survives"] is False and lv["verdict"] == "NO: exceeds level"
     assert "for max theta/alpha <= 0.4" in table_text([lv])
+    assert table_text([lv]).splitlines()[2].rstrip().endswith("NO: exceeds 0.4")
+    # one that overturns reads NO, as without a level
+    over = design_rows([dict(base, record="a", pair="a", design_limit=0.4, overturns=True)])[0]
+    assert over["verdict"] == "NO"
 
 
 def test_the_motion_that_governs_is_marked_where_it_is_the_vertical():
@@ -125,7 +129,7 @@ def test_a_levels_overturning_width_is_the_widest_over_directions_and_in_the_fin
     assert d["overturning_width_m"] == 0.8 and d["design_width_m"] == 1.0
     text = table_text([d])
     assert "1.000 m for max theta/alpha <= 0.5" in text
-    assert "at least the overturning design width (overturning_width_m, 0.800 m here)" in text
+    assert "the verge (no margin) is 0.800 m" in text and "is at least the verge" in text
     plain, = design_rows([_row(0, 1.0, None, search=0.95)])
     assert plain["overturning_width_m"] is None
     assert "overturning design width" not in table_text([plain])

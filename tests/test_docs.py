@@ -62,7 +62,7 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     exec(compile(code, "README.md", "exec"), {"__name__": "readme"})
     out = capsys.readouterr().out.split("\n")
     # the values the README's comments state
-    assert out[:6] == ["sine 0.59 0.9", "True", "False 0.74", "2.441", "1.683", ""]
+    assert out[:7] == ["sine 0.59 0.9", "True", "False 0.74", "2.441", "1.683", "2.158", ""]
 
 
 #: the outside specification's name as a word (written so that this file does not hold it)
@@ -283,14 +283,21 @@ def test_each_record_file_has_one_name_and_one_release():
         assert not found, f"{base!r} without its release: {found}"
 
 
+def _close_to_printed(stated: str, width: float) -> bool:
+    """``width`` rounds to the number ``stated`` at the digits it prints."""
+    return abs(float(stated) - width) <= 0.5 * 10 ** -len(stated.split(".")[1]) + 1e-9
+
+
 def test_each_record_file_has_one_design_width_across_the_docs():
-    """Every sentence that names a record (or its file) and states its design width, and every
-    row of the demo's table, gives the width of docs/records.md's table (at the digits printed)."""
+    """Every sentence that names a record (or its file) and states its design width or its verge,
+    and every row of the demo's table, gives the width of docs/records.md's table (at the digits
+    printed)."""
     checked = 0
     for row in _records_table():
         if row["design width, 7.5 m"] == "-":
             continue
         width = float(row["design width, 7.5 m"].split()[0])
+        verge = float(row["verge, 7.5 m"].split()[0])
         file = row["file"].strip("`")
         keys = {row["name in these pages"], file, file.rsplit("/", 1)[-1]}
         for page, text in _doc_texts().items():
@@ -301,16 +308,19 @@ def test_each_record_file_has_one_design_width_across_the_docs():
                 numbers = re.findall(r"(\d+\.\d+) m\b", line)
                 if len(numbers) < 2:  # not the run's printed table (a DataFrame shown in a page)
                     continue
-                stated = numbers[1]
-                assert abs(float(stated) - width) <= 0.5 * 10 ** -len(stated.split(".")[1]) + 1e-9, (page, line)
+                assert _close_to_printed(numbers[1], width), (page, line)
+                if len(numbers) > 3:   # the verge beside it (the table of a level, the default)
+                    assert _close_to_printed(numbers[2], verge), (page, line)
                 checked += 1
             prose = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)  # the tables above: by column
             for sentence in _sentences(prose):
                 if not any(k in sentence for k in keys) or "cap_mass_ratio" in sentence:
                     continue
                 for stated in re.findall(r"(?:verified|design) width[^;()]*?(\d+\.\d+) m\b", sentence):
-                    assert abs(float(stated) - width) <= 0.5 * 10 ** -len(stated.split(".")[1]) + 1e-9, \
-                        (page, row["name in these pages"], stated, sentence)
+                    assert _close_to_printed(stated, width), (page, row["name in these pages"], stated, sentence)
+                    checked += 1
+                for stated in re.findall(r"\bverge\b[^;()]*?(\d+\.\d+) m\b", sentence):
+                    assert _close_to_printed(stated, verge), (page, row["name in these pages"], stated, sentence)
                     checked += 1
     assert checked >= 8  # the demo's five rows in two pages and the Rinaldi sentences were read
 
@@ -335,9 +345,10 @@ def test_the_records_table_is_a_real_run():
         if not path.is_file():
             continue
         rec = pulses.read_record(str(path), **(text_options if file.endswith(".txt") else {}))
-        width = rocking.required_width(7.5, rec, rule="exact").width
-        number = stated.split()[0]
-        # the table prints 3 decimals: the width rounds to it
-        assert abs(width - float(number)) <= 0.5 * 10 ** -len(number.split(".")[1]) + 1e-9, (file, width, number)
+        verge = rocking.required_width(7.5, rec, rule="exact").width
+        width = rocking.required_width(7.5, rec, rule="exact", limit=0.5, overturning=True).width
+        # the table prints 3 decimals: the widths round to it
+        assert _close_to_printed(stated.split()[0], width), (file, width, stated)
+        assert _close_to_printed(row["verge, 7.5 m"].split()[0], verge), (file, verge, row["verge, 7.5 m"])
         checked += 1
     assert checked >= 5  # at least the bundled records

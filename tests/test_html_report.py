@@ -56,11 +56,12 @@ def test_printed_table_and_design_csv(demo):
     assert len(ids) == 5
     rows = list(csv.DictReader(io.StringIO((out / "design.csv").read_text())))
     summary = list(csv.DictReader(io.StringIO((out / "summary.csv").read_text())))
-    # 26, vertical_lift_off_s (lift-off is its own verdict, issue 37) and overturning_width_m (the
-    # width --limit's design width is held to, issue 33), site_rate_per_year and target_width_m (risk
-    # at a site, blank without --hazard: issue 44), and which model answered (body,
-    # friction_demand, slides, validity: issue 48)
-    assert len(next(iter(rows)).keys()) <= 34
+    # 26, vertical_lift_off_s (lift-off is its own verdict, issue 37), overturning_width_m (the
+    # width a level's design width is held to, issue 33), under the default level 0.5 max
+    # theta/alpha at the design width and at the verge, which model answered (body,
+    # friction_demand, slides, validity: issue 48), site_rate_per_year and target_width_m (risk
+    # at a site, blank without --hazard: issue 44)
+    assert len(next(iter(rows)).keys()) <= 36
     assert [r["record"] for r in rows] == ids  # one column: a row per record, input order
     # every value comes from summary.csv unchanged (a single component: its only direction)
     for d, s in zip(rows, summary):
@@ -68,7 +69,9 @@ def test_printed_table_and_design_csv(demo):
                     "design_width_m", "width_m", "design_adequate", "max_theta_ratio",
                     "search_width_m", "check_runs"):
             assert d[key] == s[key], key
-        assert d["survives"] == str(s["overturns"] == "False")
+        # under the default level 0.5: survives and keeps max theta/alpha within it
+        assert d["design_limit"] == "0.5"
+        assert d["survives"] == str(s["overturns"] == "False" and float(s["max_theta_ratio"]) <= 0.5)
         # the design width is above every failing width found, and at least the search's
         assert float(d["design_width_m"]) >= float(d["search_width_m"])
         if d["widest_failing_width_m"]:   # above it by at most design_rtol 1e-6: equal to 6 digits
@@ -98,11 +101,17 @@ def test_printed_table_and_design_csv(demo):
                 assert abs(float(m.group(2)) - pct) <= 0.5 * 10 ** -decimals + 1e-9, (m.group(0), pct)
         else:
             assert "%)" not in line
-        assert line.rstrip().endswith({"True": "yes" if row["design_adequate"] == "True" else "NO: safe island",
-                                       "False": "NO"}[row["survives"]])
+        stands = {"survives": "yes", "NO": "NO", "NO: safe island": "NO: safe island",
+                  "NO: exceeds level": "NO: exceeds 0.5"}[row["verdict"]]
+        if row["verdict"] != "NO" and float(row["max_theta_ratio"]) >= 1.0:
+            stands = "NO: passes alpha" if row["verdict"] == "NO: exceeds level" else stands + ", passes alpha"
+        assert line.rstrip().endswith(stands), (line, row["verdict"])
+        # the verge beside the design width, and whether the column passes alpha there
+        after = line.split(f"  {float(row['overturning_width_m']):.3f} m", 1)[1]
+        assert after.startswith(", passes alpha") == (float(row["overturning_max_theta_ratio"]) >= 1.0), line
     widest = max(rows, key=lambda r: float(r["design_width_m"]))
     assert (f"the design width covering all 5 record(s) is {float(widest['design_width_m']):.3f} m "
-            f"(set by {widest['record']})") in proc.stdout
+            f"for max theta/alpha <= 0.5 (set by {widest['record']})") in proc.stdout
     below = sum(r["eq31_below_design"] == "True" for r in rows)
     over = sum(r["eq31_width_overturns"] == "True" for r in rows)
     assert (f"Eq. 31 is below the design width on {below} of 5 record(s); a column of Eq. 31's width "
@@ -291,7 +300,10 @@ def test_report_in_chromium(demo):
     finally:
         probe.unlink()
     assert result["rows"] == _demo_ids()  # every record in the table, in input order
-    assert len(result["images"]) == 5 + 2  # each record's figure, the summary and the suite
+    # each record's figure, the summary, the suite, and the governing record's friction demand
+    # ("Where the rocking model holds")
+    assert len(result["images"]) == 5 + 2 + 1
+    assert sum("plots/friction/" in i["src"] for i in result["images"]) == 1
     failed = [i["src"] for i in result["images"] if not i["ok"]]
     assert failed == [], failed
     assert result["errors"] == []

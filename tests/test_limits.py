@@ -148,12 +148,13 @@ def test_pipeline_run_limit(tmp_path):
 
     path = str(importlib.resources.files("pipeline.data") / "synth_sine_055g_0.9s.sac")
     widths = {}
-    for name, extra in (("over", []), ("half", ["--limit", "0.5"])):
+    # the verge alone (--limit none), the level named, and the default (the same level)
+    for name, extra in (("over", ["--limit", "none"]), ("half", ["--limit", "0.5"]), ("default", [])):
         out = tmp_path / name
         assert main(["run", path, "--block", "7.5x1.8", "--out", str(out), "--no-plots", "-q"] + extra) == 0
         row = next(csv.DictReader(open(out / "design.csv")))
         widths[name] = float(row["design_width_m"])
-        assert row["design_limit"] == ("0.5" if extra else "")
+        assert row["design_limit"] == ("" if name == "over" else "0.5")
         widths[name + " overturning"] = row["overturning_width_m"]
     rec = pulses.read_record(path)
     assert not _ratio(7.5, widths["half"], rec)[0] and _ratio(7.5, widths["half"], rec)[1] <= 0.5
@@ -163,6 +164,7 @@ def test_pipeline_run_limit(tmp_path):
     # overturning run's design width (6 digits) and the level's; blank without a level
     assert float(widths["half overturning"]) <= min(float(f"{widths['over']:g}"), widths["half"])
     assert widths["over overturning"] == ""
+    assert widths["default"] == widths["half"] and widths["default overturning"] == widths["half overturning"]
 
 
 def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
@@ -178,7 +180,7 @@ def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
                 for k, s in enumerate((1.2, 1.8, 2.5, None))]
 
     (over,), _, _ = fragility_tables(rows(None))
-    (level,), _, _ = fragility_tables(rows(0.5))
+    (level,), _, _ = fragility_tables(rows(0.5), limit=0.5)
     assert over["n_overturned"] == 3 and over["n_failed_at_level"] is None
     assert level["n_overturned"] is None and level["n_failed_at_level"] == 3
     assert over["n_records"] == level["n_records"] == 4
@@ -356,6 +358,8 @@ def test_pipeline_design_limit_is_at_least_the_overturning_design():
             assert float(row["overturning_width_m"]) <= over.width * (1 + 1e-6)
     toppled, ratio = _ratio(6.0, float(run.design.iloc[0]["design_width_m"]), rec)
     assert not toppled and ratio <= 0.5
-    # without a level the column is blank
-    plain = pipeline.design([str(path)], heights=6.0, shapes="sine")
+    # without a level (limit=None: the verge alone) the column is blank; the default is the level
+    plain = pipeline.design([str(path)], heights=6.0, shapes="sine", limit=None)
     assert plain.design["overturning_width_m"].isna().all()
+    default = pipeline.design([str(path)], heights=6.0, shapes="sine")
+    assert default.design["design_width_m"].equals(run.design["design_width_m"])

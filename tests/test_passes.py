@@ -25,8 +25,9 @@ DESIGN = CHECK + ["design_width_m", "design_tan_alpha", "design_adequate"]
 #: and what follows from the design width: the column's restitution, friction and checks there
 DESIGN += ["design_eta", "design_friction_demand", "design_min_normal_force", "design_slides",
            "design_t_slide_s", "friction_width_m", "validity"]
-#: and with ``--limit``, the overturning design's width (its check runs where the level's does)
-LEVEL_DESIGN = DESIGN + ["overturning_width_m"]
+#: and under a level (the default), the overturning design's width (its check runs where the
+#: level's does) and max|theta|/alpha at both widths (the margin's columns)
+LEVEL_DESIGN = DESIGN + ["overturning_width_m", "design_max_theta_ratio", "overturning_max_theta_ratio"]
 
 
 def _rows(out):

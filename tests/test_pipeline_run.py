@@ -325,11 +325,12 @@ def test_cli_end_to_end_numbers_match_library(tmp_path):
     sim31 = rocking.simulate(rocking.Block.from_dimensions(7.5, w31), record)
     assert r["eq31_width_overturns"] == str(bool(sim31.overturned))
     assert close(r["eq31_width_max_theta_ratio"], sim31.max_rotation_ratio)
-    # the design width under the full record
-    ver = rocking.required_width(7.5, record, rule="exact")
-    assert close(r["design_width_m"], ver.width)
+    # the design width under the full record: the level 0.5 (the default), the verge beside it
+    level = dict(rule="exact", limit=0.5, overturning=True)
+    ver = rocking.required_width(7.5, record, **level)
+    assert close(r["design_width_m"], ver.width) and close(r["overturning_width_m"], ver.overturning_width)
     assert r["design_adequate"] == str(1.8 >= ver.width)
-    assert close(rows[2]["design_width_m"], rocking.required_width(9.0, record, rule="exact").width)
+    assert close(rows[2]["design_width_m"], rocking.required_width(9.0, record, **level).width)
     # every fitting shape has its design; the governing one is the widest Eq. 31 design
     fitting = r["shapes_fitting"].split(";")
     assert fitting[0] == best.shape
@@ -364,8 +365,9 @@ def paper_run(tmp_path_factory):
     records = [shared_record("Rinaldi228.AT2"), shared_record("RSN77_SFERN_PUL164.AT2"),
                shared_record("base_isolation_benchmark/erzikan.txt")]
     out = tmp_path_factory.mktemp("paper")
+    # --limit none: the paper's question, whether the column overturns (the verge, Fig. 11)
     code = main(["run", *map(str, records), "--block", "7.5x1.8", "--units", "cm/s2", "--dt", "0.005",
-                 "--column", "1", "--out", str(out), "--no-plots", "-q", "--jobs", "2"])
+                 "--column", "1", "--out", str(out), "--no-plots", "-q", "--jobs", "2", "--limit", "none"])
     return code, out
 
 

@@ -54,7 +54,10 @@ def test_record_figure_draws_the_record_its_pulses_and_rotations(tmp_path):
         assert sorted(tuple(line.get_ydata()) for line in drawn[len(curves):]) == [(-1.0, -1.0), (1.0, 1.0)]
         texts = [t.get_text() for t in ax.get_legend().get_texts()]
         for text, (_, _, res) in zip(texts, curves):
-            assert text.endswith("overturns" if res.overturned else f"max {res.max_rotation_ratio:.3g} alpha")
+            r = res.max_rotation_ratio
+            # a curve that passes its slenderness angle (and comes back) says so
+            assert text.endswith("overturns" if res.overturned else
+                                 f"passes alpha, max {r:.4g} alpha" if r >= 1 else f"max {r:.3g} alpha")
     # one time axis: the record's span on every panel, tick labels on the bottom one only
     for ax in fig.axes:
         assert ax.get_xlim() == (record.t_start, record.t_start + record.duration)
@@ -153,17 +156,19 @@ def test_summary_figure_without_columns_says_so():
 @pytest.mark.slow
 def test_record_figure_velocity_pulse_and_design_width(tmp_path):
     """The run's figure adds the record's velocity with the extracted velocity pulse (the
-    classification's own arrays) and the column at its design width (the row's width)."""
+    classification's own arrays), the column at its design width (the row's width) and, under
+    the default level, at the verge beside it (the row's overturning width)."""
     import pulses
 
     path = write_good(tmp_path, 4)
     task, = make_tasks([str(path)], [Column(7.5, 1.8)], Options())
     rows, (record, fit, fitting, histories, _velocity), _designs, _friction = _process(task)
     (label, curves), = histories
-    assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "design width"]
+    assert [c[0].split(",")[0] for c in curves] == ["as it stands", "Eq. 31 design", "design width", "verge"]
     _, block_v, res_v = curves[2]
     assert block_v.width == pytest.approx(rows[0]["design_width_m"], rel=1e-12)
-    assert not res_v.overturned  # the design width survives the record
+    assert not res_v.overturned and res_v.max_rotation_ratio <= 0.5  # the design width keeps the level
+    assert curves[3][1].width == pytest.approx(rows[0]["overturning_width_m"], rel=1e-12)
     cls = pulses.classify_pulse(record)
     fig = plots.record_figure(task.record_id, record, fit, fitting, histories, velocity=cls)
     top, vel, rot = fig.axes
@@ -171,7 +176,7 @@ def test_record_figure_velocity_pulse_and_design_width(tmp_path):
     np.testing.assert_array_equal(ground.get_ydata(), cls.velocity)
     np.testing.assert_array_equal(pulse.get_ydata(), cls.pulse)
     assert f"Tp {cls.tp:.3g} s" in vel.get_legend().get_texts()[1].get_text()
-    assert len(rot.get_legend().get_texts()) == 3
+    assert len(rot.get_legend().get_texts()) == 4
     # the run's figure is this one, drawn the same way every time
     png = plots.run_figure_png(task.record_id, record, fit, fitting, histories)
     assert png == plots.record_figure_png(task.record_id, record, fit, fitting, histories, velocity=cls)

@@ -97,8 +97,11 @@ def test_stale_reports_failures_and_force_are_computed_again(batch, whole, tmp_p
     assert again["good00.csv"] == first["good00.csv"]
     assert again["good01.csv"] != first["good01.csv"]
     summary = again["summary.csv"].decode()
-    assert summary == report.csv_text(resume._fields(), []) + "".join(
-        resume.report_rows_text(again[f"good{k:02d}.csv"]) for k in range(4))
+    from pipeline.batch.tasks import Options
+
+    fields = resume._fields(Options())   # the columns of the run's options (the default level's)
+    assert summary == report.csv_text(fields, []) + "".join(
+        resume.report_rows_text(again[f"good{k:02d}.csv"], fields) for k in range(4))
     # another column height: a different option, so nothing is kept
     assert main(["run", *paths, *args, "--block", "6x1.2"]) == 1
     assert _counts(capsys.readouterr().out) == (4, 5, 0, 5)

@@ -284,3 +284,17 @@ def test_risk_rows_of_a_column_as_it_stands():
     assert len(res.record_rows()) == 2 * 6
     ff = nrml.functions_of(res)
     assert [s[0] for s in ff.limit_states] == ["exceeds_0_5", "overturns"]
+
+
+def test_a_circular_columns_risk_uses_its_own_body():
+    # the critical scales are the cylinder's own (its p and impact rule), not the rectangle's
+    x = np.geomspace(0.01, 10.0, 76)
+    curve = HazardCurve("PGA", x, 2e-4 * x ** -2.3, units="g")
+    recs = _suite()
+    drum = rocking.risk(recs, curve, height=6.0, width=1.2, body="cylinder", n_boot=5)
+    block = rocking.Block.from_dimensions(6.0, 1.2, body="cylinder")
+    for rec, entry in zip(recs, drum.modes[0].critical.entries):
+        own = rocking.critical_scale(block, rec, up_to=entry.up_to)
+        assert entry.scale == own.scale
+    box = rocking.risk(recs, curve, height=6.0, width=1.2, n_boot=5)
+    assert drum.rate != box.rate

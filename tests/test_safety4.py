@@ -448,7 +448,7 @@ def test_design_takes_thorough_plots_all_or_none_and_numpy_integers(tmp_path):
 
     for plots, cli in (("all", ["--plots", "all"]), ("none", ["--no-plots"]), ("governing", []), (False, ["--no-plots"])):
         plan = api._plan([tmp_path / "a.sac"], blocks="7.5x1.8", heights=None, pairs=None, directions=np.int64(3),
-                         vertical="auto", limit=None, jobs=np.int64(1), out=None, shapes=None,
+                         vertical="auto", limit=None, restitution=None, jobs=np.int64(1), out=None, shapes=None,
                          weighting="background", units=None, dt=None, scale=None, plots=plots, force=False,
                          quiet=True, thorough=True)
         args = build_parser().parse_args(["run", "a.sac", "--block", "7.5x1.8", "--thorough", *cli])

@@ -200,9 +200,10 @@ def test_scale_and_scales(pairs, tmp_path):
     (r1,), (r2,) = _read(out1 / "summary.csv"), _read(out2 / "summary.csv")
     assert r1["scale"] == "1" and r2["scale"] == "2"
     assert _f(r2["pga_g"]) == pytest.approx(2 * _f(r1["pga_g"]), rel=1e-5)
-    # the design width of the scaled record, from the library on the record scaled here
+    # the design width of the scaled record (the default level 0.5), from the library on the record
+    # scaled here
     rec = pulses.read_record(a1).scaled(2.0)
-    ref = rocking.required_width(H, rec, rule="exact").width
+    ref = rocking.required_width(H, rec, rule="exact", limit=0.5, overturning=True).width
     assert _f(r2["design_width_m"]) == pytest.approx(ref, rel=1e-5)
     table = tmp_path / "scales.csv"
     table.write_text(f"record,scale\n{pathlib.Path(a1).name},2\n")
@@ -245,8 +246,10 @@ def test_frame_reports(pairs, tmp_path):
     assert _run(out, a1, "--height", H, "--cap-mass-ratio", "2") == 0
     (r,) = _read(out / "summary.csv")
     assert r["cap_mass_ratio"] == "2"
-    ref = rocking.required_width(H, pulses.read_record(a1), rule="exact", cap_mass_ratio=2.0).width
-    lone = rocking.required_width(H, pulses.read_record(a1), rule="exact").width
+    # the run's headline: the level 0.5 with its overturning design (pipeline run's default)
+    level = dict(rule="exact", limit=0.5, overturning=True)
+    ref = rocking.required_width(H, pulses.read_record(a1), cap_mass_ratio=2.0, **level).width
+    lone = rocking.required_width(H, pulses.read_record(a1), **level).width
     assert _f(r["design_width_m"]) == pytest.approx(ref, rel=1e-5)
     assert abs(ref - lone) > 1e-3 * lone  # the frame is not the lone column here
     assert _run(tmp_path / "bad", a1, "--height", H, "--cap-mass-ratio", "-1") == 2

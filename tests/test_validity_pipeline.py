@@ -35,15 +35,16 @@ def judged(tmp_path_factory):
 def test_rows_name_the_body_and_the_restitution(judged):
     rows = {r["column"]: r for r in _rows(judged)}
     assert set(rows) == {"7.5x1.8", "cyl:7.5x1.8", "7.5"}
-    assert rows["7.5x1.8"]["body"] == "rectangular" and rows["7.5x1.8"]["restitution"] == "Eq. 5"
+    assert rows["7.5x1.8"]["body"] == "rectangular" and rows["7.5x1.8"]["impact_rule"] == "Eq. 5"
     cyl = rows["cyl:7.5x1.8"]
     assert cyl["body"] == "cylinder (planar rocking)"
     drum = rocking.Block.from_dimensions(7.5, 1.8, body="cylinder")
     assert float(cyl["eta"]) == pytest.approx(drum.eta, rel=1e-5)      # 6 digits printed
     assert float(cyl["p_rad_s"]) == pytest.approx(drum.p, rel=1e-5)
-    # the cylinder's design width is the library's, with its own p and impact rule
+    # the cylinder's design width is the library's, with its own p and impact rule (at the run's
+    # default level, max|theta|/alpha <= 0.5, at least the verge)
     rec = pulses.read_record(RECORD)
-    w = rocking.required_width(7.5, rec, rule="exact", body="cylinder").width
+    w = rocking.required_width(7.5, rec, rule="exact", body="cylinder", limit=0.5, overturning=True).width
     assert float(cyl["design_width_m"]) == pytest.approx(w, rel=1e-5)
     assert float(cyl["design_width_m"]) != float(rows["7.5x1.8"]["design_width_m"])
 

@@ -137,7 +137,7 @@ def test_a_level_with_the_vertical_is_at_least_the_overturning_design_in_every_d
     the level's with and without the vertical) is at least the overturning design width (the
     wider of the overturning designs with and without it), and the one with the vertical is at
     least that direction's overturning design with it; design.csv's is the widest over the
-    directions; the design width is at least the plain run's; without --limit the column is blank."""
+    directions; the design width is at least the plain run's; with --limit none the column is blank."""
     out = tmp_path / "level"
     assert main(["run", "--triplet", *files, *RUN_ARGS, "--scale", "5", "--limit", "0.5",
                  "--out", str(out)]) == 0
@@ -149,7 +149,7 @@ def test_a_level_with_the_vertical_is_at_least_the_overturning_design_in_every_d
     (design,) = rows(out, "design.csv")
     assert float(design["overturning_width_m"]) == max(float(r["overturning_width_m"]) for r in summary)
     plain = tmp_path / "plain"
-    assert main(["run", "--triplet", *files, *RUN_ARGS, "--scale", "5", "--out", str(plain)]) == 0
+    assert main(["run", "--triplet", *files, *RUN_ARGS, "--scale", "5", "--limit", "none", "--out", str(plain)]) == 0
     assert all(r["overturning_width_m"] == "" for r in rows(plain))
     # the level's design width is at least the plain run's (the overturning design), for the pair
     # and direction by direction; the overturning design of the level's run, checked only above

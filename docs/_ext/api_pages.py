@@ -29,7 +29,7 @@ THEMES = {
         ("Results as tables", ["to_frame"]),
     ]),
     "rocking": ("rocking: the block, the solvers, design", [
-        ("The block", ["Block", "eta_housner", "linear_error_estimate"]),
+        ("The block", ["Block", "Restitution", "eta_housner", "linear_error_estimate"]),
         ("Simulation", ["simulate", "RockingResult", "simulate_many", "BatchResult",
                         "simulate_vertical_reference", "VerticalRockingResult"]),
         ("Design: the width a column needs", ["required_width", "RequiredWidth", "eq31", "eq20",

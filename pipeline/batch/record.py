@@ -13,9 +13,7 @@ import math
 import threading
 import time
 
-from pulses.shapes import AntisymmetricRicker
-
-from . import memo, peer_inputs, site, validity, vertical
+from . import margin, memo, peer_inputs, site, validity, vertical
 from ..reports.design_table import check_bin_words, check_reach_words
 from ..reports.report import FIT_TOLERANCE, SHAPE_NAMES, Columns, _shape_key, shape_list
 from .tasks import MAX_ID_LENGTH, RESERVED_IDS, Column, Options, Task, record_ids  # noqa: F401 (tests import them here)
@@ -32,12 +30,6 @@ def _g(x):
     from pulses import G
 
     return None if x is None else float(x) / G
-
-
-def _sim(block, record, history):
-    import rocking
-
-    return rocking.simulate(block, record, history=history)
 
 
 def process_record(task: Task) -> dict:
@@ -450,15 +442,45 @@ def _check_fields(ver) -> dict:
     })
 
 
-#: every column of the per-record reports and ``summary.csv``, in order: (name, unit, meaning)
-COLUMNS = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
-           + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
-           + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
-           + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + DESIGN_WIDTH_COLUMNS.columns
-           + CHECK_COLUMNS.columns
-           + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns + vertical.VERTICAL_COLUMNS.columns
-           + validity.VALIDITY_COLUMNS.columns)
+_TO_DESIGN_WIDTH = (RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
+                    + COLUMN_COLUMNS.columns + AS_STANDS_DESIGN_COLUMNS.columns
+                    + GOVERNING_COLUMNS.columns + sum((SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
+                    + AS_STANDS_COLUMNS.columns + EQ31_DESIGN_COLUMNS.columns + DESIGN_WIDTH_COLUMNS.columns)
+_FROM_CHECK = (CHECK_COLUMNS.columns + site.ENVELOPE_COLUMNS.columns + site.FRAGILITY_COLUMNS.columns
+               + vertical.VERTICAL_COLUMNS.columns + validity.VALIDITY_COLUMNS.columns)
+#: the columns every run's per-record reports and ``summary.csv`` have, in order: (name, unit,
+#: meaning); :func:`columns_for` adds those of a run's options
+COLUMNS = _TO_DESIGN_WIDTH + _FROM_CHECK
 FIELDS = [name for name, _, _ in COLUMNS]
+
+
+def columns_for(options) -> tuple:
+    """The columns of the reports of a run with ``options``: :data:`COLUMNS` with, after the design
+    width's, the margin's under a level and the restitution's with ``--restitution``
+    (:func:`pipeline.batch.margin.extra_columns`)."""
+    return _TO_DESIGN_WIDTH + margin.extra_columns(options) + _FROM_CHECK
+
+
+def fields_for(options) -> list:
+    """The names of :func:`columns_for`."""
+    return [name for name, _, _ in columns_for(options)]
+
+
+def _base_fields(task, record, fit, fitting, vertical_note):
+    """``(fields, velocity classification)``: what every row of the record holds (its reading, its
+    fit, whether it is pulse-like, its PEER metadata) and the classification for its figure."""
+    base = _record_fields(task, record, fit, fit.best, fitting)
+    # a lone record is classified once, for its row and its figure (a pair's classification comes
+    # with the task; the figure of a pair's direction classifies the component it draws)
+    velocity = None if task.pair_fields else _stage("classify", _classify, record)
+    site_fields, warning = _stage("classify", site.site_fields, task, record, velocity)
+    if warning:
+        base["warnings"] = "; ".join(w for w in (base["warnings"], warning) if w)
+    base.update(site_fields)
+    base.update(peer_inputs.fields(task))
+    if vertical_note:
+        base["warnings"] = "; ".join(w for w in (base["warnings"], vertical_note) if w)
+    return base, velocity
 
 
 def _process(task: Task):
@@ -473,17 +495,7 @@ def _process(task: Task):
     by_shape = {}
     for c in candidates:  # candidates are ranked: keep the best of each shape
         by_shape.setdefault(c.shape, c)
-    base = _record_fields(task, record, fit, best, fitting)
-    # a lone record is classified once, for its row and its figure (a pair's classification comes
-    # with the task; the figure of a pair's direction classifies the component it draws)
-    velocity = None if task.pair_fields else _stage("classify", _classify, record)
-    site_fields, warning = _stage("classify", site.site_fields, task, record, velocity)
-    if warning:
-        base["warnings"] = "; ".join(w for w in (base["warnings"], warning) if w)
-    base.update(site_fields)
-    base.update(peer_inputs.fields(task))
-    if vertical_note:
-        base["warnings"] = "; ".join(w for w in (base["warnings"], vertical_note) if w)
+    base, velocity = _base_fields(task, record, fit, fitting, vertical_note)
     shown_vertical = None if up is None else (up.metadata.get("source") or task.vertical)
     draw = opts.plots and task.plot
     settings = _check_settings(task)
@@ -492,13 +504,15 @@ def _process(task: Task):
     blocks = {col: rocking.Block.from_dimensions(col.height, col.width, cap_mass_ratio=gamma,
                                                  body=col.body)
               for col in task.columns if col.width is not None}
-    exact = _stage("design", _exact_by_body, fitting, list(blocks.values()), gamma)
+    exact = _stage("design", _exact_by_body, fitting, list(blocks.values()), gamma, opts.restitution)
     extra_cache = {}
 
     rows = []
     histories, frictions = [], []
     design_cache = {}
+    margin_cache = {}
     eq31_cache = {}
+    fields = fields_for(opts)
     for col in task.columns:
         H = col.height
         block = blocks.get(col)
@@ -520,30 +534,31 @@ def _process(task: Task):
             return fields
 
         designed = _stage("design", design)
-        res = None
-        if block is not None:
-            res = _stage("verify", _sim, block, record, draw)
+        res = block_s = None
+        if block is not None:   # (with a restitution band: its most demanding value, margin.simulate)
+            block_s, res = _stage("verify", margin.simulate, H, col.width, record, opts, draw, body=col.body)
             if draw:
-                curves.append((f"as it stands, {col.width:.3g} m wide", block, res))
+                curves.append((f"as it stands, {col.width:.3g} m wide", block_s, res))
 
         # -- the Eq. 31 design under the full record ---------------------------------------------
-        block31 = rocking.Block.from_dimensions(H, w31, cap_mass_ratio=gamma, body=col.body)
-        res31 = _stage("verify", _sim, block31, record, draw)
+        block31, res31 = _stage("verify", margin.simulate, H, w31, record, opts, draw, body=col.body)
         if draw:
             curves.append((f"Eq. 31 design, {w31:.3g} m wide", block31, res31))
 
         # -- design width: smallest width surviving the full record (islands respected), above
-        #    every width found to fail, with the vertical where there is one ----------------------
+        #    every width found to fail, with the vertical where there is one; under a level, the
+        #    verge beside it (its overturning design) ----------------------------------------------
         if hk not in design_cache:
-            design_cache[hk] = design_width(record, up, H, gamma, opts.limit, settings[col], col.body)
+            design_cache[hk] = design_width(record, up, H, gamma, opts.limit, settings[col], col.body,
+                                            opts.restitution)
         ver = design_cache[hk]
-        if draw:  # the column at its design width, for the figure
-            wv = float(ver.width)
-            block_v = rocking.Block.from_dimensions(H, wv, cap_mass_ratio=gamma, body=col.body)
-            curves.append((f"design width, {wv:.3g} m", block_v, _stage("verify", _sim, block_v, record, True)))
+        if draw or (opts.limit is not None and hk not in margin_cache):
+            curves += _stage("verify", margin.design_curves, H, ver, record, up, opts, margin_cache, draw,
+                             hk)
+        if draw:
             histories.append((col.label, curves))
-        valid, need = _stage("verify", validity.fields, col, block, record, up, ver, gamma,
-                             opts.friction, block31, extra_cache)
+        valid, need = _stage("verify", validity.fields, col, block_s, record, up, ver, gamma,
+                             opts.friction, block31, extra_cache, opts.restitution)
         frictions.append((col.label, need))
 
         row = dict(base)
@@ -552,12 +567,15 @@ def _process(task: Task):
         row.update(_as_stands_fields(block, designed, res))
         row.update(_eq31_design_fields(H, w31, res31))
         row.update(_design_width_fields(col, ver))
+        row.update(margin_cache.get(hk, margin.MARGIN_COLUMNS.blank()))
+        if opts.restitution is not None:
+            row.update(margin.restitution_fields(H, ver, opts))
         row.update(_check_fields(ver))
         row.update(_stage("verify", site.extra_fields, H, block, record, fitting, opts, extra_cache,
                           col.body))
-        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, ver))
+        row.update(_stage("verify", vertical.fields, block, record, up, shown_vertical, ver, opts))
         row.update(valid)
-        rows.append(row)
+        rows.append({k: row[k] for k in fields})
 
     return rows, (record, fit, fitting, histories, velocity), design_cache, (frictions, opts.friction)
 
@@ -568,20 +586,22 @@ def _height_key(col):
     return col.height if col.body == "rectangular" else (col.height, col.body)
 
 
-def design_width(record, up, height, cap_mass_ratio, limit, settings, body="rectangular"):
+def design_width(record, up, height, cap_mass_ratio, limit, settings, body="rectangular", restitution=None):
     """The design width of a column ``height`` (m) tall under ``record`` (with its vertical ``up``
     where there is one, :func:`pipeline.batch.vertical.design`).  With a level ``limit``: the
     level's design first, then the overturning design where it can change it (a width that
     overturns fails every level; ``rocking.required_width(..., overturning=True)``: its search, its
     check above the level's width), the level with each motion at least that motion's
-    overturning width; ``.overturning_width`` is that design's width."""
+    overturning width; ``.overturning_width`` is that design's width.  ``restitution``: a
+    :class:`rocking.restitution.Restitution` (a band: the design covering it, each value designed
+    so) or None (Eq. 5)."""
     import rocking
 
-    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings, body=body)
+    kw = dict(rule="exact", cap_mass_ratio=cap_mass_ratio, settings=settings, body=body, eta=restitution)
     over = None if limit is None else True
     alone = _stage("verify", rocking.required_width, height, record, limit=limit, overturning=over, **kw)
     return _stage("verify", vertical.design, record, up, height, alone, cap_mass_ratio, limit, over,
-                  body)
+                  body, restitution)
 
 
 def _check_settings(task: Task) -> dict:
@@ -608,16 +628,16 @@ def _classify(record):
 EXACT_KSECTION = 4
 
 
-def _exact_by_body(fitting, blocks, cap_mass_ratio=0.0) -> dict:
+def _exact_by_body(fitting, blocks, cap_mass_ratio=0.0, restitution=None) -> dict:
     """:func:`_exact_by_shape` for the blocks of each body, by its own impact rule."""
     exact = {}
     for kind in dict.fromkeys(["rectangular"] + [b.body.kind for b in blocks]):
         exact.update(_exact_by_shape(fitting, [b for b in blocks if b.body.kind == kind],
-                                     cap_mass_ratio, kind))
+                                     cap_mass_ratio, kind, restitution))
     return exact
 
 
-def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0, body="rectangular") -> dict:
+def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0, body="rectangular", restitution=None) -> dict:
     """Exact minimum tan(alpha) of every fitting pulse for every block: ``{(shape, block): tan}``.
 
     One ``rocking.min_slenderness_batch`` call per shape covers all the blocks (the similarity law:
@@ -626,7 +646,7 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0, body="rectangular") -> 
     step (three runs a solver call: a pulse run is short, and a call's own cost, not the runs,
     decides; measured, 10 % less CPU than bisection on the pulses fitted to a real pair's
     directions, 40 % at pTp 2-4, answers within 1e-9 relative of it; the safe islands below it
-    are not reported here).
+    are not reported here).  ``restitution``: as the run's (a band: the answer covering it).
     """
     import rocking
     from pulses import G
@@ -639,9 +659,11 @@ def _exact_by_shape(fitting, blocks, cap_mass_ratio=0.0, body="rectangular") -> 
         key = (c.shape, tuple(p_tp), abs(c.ap) / G, cap_mass_ratio)  # its every input
         if body != "rectangular":
             key += (body,)
+        if restitution is not None:
+            key += (str(restitution),)
         res = memo.remembered("slenderness", key, lambda: rocking.min_slenderness_batch(
             c.shape, p_tp, [abs(c.ap) / G] * len(blocks), refine="top", ksection=EXACT_KSECTION,
-            cap_mass_ratio=cap_mass_ratio, body=body))
+            cap_mass_ratio=cap_mass_ratio, body=body, eta=restitution))
         for b, r in zip(blocks, res):
             out[(c.shape, b)] = float(r.tan_alpha)
     return out

@@ -92,7 +92,7 @@ def _as_given(res: dict, task: Task, swaps: dict) -> dict:
         row["file"] = task.path
         if "file2" in row:
             row["file2"] = task.path2
-    res[worker.TEXT] = worker.rows_text(res["rows"])  # with the paths as given
+    res[worker.TEXT] = worker.rows_text(res["rows"], task.options)  # with the paths as given
     if res["failure"]:
         res["failure"]["file"] = task.path
         res["failure"]["reason"] = given(res["failure"]["reason"])

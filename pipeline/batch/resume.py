@@ -151,20 +151,22 @@ def _digest(raw: bytes) -> str:
     return hashlib.sha256(raw).hexdigest()
 
 
-def report_rows_text(raw: bytes) -> str | None:
+def report_rows_text(raw: bytes, fields=None) -> str | None:
     """The rows of a per-record report (its text after the header line), or None if the header is
     not the present one."""
     text = raw.decode("utf-8", "surrogateescape")
     head, sep, rest = text.partition("\n")
-    if not sep or head + "\n" != report.csv_text(_fields(), []):
+    if not sep or head + "\n" != report.csv_text(fields or _fields(), []):
         return None
     return rest
 
 
-def _fields():
-    from .record import FIELDS
+def _fields(options=None):
+    """The columns of the reports of a run with ``options`` (None: ``--limit none``'s, the
+    columns every run has)."""
+    from .record import FIELDS, fields_for
 
-    return FIELDS
+    return FIELDS if options is None else fields_for(options)
 
 
 def typed(cell: str):
@@ -182,9 +184,10 @@ def typed(cell: str):
     return value if report.fmt(value) == cell else cell
 
 
-def rows_from_text(rows_text: str) -> list[dict]:
-    """Rows (dicts of :func:`typed` values) of report text without its header."""
-    fields = _fields()
+def rows_from_text(rows_text: str, fields=None) -> list[dict]:
+    """Rows (dicts of :func:`typed` values) of report text without its header (``fields``: its
+    columns; default those every run has)."""
+    fields = fields or _fields()
     return [{f: typed(c) for f, c in zip(fields, cells)} for cells in csv.reader(io.StringIO(rows_text))]
 
 
@@ -250,7 +253,7 @@ class Journal:
             fig = report._regular_file_bytes(self.folder / report.record_plot_name(task.record_id))
             if fig is None or entry[2] == "-" or _digest(fig) != entry[2]:
                 return None
-        return report_rows_text(raw)
+        return report_rows_text(raw, _fields(task.options))
 
     def add(self, record_id: str, key: str, report_raw: bytes, figure_raw: bytes | None,
             form: str | None = None) -> None:

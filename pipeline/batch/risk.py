@@ -3,7 +3,7 @@
 After the batch, each column's suite (every record with results; a pair by the directions the run
 designed for, measured by its RotD50) is assessed against the site's hazard curve by
 :func:`rocking.risk.site.assess`: the annual rate of overturning of each ``--block`` column as it
-stands (and of the ``--limit`` level), and with ``--target-rate`` or ``--target-poe`` the width
+stands (and of the level a ``--limit R`` names, as ``--fragility``'s), and with ``--target-rate`` or ``--target-poe`` the width
 for the target of every column.  Files: ``risk.csv``, ``risk_records.csv``, ``risk_widths.csv``,
 ``risk_disaggregation.csv``, ``fragility.xml`` (OpenQuake NRML) and with plots
 ``plots/risk_widths.png`` and ``plots/risk_disaggregation.png``.  The hazard file is read and
@@ -186,8 +186,8 @@ def assess_columns(tasks, rows, options, jobs, say):
                 raise ValueError("a column given by its height only: give --target-rate or --target-poe")
             out[col.label] = assess(suite, ro.curve, height=col.height, width=col.width,
                                     target_rate=ro.target_rate, years=ro.years, age=ro.age,
-                                    limit=options.limit, restitution=ro.restitution, seed=ro.seed,
-                                    cap_mass_ratio=options.cap_mass_ratio, jobs=jobs or 1)
+                                    limit=options.fragility_limit, restitution=ro.restitution, seed=ro.seed,
+                                    cap_mass_ratio=options.cap_mass_ratio, jobs=jobs or 1, body=col.body)
         except ValueError as exc:
             out[col.label] = str(exc)
             say(f"pipeline run: --hazard: column {col.label}: {exc}")

@@ -19,7 +19,7 @@ from .. import interrupts
 
 from . import joblog, outlock, passes, resume, risk, site
 from ..args import ArgumentError, output_folder
-from .record import COLUMNS, FAILURE_COLUMNS, FAILURE_FIELDS, FIELDS, failure
+from .record import FAILURE_COLUMNS, FAILURE_FIELDS, columns_for, failure, fields_for
 from . import executors
 from .executors import _serial, execute
 from .scheduler import ClusterLost
@@ -89,7 +89,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
     problems = []
     try:
         if res["rows"]:
-            outputs.write(report.record_csv_name(rid), res.get(TEXT) or report.csv_text(FIELDS, res["rows"]))
+            outputs.write(report.record_csv_name(rid), res.get(TEXT) or report.csv_text(fields_for(task.options), res["rows"]))
         else:  # a report from an earlier run would look like this record's
             outputs.remove(report.record_csv_name(rid))
     except OSError as exc:
@@ -197,7 +197,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
         else:
             print(msg, file=sys.stderr)
 
-    header = report.csv_text(FIELDS, [])
+    header = report.csv_text(fields_for(options), [])
     stream = _serial([])
 
     more = _passes(plan, tasks, journal, keys, texts, options, by_pair, force, bar)
@@ -304,7 +304,7 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
     task = tasks[i]
     figure = res.get("plot")
     _write_record(outputs, task, res, options.plots and task.plot, say)
-    texts[i] = (res.get(TEXT) or report.csv_text(FIELDS, res["rows"]))[len(header):]  # made by the worker
+    texts[i] = (res.get(TEXT) or report.csv_text(fields_for(task.options), res["rows"]))[len(header):]  # made by the worker
     failures[i] = res["failure"]
     plan.note(task, res["rows"])
     if res["failure"] or not res["rows"] or keys[i] is None:
@@ -369,14 +369,14 @@ def _reusable(tasks, journal, force: bool, options, plan, by_pair):
         kept = {} if force else _settled_pair(tasks, indices, journal, version)
         for i, (form, keys[i], texts[i]) in kept.items():
             tasks[i] = form
-            plan.note(form, resume.rows_from_text(texts[i]))
+            plan.note(form, resume.rows_from_text(texts[i], fields_for(options)))
         plan.held -= set(kept)
     for t in list(tasks):
         if t.index in plan.held or texts[t.index]:
             continue
         keys[t.index], texts[t.index] = _reuse(t, journal, force, version)
         if texts[t.index]:
-            plan.note(t, resume.rows_from_text(texts[t.index]))
+            plan.note(t, resume.rows_from_text(texts[t.index], fields_for(options)))
         else:
             journal.drop(t.record_id)
             todo.append(t)
@@ -425,7 +425,7 @@ def _later_pass(plan, tasks, journal, keys, texts, options, force):
             else:
                 tasks[t.index] = t
                 texts[t.index] = kept
-                plan.note(t, resume.rows_from_text(kept))
+                plan.note(t, resume.rows_from_text(kept, fields_for(options)))
                 found = True
         if todo or not found:
             plan.sent(todo)
@@ -485,12 +485,13 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     outputs = _Figures(outputs, say)
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
-    outputs.write(report.COLUMNS_MD, report.columns_markdown(COLUMNS, FAILURE_COLUMNS.columns)
-                  + site.columns_markdown() + design_table.columns_markdown()
+    outputs.write(report.COLUMNS_MD, report.columns_markdown(columns_for(options), FAILURE_COLUMNS.columns)
+                  + site.columns_markdown() + design_table.columns_markdown(options.limit is not None,
+                                                                           options.restitution is not None)
                   + (risk.columns_markdown() if options.risk is not None else ""))
     # the rows as the reports hold them, so that a resumed run writes the same files
-    rows = resume.rows_from_text(text)
-    site.write_outputs(outputs, rows, FIELDS, options, failed, render)
+    rows = resume.rows_from_text(text, fields_for(options))
+    site.write_outputs(outputs, rows, fields_for(options), options, failed, render)
     answers, risk_rows = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
     if options.plots and rows:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
@@ -507,7 +508,7 @@ def write_answer(outputs, out, tasks, rows, failures, failed, options, answers=N
     """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run).
     ``answers``: each column's risk at the site (pipeline.batch.risk.write_outputs)."""
     design = design_table.design_rows(rows, failed, answers)
-    outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.DESIGN_FIELDS, design))
+    outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.design_fields(rows), design))
     ids = [t.record_id for t in tasks]
     this_run = set(outfiles.fixed_files(options))  # a figure of an earlier run with other options is not shown
     names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", report.SUITE_PLOT),

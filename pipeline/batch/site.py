@@ -20,7 +20,7 @@ from . import memo, peer_inputs
 from .pairs import SiteError, directions  # noqa: F401 (tests import directions here)
 from .peer_inputs import PEER_TP
 from ..reports.pulse_row import NOT_PULSE_WARNING, RUN_PULSE_COLUMNS, classification_fields  # noqa: F401 (tests import them here)
-from ..args import SCALE_RANGE, parse_cap_mass_ratio, parse_limit, parse_up_to
+from ..args import SCALE_RANGE, parse_cap_mass_ratio, parse_up_to
 from ..reports.report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
                      Columns)
 
@@ -127,14 +127,15 @@ def extra_fields(H, block, record, fitting, options, cache, body="rectangular") 
     ``body``'s shape, rocking.bodies)."""
     import rocking
 
+    from . import margin
+
     g = options.cap_mass_ratio
     key = ("envelope", H) if body == "rectangular" else ("envelope", H, body)
     if key not in cache:
         widths = [float(rocking.required_width(H, c.pulse, rule="envelope", shape=c.shape,
                                                cap_mass_ratio=g, body=body).width) for c in fitting]
         w = max(widths)
-        res = rocking.simulate(rocking.Block.from_dimensions(H, w, cap_mass_ratio=g, body=body),
-                               record)
+        res = margin.simulate(H, w, record, options, body=body)[1]
         cache[key] = ENVELOPE_COLUMNS.row({"envelope_width_m": w,
                                            "envelope_width_overturns": bool(res.overturned)})
     fields = dict(cache[key])
@@ -143,7 +144,10 @@ def extra_fields(H, block, record, fitting, options, cache, body="rectangular") 
         return fields
     from pulses import G
 
-    cs = rocking.critical_scale(block, record, up_to=options.up_to, limit=options.limit)
+    # with a restitution band, the weakest of its values (the smallest critical scale)
+    scales = [rocking.critical_scale(b, record, up_to=options.up_to, limit=options.fragility_limit)
+              for b in margin.blocks(H, block.width, options)]
+    cs = min(scales, key=lambda s: math.inf if s.scale is None else s.scale)
     fields.update(FRAGILITY_COLUMNS.row({
         "critical_scale": cs.scale,
         "critical_pga_g": None if cs.critical_pga is None else cs.critical_pga / G,
@@ -176,24 +180,18 @@ def add_options(parser) -> None:
                              "lone columns)")
     parser.add_argument("--fragility", action=argparse.BooleanOptionalAction, default=False,
                         help="collapse fragility of each --block column as it stands: the critical "
-                             "scale factor per record and direction, the suite's lognormal curve")
+                             "scale factor per record and direction, the suite's lognormal curve "
+                             "(with --limit R given, the fragility of exceeding max|theta|/alpha = R)")
     parser.add_argument("--up-to", metavar="K", default="10",
                         help="--fragility: largest scale factor examined (default 10)")
-    parser.add_argument("--limit", metavar="R", default=None,
-                        help="performance level: design widths for max|theta|/alpha <= R and "
-                             "critical scales at which it first exceeds R, 0 < R <= 1 (default: "
-                             "overturning). Each column's design width is at least its "
-                             "overturning design width, computed where it can change the level's "
-                             "(overturning_width_m): a width that overturns fails every level "
-                             "(about as many solver runs as an overturning design; docs/design.md)")
 
 
 def options_from_args(args) -> dict:
-    """``cap_mass_ratio``, ``fragility``, ``up_to``, ``limit`` of :class:`pipeline.batch.tasks.Options`
-    (the rules of :mod:`pipeline.args`, which ``pipeline.design()`` follows too)."""
-    limit = getattr(args, "limit", None)
+    """``cap_mass_ratio``, ``fragility``, ``up_to`` of :class:`pipeline.batch.tasks.Options`
+    (the rules of :mod:`pipeline.args`, which ``pipeline.design()`` follows too; ``--limit`` and
+    ``--restitution``: :func:`pipeline.commands.run.options_from`)."""
     return {"cap_mass_ratio": parse_cap_mass_ratio(args.cap_mass_ratio), "fragility": bool(args.fragility),
-            "up_to": parse_up_to(args.up_to), "limit": None if limit is None else parse_limit(limit)}
+            "up_to": parse_up_to(args.up_to)}
 
 
 # -- after the run: pairs, suite, fragility -----------------------------------------------------------
@@ -334,9 +332,10 @@ FRAGILITY_CURVE_COLUMNS = Columns(
 CURVE_POINTS = 60
 
 
-def _critical(group):
+def _critical(group, limit=None):
     """The weakest direction of one record: a :class:`rocking.CriticalScale`-like entry for
-    :func:`rocking.fragility` (scale, PGA and the largest factor examined)."""
+    :func:`rocking.fragility` (scale, PGA and the largest factor examined; ``limit`` the level of
+    the critical scales, None: overturning)."""
     from pulses import G
     from rocking.fragility import CriticalScale
 
@@ -347,12 +346,13 @@ def _critical(group):
     pga = r["pga_g"] * G
     return CriticalScale(scale=r["critical_scale"], islands=[], up_to=r["fragility_up_to"],
                          uplift_scale=r["uplift_scale"], pga=pga, n_scan=0, step=0.0, resolution=0.0,
-                         near=0.0, rtol=0.0, runs=0, calls=0, limit=r.get("design_limit"))
+                         near=0.0, rtol=0.0, runs=0, calls=0, limit=limit)
 
 
-def fragility_tables(rows):
+def fragility_tables(rows, limit=None):
     """``(summary rows, curve rows, fits)`` of ``--fragility``; ``fits`` maps a column to
-    ``(Fragility by scale, Fragility by PGA, critical entries)`` for the plot."""
+    ``(Fragility by scale, Fragility by PGA, critical entries)`` for the plot; ``limit``: the level
+    of the critical scales (``Options.fragility_limit``; None: collapse, overturning)."""
     import numpy as np
     import rocking
 
@@ -362,7 +362,7 @@ def fragility_tables(rows):
             by_column.setdefault(r["column"], []).append(r)
     summary, curve, fits = [], [], {}
     for label, crows in by_column.items():
-        entries = [_critical(g) for g in _groups(crows).values()]
+        entries = [_critical(g, limit) for g in _groups(crows).values()]
         n_failed = sum(e.scale is not None for e in entries)
         level = entries[0].limit if entries else None
         # a critical scale under a level is where max|theta|/alpha first exceeds it: it does not
@@ -410,7 +410,7 @@ def write_outputs(outputs, rows, fields, options, failed=None, render=None) -> N
     if options.plots and rows:
         outputs.write(SUITE_PLOT, render("plot_site:suite_figure_png", rows, suite))
     if options.fragility:
-        summary, curve, fits = fragility_tables(rows)
+        summary, curve, fits = fragility_tables(rows, options.fragility_limit)
         outputs.write(FRAGILITY_CSV, report.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
         outputs.write(FRAGILITY_CURVE_CSV, report.csv_text(list(FRAGILITY_CURVE_COLUMNS.names), curve))
         if options.plots and fits:

@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass, field
 
 from ..reports.outfiles import RESERVED_IDS
+from .margin import DEFAULT_LIMIT
 
 @dataclass(frozen=True)
 class Column:
@@ -52,8 +53,15 @@ class Options:
     cap_mass_ratio: float = 0.0
     fragility: bool = False
     up_to: float = 10.0
-    #: the performance level (``--limit`` R: max|theta|/alpha <= R); None: overturning
-    limit: float | None = None
+    #: the performance level (``--limit`` R: max|theta|/alpha <= R; default 0.5, the paper's
+    #: dependable design); None (``--limit none``): the verge of overturning alone
+    limit: float | None = DEFAULT_LIMIT
+    #: the level of ``--fragility``'s critical scales: ``--limit R`` given (R); None: collapse
+    #: (overturning), also where the design's level is the default one
+    fragility_limit: float | None = None
+    #: ``--restitution``: a :class:`rocking.restitution.Restitution` (a factor of Eq. 5, an eta or an
+    #: r; one value or a band) every block of the run is made with; None: Eq. 5
+    restitution: object = None
     #: ``"auto"``: use a record's known vertical (pipeline.batch.vertical); ``"none"``: horizontal only
     vertical: str = "auto"
     #: ``--thorough``: every direction of a pair gets the check above its search width and

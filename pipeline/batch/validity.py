@@ -15,9 +15,10 @@ VALIDITY_COLUMNS = Columns(
     ("body", "-", "The body that rocks: `rectangular` (`--block HxW`), `cylinder (planar rocking)` "
                   "(`--block cyl:HxD`: a solid circular column of diameter D rocking in a plane, "
                   "no wobbling or rolling; docs/theory.md, \"Bodies\")."),
-    ("restitution", "-", "The coefficient of restitution the responses used: `Eq. 5` (Housner's "
-                         "rule for the body, the largest for which it rocks; the cylinder's own "
-                         "rule for a cylinder) or the value given."),
+    ("impact_rule", "-", "The restitution the responses used, in words: `Eq. 5` (Housner's rule "
+                         "for the body, the largest for which it rocks; the cylinder's own rule for "
+                         "a cylinder), a factor of it (`0.97 x Eq. 5`) or the value given "
+                         "(`--restitution`, whose text is in `restitution`)."),
     ("eta", "-", "The velocity ratio at impact eta of the column as it stands (the energy ratio "
                  "is r = eta^2); blank for `--height`."),
     ("design_eta", "-", "eta of the column at its design width (Eq. 5 follows the width)."),
@@ -69,17 +70,25 @@ def _need(block, record, up):
     return rocking.friction_demand(res, record, vertical=up), res
 
 
-def fields(col, block, record, up, design, gamma, mu, eq31_block, cache):
+def _restitution_words(restitution, body) -> str:
+    """The restitution a row's runs used, in words: Eq. 5 (a factor of it), or the body's rule."""
+    rule = "Eq. 5" if body.is_rectangular else f"Housner's rule for the {body.kind}"
+    if restitution is None or restitution.is_housner:
+        return rule
+    return restitution.describe().replace("Eq. 5", rule)
+
+
+def fields(col, block, record, up, design, gamma, mu, eq31_block, cache, restitution=None):
     """The :data:`VALIDITY_COLUMNS` of one row, and the curves of its friction figure
     ``[(label, FrictionDemand)]``; ``design``: the row's :class:`rocking.RequiredWidth`,
-    ``cache``: the record's (a height's design is judged once)."""
-    import rocking
+    ``cache``: the record's (a height's design is judged once); ``restitution``: the run's
+    ``--restitution`` (None: the body's own impact rule)."""
     from rocking.bodies import Body
 
     body = Body.parse(col.body)
     curves, values = [], dict.fromkeys(VALIDITY_COLUMNS.names)
-    values.update(body=body.describe(), restitution="Eq. 5" if body.is_rectangular else
-                  f"Housner's rule for the {body.kind}", friction_mu=mu)
+    values.update(body=body.describe(), impact_rule=_restitution_words(restitution, body),
+                  friction_mu=mu)
     lift = []
     if block is not None:
         need, res = _need(block, record, up)
@@ -105,11 +114,10 @@ def fields(col, block, record, up, design, gamma, mu, eq31_block, cache):
 
 def _design(col, design, record, up, gamma, mu, eq31_block) -> dict:
     """The design width's (and the Eq. 31 design's) friction demand and verdicts."""
-    import rocking
     from rocking.sliding import sliding_width
 
     width = float(design.width)
-    block = rocking.Block.from_dimensions(col.height, width, cap_mass_ratio=gamma, body=col.body)
+    block = design.block  # with the restitution the design was made with (a band: the value that governed)
     need, res = _need(block, record, up)
     need31, _ = _need(eq31_block, record, up)
     values = {"design_eta": block.eta, "design_friction_demand": need.max_demand,
@@ -121,8 +129,9 @@ def _design(col, design, record, up, gamma, mu, eq31_block) -> dict:
         values.update(design_slides=check.slides, design_t_slide_s=check.t_slide,
                       eq31_width_slides=need31.judge(mu).slides)
         if check.slides:
+            eta = design.restitution_governing if design.restitution_values else design.eta
             found = sliding_width(col.height, record, width, mu, body=col.body,
-                                  cap_mass_ratio=gamma, vertical=up)
+                                  cap_mass_ratio=gamma, eta=eta, vertical=up)
             values["friction_width_m"] = found.width
             out["reason"] = found.reason
     return out
@@ -130,7 +139,7 @@ def _design(col, design, record, up, gamma, mu, eq31_block) -> dict:
 
 def _words(values, body, lift, up, reason) -> str:
     """The ``validity`` cell."""
-    parts = [f"body: {body.describe()}", f"restitution: {values['restitution']}"]
+    parts = [f"body: {body.describe()}", f"restitution: {values['impact_rule']}"]
     mu = values["friction_mu"]
     demand = values["design_friction_demand"]
     if values["friction_demand"] is not None:

@@ -144,13 +144,13 @@ def scaled(task, up):
 
 
 def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overturning=None,
-           body="rectangular"):
+           body="rectangular", restitution=None):
     """The design width of a column ``height`` (m) tall: ``horizontal`` (the horizontal motion's
     answer) where there is no vertical or it reaches -g, else the wider of it and the answer with
     the vertical (``rocking.required_width(..., vertical=)``, ``governed_by`` set); with a level,
     ``overturning``: True (each motion's overturning design where it can change the level's: the
     level with each motion is at least the overturning design with it), as ``horizontal`` was
-    designed, or the overturning design this function gave."""
+    designed, or the overturning design this function gave; ``restitution`` as ``horizontal``'s."""
     import numpy as np
 
     import rocking
@@ -160,12 +160,13 @@ def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overt
         return horizontal
     return rocking.required_width(height, record, rule="exact", vertical=up, horizontal=horizontal,
                                   cap_mass_ratio=cap_mass_ratio, limit=limit, overturning=overturning,
-                                  body=body)
+                                  body=body, eta=restitution)
 
 
-def fields(block, record, up, shown_file, designed=None) -> dict:
+def fields(block, record, up, shown_file, designed=None, options=None) -> dict:
     """The :data:`VERTICAL_COLUMNS` of one row (blank without a vertical); ``designed``: the
-    answer of :func:`design` (its ``vertical_width`` is the design width with the vertical)."""
+    answer of :func:`design` (its ``vertical_width`` is the design width with the vertical);
+    ``options``: the run's (its restitution; a band: the most demanding of its values)."""
     import numpy as np
 
     import rocking
@@ -182,7 +183,12 @@ def fields(block, record, up, shown_file, designed=None) -> dict:
     if designed is not None and designed.vertical_width is not None:
         values["vertical_design_width_m"] = float(designed.vertical_width)
     if block is not None:
-        res = rocking.simulate(block, record, vertical=up, history=False)
+        if options is None:
+            res = rocking.simulate(block, record, vertical=up, history=False)
+        else:
+            from . import margin
+
+            res = margin.simulate(block.height, block.width, record, options, vertical=up)[1]
         values.update(vertical_overturns=bool(res.overturned), vertical_max_theta_ratio=float(res.max_rotation_ratio),
                       vertical_lifts_off=bool(res.lifts_off),
                       vertical_t_lift_off_s=None if not res.lifts_off else float(res.t_lift_off),

@@ -7,7 +7,7 @@ import os
 
 from . import joblog, memo
 from .quiet import quiet_now  # noqa: F401 (what the pools' initializers are given)
-from .record import FIELDS, failure, process_record
+from .record import failure, fields_for, process_record
 from .tasks import Task
 
 
@@ -72,7 +72,7 @@ def work(task: Task) -> dict:
     # main process's to getrusage (forkserver), so a batch's CPU is the sum of these
     res[joblog.CPU] = time.process_time() - cpu
     res[joblog.WORKER] = joblog.here()
-    res[TEXT] = rows_text(res["rows"])
+    res[TEXT] = rows_text(res["rows"], task.options)
     return res
 
 
@@ -101,13 +101,13 @@ def work_many(tasks: list[Task]) -> list[dict]:
 TEXT = "text"
 
 
-def rows_text(rows):
-    """``<record>.csv``'s text of ``rows``, or None where they do not match the columns (the main
-    process then fails as it did)."""
+def rows_text(rows, options):
+    """``<record>.csv``'s text of ``rows`` (the columns of the run's ``options``), or None where
+    they do not match the columns (the main process then fails as it did)."""
     from ..reports.report import ReportError, csv_text
 
     try:
-        return csv_text(FIELDS, rows)
+        return csv_text(fields_for(options), rows)
     except ReportError:
         return None
 

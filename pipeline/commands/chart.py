@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import time
 
-from ..args import ArgumentError, ShapeNames, parse_acceleration, parse_column_block, parse_positive
+from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration,
+                    parse_column_block, parse_positive, parse_restitution)
 
 
 def _floats(text, what):
@@ -41,6 +42,7 @@ def add_parser(subparsers):
                                    "marked on the chart")
     p.add_argument("--csv", help="write the table to this CSV file")
     p.add_argument("--plot", help="write the chart to this PNG file")
+    add_restitution_option(p)
     p.set_defaults(func=run)
 
 
@@ -78,18 +80,23 @@ def run(args) -> int:
     check_file_options(args, "chart")
     pulse = _your_pulse(args)
     column = parse_column_block(args.block) if args.block else None
+    eta = parse_restitution(args.restitution)
     if args.heights:
         if pulse is None:
             raise ArgumentError("--heights needs your pulse: --pulse SHAPE --ap AMPLITUDE --tp PERIOD")
-        return _run_heights(args, _heights(args.heights), pulse, column)
+        return _run_heights(args, _heights(args.heights), pulse, column, eta)
     shapes = ShapeNames().names() if args.pulse == "all" else [args.pulse]
     ptp = _floats(args.ptp, "--ptp") if args.ptp else CHART_PTP
     apg = _floats(args.apg, "--apg") if args.apg else CHART_APG
     start = time.perf_counter()
-    frame = rocking.slenderness_chart(shapes, ptp, apg, criterion=args.criterion)
+    frame = rocking.slenderness_chart(shapes, ptp, apg, criterion=args.criterion, eta=eta)
     elapsed = time.perf_counter() - start
     print(f"Exact minimum tan(alpha) ({args.criterion}) for {len(shapes)} shape(s) x {len(ptp)} pTp "
           f"x {len(apg)} ap/g in {elapsed:.1f} s; ratio = exact / Eq. 31 (> 1: Eq. 31 unconservative)")
+    if eta is not None:
+        print(f"restitution {eta.describe()}" + (f": a band, {_band_values()} values run at each point, "
+                                                 "the largest tan(alpha) kept (restitution_governing)"
+                                                 if eta.is_band else ""))
     print(f"{'shape':<12} {'pTp':>6} {'max ratio':>10} {'at ap/g':>8} {'min ratio':>10} "
           f"{'islands':>8}")
     for (shape, x), sub in frame.groupby(["shape", "pTp"], sort=False):
@@ -120,7 +127,13 @@ def _mark(pulse, column):
     return shape, block.p * tp, ap / G, block.tan_alpha
 
 
-def _run_heights(args, heights, pulse, column) -> int:
+def _band_values() -> int:
+    from rocking.band import BAND_VALUES
+
+    return BAND_VALUES
+
+
+def _run_heights(args, heights, pulse, column, eta=None) -> int:
     import pulses
 
     from ..reports.outpaths import figure_png, write_output
@@ -129,7 +142,7 @@ def _run_heights(args, heights, pulse, column) -> int:
     shape, ap, tp = pulse
     start = time.perf_counter()
     body = None if column is None else column[2]
-    frame = widths_by_height(pulses.make_pulse(shape, ap, tp), heights, body=body)
+    frame = widths_by_height(pulses.make_pulse(shape, ap, tp), heights, body=body, eta=eta)
     elapsed = time.perf_counter() - start
     title = f"{shape} pulse, ap = {ap / pulses.G:.3g} g, Tp = {tp:g} s: width a column needs"
     print(f"{title}, by rule, {len(heights)} heights in {elapsed:.1f} s (m)")
@@ -142,7 +155,7 @@ def _run_heights(args, heights, pulse, column) -> int:
         import rocking
 
         need = rocking.required_width(h, pulses.make_pulse(shape, ap, tp), rule="exact",
-                                      body=body).width
+                                      body=body, eta=eta).width
         print(f"your column {h:g} x {b:g} m: the exact rule asks for {need:.3f} m "
               + ("(it is wide enough)" if b >= need else "(it is too narrow)"))
     if args.csv:

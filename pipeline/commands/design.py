@@ -9,8 +9,9 @@ import json
 import math
 import sys
 
-from ..args import (ArgumentError, ShapeNames, parse_acceleration, parse_column_block,
-                   parse_column_height, parse_friction, parse_positive)
+from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration,
+                   parse_column_block, parse_column_height, parse_friction, parse_positive,
+                   parse_restitution)
 
 
 
@@ -42,6 +43,7 @@ def add_parser(subparsers):
     p.add_argument("--friction", metavar="MU",
                    help="judge the friction the column (and the exact design) needs under the "
                         "pulse against the base's coefficient MU; default: reported, not judged")
+    add_restitution_option(p)
     p.add_argument("--json", action="store_true", help="print the results as JSON")
     p.set_defaults(func=run)
 
@@ -56,6 +58,48 @@ def _limit(args):
     if not 0.0 < value <= 1.0:
         raise ArgumentError(f"--limit (max|theta|/alpha) must lie in (0, 1], got {args.limit!r}")
     return value
+
+
+def _print_restitution(eta, rules) -> None:
+    """The line that says which restitution the exact rules used (none for Eq. 5)."""
+    if eta is None:
+        return
+    print(f"Restitution: {eta.describe()} (eta the velocity ratio at impact, r = eta^2 the energy "
+          "ratio); the exact rules use it, Eq. 31, Eq. 20 and the envelope do not depend on it"
+          + (f"; a band: {rules['exact']['restitution_values_run']} values run, "
+             f"{rules['exact']['restitution_governing']} governed the exact width"
+             if "restitution_values_run" in rules["exact"] else ""))
+
+
+def _eta_of(height, width, eta):
+    """The block's velocity ratio at impact (a number), or ``"LOW-HIGH"`` over a band's ends."""
+    import rocking
+    from rocking import band
+
+    if not band.is_band(eta):
+        return rocking.Block.from_dimensions(height, width, band.plain(eta)).eta
+    lo, hi = (rocking.Block.from_dimensions(height, width, v).eta for v in (eta.values(2)))
+    return f"{lo:.4g}-{hi:.4g}"
+
+
+def _eta_text(eta) -> str:
+    return eta if isinstance(eta, str) else f"{eta:.3f}"
+
+
+def _required_widths(rules, height, pulse, lam, criterion, eta, body=None) -> None:
+    """Each rule's required width for the column's height (of ``body``'s shape) into ``rules`` (the
+    exact rule with the restitution ``eta``; a band: how many values ran, which governed)."""
+    import rocking
+
+    for name in ("eq31", "eq20", "envelope", "exact"):
+        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=criterion,
+                                   shape=pulse.shape, eta=eta if name == "exact" else None, body=body)
+        rules.setdefault(name, {})
+        rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
+                            "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
+        if w.restitution_values:
+            rules[name].update(restitution_values_run=len(w.restitution_values),
+                               restitution_governing=str(w.restitution_governing))
 
 
 def _pulse(args):
@@ -129,6 +173,7 @@ def run(args) -> int:
     lam = parse_positive(args.lam, "--lam")
     limit = _limit(args)
     mu = parse_friction(args.friction)
+    eta = parse_restitution(args.restitution)
     if args.block is not None:
         height, width, body = parse_column_block(args.block)
         block = rocking.Block.from_dimensions(height, width, body=body)
@@ -140,11 +185,12 @@ def run(args) -> int:
                   "origin": origin},
         "height_m": height, "criterion": args.criterion,
         "body": rocking.Body.parse(body).describe(),
+        "restitution": None if eta is None else str(eta),
     }
     rules = {}
     if block is not None:
         p = block.p
-        exact = rocking.min_slenderness(pulse, p, criterion=args.criterion, body=body)
+        exact = rocking.min_slenderness(pulse, p, criterion=args.criterion, body=body, eta=eta)
         values = {
             "eq31": rocking.eq31(pulse.ap, pulse.tp, p),
             "eq20": rocking.eq20(pulse.ap, pulse.tp, p, lam),
@@ -154,20 +200,17 @@ def run(args) -> int:
         out["envelope_shape"] = pulse.shape
         out["block"] = {"height_m": height, "width_m": width, "p_rad_s": p,
                         "tan_alpha": block.tan_alpha, "alpha_deg": math.degrees(block.alpha),
-                        "eta": block.eta, "pTp": p * pulse.tp}
+                        "eta": _eta_of(height, width, eta), "pTp": p * pulse.tp}
+        if exact.band is not None:
+            out["exact_restitution_governing"] = str(exact.eta)
         out["exact_transitions"] = list(exact.transitions)
         out["exact_safe_islands"] = [list(s) for s in exact.safe_islands]
         for name, value in values.items():
             rules[name] = {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
-    for name in ("eq31", "eq20", "envelope", "exact"):
-        w = rocking.required_width(height, pulse, rule=name, lam=lam, criterion=args.criterion,
-                                   shape=pulse.shape, body=body)
-        rules.setdefault(name, {})
-        rules[name].update({"required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
-                            "p_at_width": w.p, "iterations": w.iterations, "method": w.method})
+    _required_widths(rules, height, pulse, lam, args.criterion, eta, body)
     names = ["eq31", "eq20", "envelope", "exact"]
     if limit is not None:
-        w = rocking.required_width(height, pulse, rule="exact", limit=limit, body=body)
+        w = rocking.required_width(height, pulse, rule="exact", limit=limit, body=body, eta=eta)
         rules["level"] = {"limit": limit, "required_width_m": w.width, "tan_alpha_at_width": w.tan_alpha,
                           "p_at_width": w.p, "iterations": w.iterations, "method": w.method}
         if block is not None:
@@ -184,8 +227,9 @@ def run(args) -> int:
     if block is not None:
         b = out["block"]
         print(f"Block: {height:g} x {width:g} m, p = {b['p_rad_s']:.4g} rad/s, tan(alpha) = "
-              f"{b['tan_alpha']:.4g} (alpha = {b['alpha_deg']:.3g} deg), eta = {b['eta']:.3f}, "
+              f"{b['tan_alpha']:.4g} (alpha = {b['alpha_deg']:.3g} deg), eta = {_eta_text(b['eta'])}, "
               f"pTp = {b['pTp']:.4g}")
+    _print_restitution(eta, rules)
     labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})",
               "envelope": f"envelope ({pulse.shape})",
               "exact": f"exact ({args.criterion})",

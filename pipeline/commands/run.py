@@ -4,8 +4,9 @@ from __future__ import annotations
 import argparse
 
 from ..batch import peer_inputs, risk, site, vertical
-from ..args import (ArgumentError, ShapeNames, add_record_options, add_weighting_option, jobs_count,
-                   parse_column_block, parse_column_height, parse_friction, parse_shapes,
+from ..args import (ArgumentError, ShapeNames, add_record_options, add_restitution_option, add_weighting_option,
+                   jobs_count, parse_column_block, parse_column_height, parse_friction, parse_limit,
+                   parse_restitution, parse_shapes,
                    record_options)
 
 DEFAULT_OUT = "pipeline-output"
@@ -35,6 +36,16 @@ def add_common(parser: argparse.ArgumentParser, default_out: str) -> None:
                         help="write no figures")
     parser.add_argument("--quiet", "-q", action="store_true",
                         help="no progress bar and no messages (the exit status tells)")
+    parser.add_argument("--limit", metavar="R", default=None,
+                        help="performance level of the design width, the width quoted first: "
+                             "max|theta|/alpha <= R, 0 < R <= 1 (default 0.5, the paper's "
+                             "dependable design: peaks at or below alpha/2), at least the "
+                             "overturning design width; that width, the verge (no margin), is "
+                             "reported beside it (overturning_width_m). `none`: the verge alone, "
+                             "as the design width. With --fragility and R given, critical scales "
+                             "at which max|theta|/alpha first exceeds R (without --limit: collapse; "
+                             "docs/design.md)")
+    add_restitution_option(parser)
 
 
 def add_parser(subparsers) -> None:
@@ -119,10 +130,15 @@ def build_columns(blocks, heights):
 
 
 def options_from(args, **overrides):
+    from ..batch.margin import DEFAULT_LIMIT
     from ..batch.tasks import Options
 
+    limit = DEFAULT_LIMIT if args.limit is None else parse_limit(args.limit)
+    # the fragility stays collapse unless a level is asked for by name (--limit R)
     kw = dict(plots=args.plots != "none", plots_all=args.plots == "all",
-              thorough=bool(getattr(args, "thorough", False)))
+              thorough=bool(getattr(args, "thorough", False)), limit=limit,
+              fragility_limit=None if args.limit is None else limit,
+              restitution=parse_restitution(args.restitution))
     kw.update(overrides)
     return Options(**kw)
 
@@ -137,7 +153,7 @@ def main(args) -> int:
     options = options_from(args, shapes=parse_shapes(args.shapes), weighting=args.weighting,
                            friction=parse_friction(getattr(args, "friction", None)),
                            vertical=args.vertical, **record_options(args), **site.options_from_args(args),
-                           risk=risk.options_from_args(args))
+                           risk=risk.options_from_args(args, restitution=parse_restitution(args.restitution)))
     plan = api.Plan(records=list(args.records), columns=columns, options=options, record_opts=record_options(args),
                     pairs=args.pairs, pair=list(args.pair),
                     triplets={(str(a), str(b)): str(v) for a, b, v in args.triplet},

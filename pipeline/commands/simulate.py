@@ -37,7 +37,10 @@ def add_parser(subparsers) -> None:
     p.add_argument("--tol", default="1e-6", help="accepted error in max|theta|/alpha for auto")
     p.add_argument("--duration", help="length of history in s (default: the excitation; longer "
                                       "adds the free rocking after it)")
-    p.add_argument("--eta", help="coefficient of restitution (default Eq. 5)")
+    p.add_argument("--eta", help="coefficient of restitution, the velocity ratio at impact (default Eq. 5)")
+    p.add_argument("--restitution", metavar="VALUE",
+                   help="the restitution as the design commands take it: a factor of Eq. 5 (0.97), "
+                        "eta=V or r=V (the energy ratio); one value (a run has one restitution)")
     p.add_argument("--friction", metavar="MU",
                    help="judge the friction the response needs against the base's coefficient MU "
                         "(default: the demand is reported, not judged)")
@@ -80,6 +83,15 @@ def run(args) -> int:
         eta = float(args.eta) if args.eta.replace(".", "", 1).isdigit() else math.nan
         if not (0.0 <= eta <= 1.0):
             raise ArgumentError(f"--eta must lie in [0, 1], got {args.eta!r}")
+    if args.restitution is not None:
+        from ..args import parse_restitution
+
+        if args.eta is not None:
+            raise ArgumentError("give --eta or --restitution, not both")
+        eta = parse_restitution(args.restitution)
+        if eta.is_band:
+            raise ArgumentError(f"--restitution {args.restitution}: a run has one restitution; a band "
+                                "goes with run, design, chart and spectrum (their answers cover it)")
     block = rocking.Block.from_dimensions(height, width, eta, body=body)
     excitation, label = _excitation(args)
     tol = parse_positive(args.tol, "--tol")

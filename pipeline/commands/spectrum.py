@@ -9,8 +9,8 @@ import math
 import re
 import time
 
-from ..args import (ArgumentError, ShapeNames, parse_acceleration, parse_angle, parse_column_block,
-                    parse_positive)
+from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration, parse_angle,
+                    parse_column_block, parse_positive, parse_restitution)
 
 
 
@@ -51,6 +51,7 @@ def add_parser(subparsers):
     p.add_argument("--ap-range", default="1:6", help="ap/(g tan alpha) range (default 1:6)")
     p.add_argument("--csv", help="write the grid (long format) to this CSV file")
     p.add_argument("--plot", help="write the spectrum plot to this PNG file")
+    add_restitution_option(p)
     p.set_defaults(func=run)
 
 
@@ -74,15 +75,23 @@ def run(args) -> int:
     w0, w1 = _range(args.wp_range, "--wp-range")
     a0, a1 = _range(args.ap_range, "--ap-range")
     start = time.perf_counter()
-    # a circular column's impact rule differs from Eq. 5: its own eta at its alpha
-    eta = None if block is None or block.body.is_rectangular or args.alpha else block.eta
+    eta = parse_restitution(args.restitution)
+    if block is not None and not block.body.is_rectangular and not args.alpha:
+        # a circular column's impact rule differs from Eq. 5: its own eta at its alpha (a factor
+        # given multiplies that rule)
+        if eta is not None and eta.is_band:
+            raise ArgumentError("--restitution: a band goes with a rectangular column's spectrum; give "
+                                "one value for a circular column")
+        eta = rocking.Block.from_dimensions(block.height, block.width, eta, body=block.body).eta
     spec = rocking.overturning_spectrum(alpha, args.pulse, np.linspace(w0, w1, nw),
                                         np.linspace(a0, a1, na), eta=eta)
     elapsed = time.perf_counter() - start
     n = spec.overturned.size
     islands = spec.safe_islands()
+    shown = (f"{spec.eta:.3f}" if not spec.band_runs else
+             f"{eta.describe()} (a band: {spec.band_runs} values run, a point overturns where any does)")
     print(f"Overturning spectrum: {args.pulse} pulse, alpha = {math.degrees(alpha):.4g} deg "
-          f"(tan {math.tan(alpha):.4g}), eta = {spec.eta:.3f}; {nw} x {na} points in "
+          f"(tan {math.tan(alpha):.4g}), eta = {shown}; {nw} x {na} points in "
           f"{elapsed:.2f} s")
     print(f"overturn: {int(spec.overturned.sum())} of {n} points; |theta| > alpha without "
           f"overturning: {int((spec.exceeded_alpha & ~spec.overturned).sum())}; safe-island "

@@ -61,9 +61,10 @@ DESIGN_COLUMNS = Columns(
                                  "every level). Blank without `--limit`."),
     ("eq31_below_design", "-", "The Eq. 31 width is below the design width (Eq. 31 is not conservative "
                                "for this record)."),
-    ("verdict", "-", "The column as it stands: `survives`, `NO` (overturns; with `--limit`, exceeds "
-                     "R), `NO: safe island` (it survives but is narrower than the design width: a "
-                     "wider column fails); blank for `--height`."),
+    ("verdict", "-", "The column as it stands: `survives` (under a level: and keeps max|theta|/alpha "
+                     "<= R), `NO` (overturns), `NO: exceeds level` (under a level: it does not "
+                     "overturn, but max|theta|/alpha exceeds R), `NO: safe island` (it survives but "
+                     "is narrower than the design width: a wider column fails); blank for `--height`."),
     ("check_runs", "-", "Widths the check ran above the search width in the governing direction."),
     ("vertical_lift_off_s", "s", "Earliest time at which g + av < 0 before the response ended, over "
                                  "the directions: the block leaves the ground, which the rocking model "
@@ -93,6 +94,40 @@ RISK_COLUMNS = Columns(
 )
 DESIGN_COLUMNS = Columns(*DESIGN_COLUMNS.columns, *RISK_COLUMNS.columns)
 DESIGN_FIELDS = list(DESIGN_COLUMNS.names)
+
+#: under a performance level (the default): max|theta|/alpha at the design width and at the verge
+MARGIN_DESIGN_COLUMNS = Columns(
+    ("design_max_theta_ratio", "-", "max|theta|/alpha of a column of the design width under the record "
+                                    "(its governing direction; as in summary.csv): at most `design_limit`."),
+    ("overturning_max_theta_ratio", "-", "max|theta|/alpha of a column of `overturning_width_m`, the verge "
+                                         "(no margin), under the record (the direction it comes from): 1 or "
+                                         "more where the column passes its slenderness angle there."),
+)
+#: with ``--restitution``: the restitution of the row's design
+RESTITUTION_DESIGN_COLUMNS = Columns(
+    ("restitution", "-", "`--restitution` as given (a factor of Eq. 5, `eta=V` or `r=V`; `LOW:HIGH` a band)."),
+    ("restitution_values_run", "-", "Single values of the restitution run (a band: its values, ends included)."),
+    ("restitution_governing", "-", "The value whose design width governs (the widest)."),
+    ("design_eta", "-", "The velocity ratio eta at impact at the design width (the governing value)."),
+    ("design_r", "-", "The energy ratio r = eta^2 at impact at the design width."),
+)
+
+
+def design_columns(margin: bool = False, restitution: bool = False) -> tuple:
+    """The columns of ``design.csv``: :data:`DESIGN_COLUMNS`, with after ``overturning_width_m``
+    the margin's (under a level) and the restitution's (with ``--restitution``)."""
+    base = DESIGN_COLUMNS.columns
+    k = DESIGN_COLUMNS.names.index("overturning_width_m") + 1
+    extra = (MARGIN_DESIGN_COLUMNS.columns if margin else ()) + (
+        RESTITUTION_DESIGN_COLUMNS.columns if restitution else ())
+    return base[:k] + extra + base[k:]
+
+
+def design_fields(rows) -> list:
+    """The names of :func:`design_columns` for the rows of ``summary.csv`` (or of ``design.csv``)
+    ``rows``: the extra groups where the rows have them."""
+    first = rows[0] if rows else {}
+    return [n for n, _, _ in design_columns("design_max_theta_ratio" in first, "restitution" in first)]
 
 
 def _groups(rows):
@@ -134,6 +169,24 @@ def _whole(value):
     return str(int(v)) if v is not None and v == int(v) else str(value)
 
 
+def _at_widest(group, width, value):
+    """``value`` of the row of ``group`` whose ``width`` is the widest (the first of equals)."""
+    rows = [r for r in group if number(r.get(width)) is not None]
+    return max(rows, key=lambda r: number(r[width])).get(value) if rows else None
+
+
+def _extra(gov, group) -> dict:
+    """The margin's and the restitution's cells of a design row, where the rows have them."""
+    out = {}
+    if "design_max_theta_ratio" in gov:
+        out.update(MARGIN_DESIGN_COLUMNS.row({
+            "design_max_theta_ratio": gov.get("design_max_theta_ratio"),
+            "overturning_max_theta_ratio": _at_widest(group, "overturning_width_m", "overturning_max_theta_ratio")}))
+    if "restitution" in gov:
+        out.update(RESTITUTION_DESIGN_COLUMNS.row({k: gov.get(k) for k in RESTITUTION_DESIGN_COLUMNS.names}))
+    return out
+
+
 def _meets(r, limit):
     """The column as it stands survives the row's record (and keeps max|theta|/alpha <= limit)."""
     if r.get("overturns") is None:
@@ -154,6 +207,7 @@ def design_rows(rows, failed=None, risk=None) -> list[dict]:
         ratios = [number(r.get("max_theta_ratio")) for r in group]
         ratios = [v for v in ratios if v is not None]
         survives = _bool_all([_meets(r, limit) for r in group]) if block else None
+        overturns = None if not block else any(bool(r.get("overturns")) for r in group)
         adequate = _bool_all([r.get("design_adequate") for r in group]) if block else None
         w31, wd = number(gov.get("eq31_width_m")), number(gov.get("design_width_m"))
         row = DESIGN_COLUMNS.row({
@@ -180,13 +234,16 @@ def design_rows(rows, failed=None, risk=None) -> list[dict]:
             "eq31_below_design": None if (w31 is None or wd is None) else w31 < wd,
             "check_runs": gov.get("check_runs"),
             "verdict": None if survives is None else verdict_text({"survives": survives,
-                                                                   "design_adequate": adequate}),
+                                                                   "design_adequate": adequate,
+                                                                   "overturns": overturns,
+                                                                   "design_limit": limit}),
             "vertical_lift_off_s": (None if not block else min(
                 [t for t in (number(r.get("vertical_t_lift_off_s")) for r in group if r.get("vertical_lifts_off"))
                  if t is not None], default=None)),
             **{k: (risk or {}).get(column, {}).get(k) for k in RISK_COLUMNS.names},
             **_validity(group, gov),
         })
+        row.update(_extra(gov, group))
         out.append(row)
     return out
 
@@ -205,7 +262,7 @@ def _validity(group, gov) -> dict:
 
 def design_csv(rows, failed=None) -> str:
     """The text of ``design.csv``."""
-    return csv_text(DESIGN_FIELDS, design_rows(rows, failed))
+    return csv_text(design_fields(rows), design_rows(rows, failed))
 
 
 # -- the printed table -------------------------------------------------------------------------------
@@ -258,51 +315,101 @@ def pulse_text(row) -> str:
 
 
 def verdict_text(row) -> str:
-    """``survives``, ``NO`` (overturns, or exceeds the level), ``NO: safe island`` (survives, but
-    narrower than the design width: a wider column fails) or ``-``."""
+    """``survives``, ``NO`` (overturns), ``NO: exceeds level`` (under a level ``design_limit``: it
+    does not overturn, but max|theta|/alpha exceeds the level), ``NO: safe island`` (survives,
+    but narrower than the design width: a wider column fails) or ``-``."""
     s = row.get("survives")
     if s is None:
         return "-"
     if not s:
-        return "NO"
+        level = number(row.get("design_limit")) is not None
+        return "NO: exceeds level" if level and row.get("overturns") is False else "NO"
     return "survives" if row.get("design_adequate") else "NO: safe island"
 
 
 def survives_text(row) -> str:
-    """The printed verdict of the column as it stands (:func:`verdict_text`, ``yes`` for survives)."""
-    text = verdict_text(row)
-    return "yes" if text == "survives" else text
+    """The printed verdict of the column as it stands (:func:`verdict_text`, ``yes`` for survives,
+    the level's value for ``NO: exceeds level``), with ``passes alpha`` where the column does not
+    overturn but its max|theta|/alpha reaches 1 (it passes its slenderness angle and comes
+    back)."""
+    text = row.get("verdict") or verdict_text(row)
+    text = {"survives": "yes", "NO: exceeds level": f"NO: exceeds {number(row.get('design_limit')) or 0:g}"}.get(text, text)
+    ratio = number(row.get("max_theta_ratio"))
+    if text not in ("-", "NO") and ratio is not None and ratio >= 1.0:
+        text = "NO: passes alpha" if text.startswith("NO: exceeds") else text + ", passes alpha"
+    return text
+
+
+def passes_text(ratio) -> str:
+    """``, passes alpha`` where ``ratio`` (max|theta|/alpha of a column that does not overturn) is
+    1 or more: the column passes its slenderness angle and comes back; else ``""``."""
+    r = number(ratio)
+    return ", passes alpha" if r is not None and r >= 1.0 else ""
 
 
 def eq31_text(row) -> str:
     """``2.441 m``, or ``0.400 m BELOW`` where the Eq. 31 width is below the design width (``,
-    overturns`` where its design overturns under the record)."""
+    overturns`` where its design overturns under the record; ``, passes alpha`` where it does not
+    but passes its slenderness angle, ``eq31_width_max_theta_ratio`` where the row has it)."""
     text = _m(row.get("eq31_width_m"))
     if text == "-":
         return text
     text += " m"
     if row.get("eq31_below_design"):
         text += " BELOW" + (", overturns" if row.get("eq31_width_overturns") else "")
+    if not row.get("eq31_width_overturns"):
+        text += passes_text(row.get("eq31_width_max_theta_ratio"))
     return text
+
+
+def design_text(row) -> str:
+    """``1.907 m``: the design width (`` (vertical)`` where the vertical governs, ``, passes
+    alpha`` where a column of it passes its slenderness angle)."""
+    w = number(row.get("design_width_m"))
+    if w is None:
+        return "-"
+    return (f"{w:.3f} m" + (" (vertical)" if row.get("design_governed_by") == "with vertical" else "")
+            + passes_text(row.get("design_max_theta_ratio")))
+
+
+def verge_text(row) -> str:
+    """``1.683 m, passes alpha``: the verge beside a level's design width (the overturning design
+    width, no margin), with whether a column of it passes its slenderness angle."""
+    w = number(row.get("overturning_width_m"))
+    if w is None:
+        return "-"
+    return f"{w:.3f} m" + passes_text(row.get("overturning_max_theta_ratio"))
 
 
 HEADERS = ("record", "column", "pulse-like", "governing pulse", "Eq.31 width", "design width",
            "search width", "survives")
+#: the heading of the column added under a performance level (the default): the verge beside the
+#: design width
+VERGE_HEADER = "verge (no margin)"
 #: the heading of the column added where a run used vertical components
 VERTICAL_HEADER = "with vertical"
 
 
 def table_cells(row) -> tuple[str, ...]:
-    """The printed cells of one design row (also the batch table of ``report.html``)."""
+    """The printed cells of one design row (also the batch table of ``report.html``): those of
+    :data:`HEADERS`, with the verge after the design width where the row has the margin's columns
+    (a performance level)."""
     name = display(row["record"])
     d = number(row.get("direction_deg"))
     if d is not None and (row.get("n_directions") or 1) > 1:
         name += f" @{d:.0f}deg"
+    verge = (verge_text(row),) if "overturning_max_theta_ratio" in row else ()
     return (name, display(row.get("column") or "-"), _yes(row.get("pulse_like")), pulse_text(row),
-            eq31_text(row),
-            _m(row.get("design_width_m")) + (" m" if number(row.get("design_width_m")) is not None else "")
-            + (" (vertical)" if row.get("design_governed_by") == "with vertical" else ""),
-            search_text(row), survives_text(row))
+            eq31_text(row), design_text(row)) + verge + (search_text(row), survives_text(row))
+
+
+def headers_for(rows) -> tuple[str, ...]:
+    """The printed table's headings for ``rows`` (:data:`HEADERS`, with :data:`VERGE_HEADER` after
+    the design width under a level)."""
+    if rows and "overturning_max_theta_ratio" in rows[0]:
+        k = HEADERS.index("design width") + 1
+        return HEADERS[:k] + (VERGE_HEADER,) + HEADERS[k:]
+    return HEADERS
 
 
 def search_text(row) -> str:
@@ -347,8 +454,8 @@ def metadata_text(row) -> str | None:
     return display(parts[0] + (": " + ", ".join(site) if site else ""))
 
 
-#: the index of "search width" in :data:`HEADERS`
-FAILS_COLUMN = HEADERS.index("search width")
+#: the printed columns right-aligned (widths, aligned on the decimal point)
+_RIGHT = ("Eq.31 width", "design width", VERGE_HEADER, "search width")
 
 
 def _align_failing(body, col):
@@ -361,12 +468,29 @@ def _align_failing(body, col):
             for c, (h, sep, t) in zip(body, parts)]
 
 
+def _key(row, record="record"):
+    return row.get(record) if record == "record" else (row.get("pair") or row.get("record")), row.get("column"), \
+        number(row.get("direction_deg"))
+
+
+def eq31_ratios(summary) -> dict:
+    """``{(record or pair, column, direction): max|theta|/alpha of the Eq. 31 design}`` of the rows
+    of ``summary.csv``, for :func:`eq31_text` on the design rows."""
+    return {_key(r, "pair"): r.get("eq31_width_max_theta_ratio") for r in summary}
+
+
+def with_eq31_ratio(row, ratios) -> dict:
+    """A design row with ``eq31_width_max_theta_ratio`` (from :func:`eq31_ratios`) for its cells."""
+    return {**row, "eq31_width_max_theta_ratio": ratios.get(_key(row))}
+
+
 def table_text(rows, failures=(), summary=()) -> str:
     """The compact table printed at the end of ``pipeline run``: every design row, then every failed
     record (``failures``: rows of ``failures.csv``) with its reason, then the search report's
     metadata of each record of a PEER download (``summary``: rows of ``summary.csv``)."""
-    headers = HEADERS
-    body = [table_cells(r) for r in rows]
+    headers = headers_for(rows)
+    ratios = eq31_ratios(summary)
+    body = [table_cells(with_eq31_ratio(r, ratios)) for r in rows]
     if any(r.get("survives_vertical") is not None for r in rows):
         # the verdict with the vertical, and the design width with it (the widest over a pair's
         # directions, from summary.csv's rows) beside the horizontal one
@@ -376,13 +500,13 @@ def table_text(rows, failures=(), summary=()) -> str:
             w = number(r.get("vertical_design_width_m"))
             if w is not None:
                 widths[key] = max(w, widths.get(key, w))
-        headers = HEADERS + (VERTICAL_HEADER,)
+        headers = headers + (VERTICAL_HEADER,)
         body = [c + (vertical_text(r) + (f", design {widths[(r['record'], r.get('column'))]:.3f} m"
                                           if (r["record"], r.get("column")) in widths else ""),)
                 for c, r in zip(body, rows)]
-    body = _align_failing(body, FAILS_COLUMN)
+    body = _align_failing(body, headers.index("search width"))
     widths = [max([len(h)] + [len(c[i]) for c in body]) for i, h in enumerate(headers)]
-    right = {4, 5, 6}  # widths, aligned on the decimal point
+    right = {i for i, h in enumerate(headers) if h in _RIGHT}  # widths, aligned on the decimal point
 
     def line(cells):
         return "  ".join(c.rjust(w) if i in right else c.ljust(w)
@@ -426,12 +550,17 @@ def verdict_lines(rows) -> list[str]:
         level = "" if limit is None else f" for max theta/alpha <= {limit:g}"
         line = (f"Suite, column {display(column)}: the design width covering all {n} record(s) is "
                 f"{top:.3f} m{level} (set by {display(gov['record'])})")
+        verges = [v for v in (number(r.get("overturning_width_m")) for r in group) if v is not None]
+        if verges:
+            line += f"; the verge (no margin) is {max(verges):.3f} m"
         if gov.get("width_m") is not None:
             safe = _count(group, "verdict", "NO: safe island")
             fails = _count(group, "verdict", "NO")
+            exceed = _count(group, "verdict", "NO: exceeds level")
             line += (f"; as it stands ({number(gov['width_m']):.3f} m) it "
-                     + ("passes: it survives every record" if not (safe or fails) and top <= number(gov["width_m"])
-                        else f"FAILS: {fails} record(s) overturn it" + ("" if limit is None else " or exceed the level")
+                     + ("passes: it survives every record" if not (safe or fails or exceed) and top <= number(gov["width_m"])
+                        else f"FAILS: {fails} record(s) overturn it"
+                        + ("" if limit is None else f", {exceed} exceed the level")
                         + f", {safe} leave it on a safe island"))
         out.append(line + risk_words(gov))
         out.append(eq31_line(group))
@@ -512,36 +641,44 @@ def check_bin_words() -> str:
     return f"{100.0 * float(DEFAULT_SETTINGS.check_bin_width):g} %"
 
 
+def margin_print(rows) -> str:
+    """What the design width keeps in reserve: under a level, the dependable width and the verge
+    beside it; with ``--limit none``, that the design width is the verge; and where a quoted
+    width lets the column pass its slenderness angle."""
+    limits = {number(r.get("design_limit")) for r in rows if r.get("design_width_m") is not None}
+    if not limits:
+        return ""
+    if limits == {None}:
+        return ("Margin: none, the design width is the verge of overturning (--limit none): at it "
+                "a column may pass its slenderness angle (max theta/alpha >= 1) and come back; "
+                "without --limit the design width keeps max theta/alpha <= 0.5 (docs/design.md). ")
+    shown = ", ".join(f"{v:g}" for v in sorted(v for v in limits if v is not None))
+    passes = sum(1 for r in rows if passes_text(r.get("overturning_max_theta_ratio")))
+    return (f"Margin: the design width keeps max theta/alpha <= {shown} under the record (0.5: the "
+            "dependable design, peaks at or below alpha/2) and is at least the verge. Verge (no "
+            "margin): the narrowest width found not to overturn; where the level governs it is "
+            "checked only above the design width (--limit none checks it in full: it lies between "
+            "the two)" + (f"; at the verge the column passes its slenderness angle on {passes} of "
+                          f"{len(rows)} row(s) (passes alpha)" if passes else "") + ". ")
+
+
 def fine_print(rows) -> str | None:
-    """What was tested above the design width (None where no check ran)."""
+    """What the design width keeps in reserve (:func:`margin_print`) and what was tested above it
+    (None where no check ran)."""
     runs = [number(r.get("check_runs")) for r in rows if number(r.get("check_runs"))]
     if not runs:
-        return None
-    return ("Design width: at least every width the search and the check above it found to "
+        return margin_print(rows).strip() or None
+    return (margin_print(rows) + "Design width: at least every width the search and the check above it found to "
             f"fail, refined just above the widest; the check ran {min(runs):.0f}"
             + (f"-{max(runs):.0f}" if max(runs) > min(runs) else "")
             + f" widths per record from the search width up to {check_reach_words()} (or the "
             "no-uplift width), more where the response varied from one width to the next; thinner "
             "failing slivers may remain (docs/slivers.md). Search width: the "
-            "search's first transition, with how far the design width lies above it."
-            + _level_print(rows))
+            "search's first transition, with how far the design width lies above it.")
 
 
-def _level_print(rows) -> str:
-    """Under ``--limit``: the design width is at least the overturning design's (its widths)."""
-    over = [v for v in (number(r.get("overturning_width_m")) for r in rows) if v is not None]
-    if not over:
-        return ""
-    return (" With the level, the design width is also at least the overturning design width "
-            f"(overturning_width_m, {min(over):.3f}" + (f"-{max(over):.3f}" if max(over) > min(over) else "")
-            + " m here): a width that overturns fails every level.  It is computed where it can "
-            "change the level's: where the level's own width is wider, overturning_width_m is what "
-            "its check above that width established, and the overturning design width lies between "
-            "it and the design width.")
-
-
-def columns_markdown() -> str:
-    """The section of ``columns.md`` for ``design.csv``."""
+def columns_markdown(margin: bool = False, restitution: bool = False) -> str:
+    """The section of ``columns.md`` for ``design.csv`` (its columns as :func:`design_columns`)."""
     cell = lambda text: text.replace("|", "\\|")
     lines = ["", "## Columns of `design.csv`", "",
              "One row per record (a pair once, by its governing direction) and column: the answer of "
@@ -549,5 +686,5 @@ def columns_markdown() -> str:
              "these rows (a click on a heading sorts them), every record's classification, fitted "
              "pulse, verdicts and figure, and the failures: open it in a browser from this folder.", "",
              "| column | unit | meaning |", "|---|---|---|"]
-    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in DESIGN_COLUMNS.columns]
+    lines += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in design_columns(margin, restitution)]
     return "\n".join(lines) + "\n"

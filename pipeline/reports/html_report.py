@@ -16,8 +16,9 @@ import pathlib
 import urllib.parse
 
 from . import report
-from .design_table import (check_reach_words, eq31_text, failing_text, metadata_text, pulse_text, search_text,
-                           survives_text, verdict_lines, fine_print, governing_print, vertical_text)
+from .design_table import (check_reach_words, design_text, eq31_ratios, eq31_text, failing_text, metadata_text,
+                           passes_text, pulse_text, search_text, survives_text, verdict_lines, verge_text,
+                           fine_print, governing_print, vertical_text, with_eq31_ratio)
 from .design_table import number as _num
 from .report import FIT_TOLERANCE
 
@@ -119,18 +120,21 @@ def _anchor(record_id) -> str:
     return "r-" + urllib.parse.quote(report.display(record_id), safe="").replace("_", "%5F").replace("%", "_")
 
 
-def _batch_table(design, anchors) -> list[str]:
+def _batch_table(design, anchors, ratios=None) -> list[str]:
     directions = any(r["direction_deg"] is not None for r in design)  # pairs in the run
     vertical = any(r.get("survives_vertical") is not None for r in design)  # verticals in the run
+    verge = any("overturning_max_theta_ratio" in r for r in design)  # a performance level: the margin
     heads = ["record", "column"] + (["direction (deg)"] if directions else []) + [
         "pulse-like", "velocity Tp (s)", "governing pulse", "ap (g)", "Tp (s)", "Eq. 31 width (m)",
-        "design width (m)", "search width (m)", "widest failing width (m)", "width (m)", "survives"] + (
+        "design width (m)"] + (["verge, no margin (m)"] if verge else []) + [
+        "search width (m)", "widest failing width (m)", "width (m)", "survives"] + (
         ["with vertical"] if vertical else []) + ["max theta/alpha"]
     out = ['<div class="wide"><table class="sortable" id="batch"><thead><tr>'
            + "".join(f"<th>{_e(h)}</th>" for h in heads) + "</tr></thead><tbody>"]
     for r in design:
+        r = with_eq31_ratio(r, ratios or {})
         surv = survives_text(r)
-        cls = {"NO": ' class="no"', "NO: safe island": ' class="island"'}.get(surv, "")
+        cls = ' class="no"' if surv == "NO" else ' class="island"' if surv.startswith("NO:") else ""
         target = anchors.get(r["record"])
         name = _e(r["record"])
         name = f'<a href="#{target}">{name}</a>' if target else name
@@ -145,8 +149,8 @@ def _batch_table(design, anchors) -> list[str]:
             + _cell(r["governing_ap_g"], _fixed(r["governing_ap_g"], 3), numeric=True)
             + _cell(r["governing_tp_s"], _fixed(r["governing_tp_s"], 3), numeric=True)
             + _cell(r["eq31_width_m"], eq31_text(r).replace(" m", ""), numeric=True)
-            + _cell(r["design_width_m"], _fixed(r["design_width_m"])
-                    + (" (vertical)" if r.get("design_governed_by") == "with vertical" else ""), numeric=True)
+            + _cell(r["design_width_m"], design_text(r).replace(" m", "", 1), numeric=True)
+            + (_cell(r.get("overturning_width_m"), verge_text(r).replace(" m", "", 1), numeric=True) if verge else "")
             + _cell(r.get("search_width_m"), search_text(r).replace(" m", ""), numeric=True)
             + _cell(r.get("widest_failing_width_m"),
                     failing_text(r.get("widest_failing_width_m"), r.get("search_width_m"), unit=""), numeric=True)
@@ -202,9 +206,18 @@ def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str
                      + (" (overturns)" if r.get("eq31_width_overturns") else ""),
                      f"design width {_fixed(r.get('design_width_m')) or '-'} m"
                      + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
-                     + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else "")
+                     + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else
+                        " (--limit none: the verge of overturning, no margin)")
+                     + (f" (max theta/alpha {_fixed(r['design_max_theta_ratio'], 2)} there"
+                        + passes_text(r["design_max_theta_ratio"]) + ")"
+                        if _num(r.get("design_max_theta_ratio")) is not None else "")
                      + _overturning_words(r),
                      f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
+            if r.get("restitution_values_run") is not None:
+                parts.append(f"restitution {r['restitution']} ({_whole(r.get('restitution_values_run'))} "
+                             f"value(s) run, {r.get('restitution_governing')} governed: "
+                             f"{r.get('restitution_design_widths_m')}); at the design width eta "
+                             f"{_fixed(r.get('design_eta'), 4) or '-'}, r {_fixed(r.get('design_r'), 4) or '-'}")
             if r.get("check_runs"):
                 share = _num(r.get("failing_share"))
                 parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to "
@@ -215,7 +228,8 @@ def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str
                                 if share else "none fails"))
             if r.get("column_kind") == "block":
                 surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
-                                      "design_adequate": r.get("design_adequate")})
+                                      "design_adequate": r.get("design_adequate"),
+                                      "max_theta_ratio": r.get("max_theta_ratio")})
                 verdict = {"yes": "survives", "NO": "overturns",
                            "NO: safe island": "NO: survives only on a safe island (narrower than the design width)"}
                 parts.append(f"as it stands: {verdict.get(surv, surv)}"
@@ -243,15 +257,20 @@ def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str
 
 
 def _overturning_words(r) -> str:
-    """Under ``--limit``: what the overturning design width in the row is (in full where it sets
-    the design width, else the part established: it is refined only where it can change it)."""
+    """Under a level: the verge (no margin) beside the design width, and what it is (in full where
+    it sets the design width, else the part established: it is refined only where it can change
+    the design width)."""
     over, design = _num(r.get("overturning_width_m")), _num(r.get("design_width_m"))
     if over is None:
         return ""
+    there = (f" (max theta/alpha {_fixed(r['overturning_max_theta_ratio'], 2)} there"
+             + passes_text(r["overturning_max_theta_ratio"]) + ")"
+             if _num(r.get("overturning_max_theta_ratio")) is not None else "")
     if design is None or over >= design:
-        return f", set by the overturning design width {_fixed(over)} m (a width that overturns fails every level)"
-    return (f", above the overturning design width (at least {_fixed(over)} m: refined only as far as "
-            "it could change the design width)")
+        return (f", set by the overturning design width {_fixed(over)} m, the verge (no margin){there}: "
+                "a width that overturns fails every level")
+    return (f", above the verge (no margin), the overturning design width (at least {_fixed(over)} m: "
+            f"refined only as far as it could change the design width){there}")
 
 
 def report_html(design, rows, failures, record_ids, figures, title="pipeline run") -> str:
@@ -292,10 +311,10 @@ def report_html(design, rows, failures, record_ids, figures, title="pipeline run
            + ", ".join(f'<a href="{_href(f)}">{_e(f)}</a>' for f in
                        ("design.csv", "summary.csv", "failures.csv", "columns.md"))
            + ". Click a heading to sort the table. Rows in red: the column as it stands overturns; "
-             "in yellow: it survives only on a safe island (a slightly wider column overturns), flagged "
-             "like a failure.</p>",
+             "in yellow: it survives only on a safe island (a slightly wider column overturns) or rocks "
+             "past the level, flagged like a failure.</p>",
            "<h2>Designs</h2>"]
-    out += _batch_table(design, pair_anchor)
+    out += _batch_table(design, pair_anchor, eq31_ratios(rows))
     if failures:
         out.append(f'<h2 id="failures">Failures ({len(failures)})</h2>')
         out.append('<table class="sortable" id="failed"><thead><tr><th>record</th><th>file</th><th>stage</th>'

@@ -28,12 +28,12 @@ TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE = 11, 10, 9, 8
 #: the best: at most one per shape, four shapes)
 MAX_PULSES = 4
 #: most curves per rotation-history panel (the column as it stands, the Eq. 31 design, the
-#: design width)
-MAX_CURVES = 3
+#: design width, and under a performance level the verge beside it)
+MAX_CURVES = 4
 #: Okabe-Ito colours (apart with every common colour-vision deficiency); styles tell curves apart too
 PALETTE = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9"]
 _PULSE_STYLES = ["-", "--", "-.", ":"]
-_CURVE_STYLES = ["-", "--", "-."]
+_CURVE_STYLES = ["-", "--", "-.", ":"]
 #: record figure in inches: margins (room for the y label and tick labels as wide as "-0.0075",
 #: the legends beside the panels, off the curves and the +-alpha lines, the x tick labels and
 #: label, the first title), height of a panel, gap between panels (a title)
@@ -126,7 +126,7 @@ def record_figure(record_id, record, fit, fitting, histories, velocity=None) -> 
         if len(curves) > MAX_CURVES:
             raise ValueError(f"at most {MAX_CURVES} curves per history panel, got {len(curves)}")
         for j, (curve_label, block, res) in enumerate(curves):
-            verdict = "overturns" if res.overturned else f"max {res.max_rotation_ratio:.3g} alpha"
+            verdict = verdict_words(res)
             ax.plot(*_thin(res.t, np.asarray(res.theta, dtype=float) / block.alpha), color=PALETTE[j], lw=1.0,
                     ls=_CURVE_STYLES[j], label=f"{curve_label}: {verdict}")
         ax.axhline(1.0, color="k", lw=0.5, ls=":")  # overturning starts past |theta| = alpha
@@ -160,6 +160,15 @@ def record_figure_png(record_id, record, fit, fitting, histories, velocity=None)
     """PNG bytes of :func:`record_figure` (same parameters)."""
     with _LOCK:
         return _png(record_figure(record_id, record, fit, fitting, histories, velocity=velocity))
+
+
+def verdict_words(res) -> str:
+    """A run's outcome in a legend: ``overturns``, ``passes alpha, max 1.005 alpha`` (it passes its
+    slenderness angle and comes back) or ``max 0.74 alpha``."""
+    if res.overturned:
+        return "overturns"
+    ratio = float(res.max_rotation_ratio)
+    return f"passes alpha, max {ratio:.4g} alpha" if ratio >= 1.0 else f"max {ratio:.3g} alpha"
 
 
 def run_figure_png(record_id, record, fit, fitting, histories, velocity=None) -> bytes:

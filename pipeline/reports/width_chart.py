@@ -16,10 +16,11 @@ RULES = {
 }
 
 
-def widths_by_height(pulse, heights, rules=tuple(RULES), body=None):
+def widths_by_height(pulse, heights, rules=tuple(RULES), body=None, eta=None):
     """The width (m) each rule asks for, per height (m): a :class:`pandas.DataFrame` with
     columns ``height_m``, ``rule``, ``width_m``, ``slenderness`` (``width / height``); of
-    ``body``'s shape (rocking.bodies; default rectangular)."""
+    ``body``'s shape (rocking.bodies; default rectangular); ``eta``: the restitution of the exact
+    rule (the closed forms do not depend on it; a band: the width covering it)."""
     import pandas as pd
 
     import rocking
@@ -27,7 +28,8 @@ def widths_by_height(pulse, heights, rules=tuple(RULES), body=None):
     rows = []
     for rule in rules:
         for h in heights:
-            width = rocking.required_width(float(h), pulse, rule=rule, body=body).width
+            width = rocking.required_width(float(h), pulse, rule=rule, body=body,
+                                           eta=eta if rule == "exact" else None).width
             rows.append({"height_m": float(h), "rule": rule, "width_m": width,
                          "slenderness": width / float(h)})
     return pd.DataFrame(rows)

@@ -95,7 +95,7 @@ def _label(res):
 def _eta(rest, res, width):
     from ..block import Block
 
-    return Block.from_dimensions(res.height, width, rest).eta
+    return Block.from_dimensions(res.height, width, rest, body=res.body).eta
 
 
 def risk_rows(res) -> list[dict]:

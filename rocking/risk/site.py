@@ -68,6 +68,8 @@ class RiskResult:
     names: list = field(repr=False, default_factory=list)
     #: the level R the target is for (None: overturning)
     limit: float | None = None
+    #: the column's shape (rocking.bodies; a cylinder's width is its diameter)
+    body: str = "rectangular"
 
     @property
     def rate(self) -> float | None:
@@ -134,7 +136,7 @@ def _mode(runner, curve, height, width, limit, restitution, seed, gamma, n_boot)
 
 def risk(records, hazard, *, height, width=None, target_rate=None, target_poe=None, years=50.0,
          age=None, limit=None, restitution=None, seed=0, cap_mass_ratio=0.0, names=None,
-         n_boot=N_BOOT, jobs=1, **read) -> RiskResult:
+         n_boot=N_BOOT, jobs=1, body="rectangular", **read) -> RiskResult:
     """The annual rate of failure of a column at a site, and the width for a target.
 
     Parameters
@@ -159,6 +161,8 @@ def risk(records, hazard, *, height, width=None, target_rate=None, target_poe=No
         is reported beside it.
     jobs : int
         Processes for the critical scales.
+    body : str, optional
+        The column's shape (:mod:`rocking.bodies`; ``"cylinder"``: ``width`` is its diameter).
 
     Examples
     --------
@@ -180,14 +184,15 @@ def risk(records, hazard, *, height, width=None, target_rate=None, target_poe=No
     suite = suites.members(records, curve.measure, names)
     return assess(suite, curve, height=height, width=width, target_rate=target_rate,
                   target_poe=target_poe, years=years, age=age, limit=limit, restitution=restitution,
-                  seed=seed, cap_mass_ratio=cap_mass_ratio, n_boot=n_boot, jobs=jobs)
+                  seed=seed, cap_mass_ratio=cap_mass_ratio, n_boot=n_boot, jobs=jobs, body=body)
 
 
 def assess(suite, curve, *, height, width=None, target_rate=None, target_poe=None, years=50.0,
            age=None, limit=None, restitution=None, seed=0, cap_mass_ratio=0.0, n_boot=N_BOOT,
-           jobs=1) -> RiskResult:
+           jobs=1, body="rectangular") -> RiskResult:
     """:func:`risk` for a suite already made (:class:`rocking.risk.suite.Member` s, as the
-    pipeline makes them from its tasks: a pair in the directions the run designed for)."""
+    pipeline makes them from its tasks: a pair in the directions the run designed for); ``body``:
+    the column's shape (rocking.bodies; a cylinder's width is its diameter)."""
     from ..restitution import Restitution
     from . import suite as suites
     from .rate import parse_poe, rate_for
@@ -200,7 +205,7 @@ def assess(suite, curve, *, height, width=None, target_rate=None, target_poe=Non
         target_rate = rate_for(*parse_poe(target_poe))
     _check(height, width, target_rate, years, age)
     gamma = float(cap_mass_ratio)
-    with suites.Runner(suite, jobs) as runner:
+    with suites.Runner(suite, jobs, body) as runner:
         modes = []
         if width is not None:
             for lim in [None] + ([limit] if limit is not None else []):
@@ -212,7 +217,7 @@ def assess(suite, curve, *, height, width=None, target_rate=None, target_poe=Non
     return RiskResult(curve, float(height), None if width is None else float(width), modes, target,
                       float(years), None if age is None else float(age),
                       "Eq. 5" if rest is None else rest.describe(), int(seed), [m.name for m in suite],
-                      limit)
+                      limit, str(body))
 
 
 def _read(path, read):

@@ -77,17 +77,18 @@ def _critical(args):
     """The critical scale of one component (by its index in the runner's list) for one column."""
     import rocking
 
-    k, height, width, eta, gamma, up_to, limit = args
-    block = rocking.Block.from_dimensions(height, width, eta, cap_mass_ratio=gamma)
+    k, height, width, eta, gamma, up_to, limit, body = args
+    block = rocking.Block.from_dimensions(height, width, eta, cap_mass_ratio=gamma, body=body)
     return rocking.critical_scale(block, _COMPONENTS[k], up_to=up_to, limit=limit)
 
 
 class Runner:
     """Critical scales of the suite's components, here (``jobs`` 1) or in ``jobs`` processes that
-    receive the records once.  A context manager (the pool is stopped on leaving it)."""
+    receive the records once, for columns of ``body``'s shape (rocking.bodies).  A context manager
+    (the pool is stopped on leaving it)."""
 
-    def __init__(self, suite, jobs: int = 1):
-        self.suite = suite
+    def __init__(self, suite, jobs: int = 1, body="rectangular"):
+        self.suite, self.body = suite, body
         self.index = [(i, j) for i, m in enumerate(suite) for j in range(len(m.components))]
         self.components = [suite[i].components[j] for i, j in self.index]
         self.jobs = max(1, int(jobs or 1))
@@ -150,7 +151,8 @@ def critical_set(runner, height, width, curve, *, restitution=None, seed=0, limi
     tasks = []
     for k, (i, _) in enumerate(runner.index):
         up_to = max(top / suite[i].intensity, 1e-9)
-        tasks.append((k, float(height), float(width), rests[i], float(cap_mass_ratio), up_to, limit))
+        tasks.append((k, float(height), float(width), rests[i], float(cap_mass_ratio), up_to, limit,
+                      runner.body))
     results = runner.map(tasks)
     entries = []
     for i in range(len(suite)):
