@@ -313,7 +313,13 @@ def _events(n: int) -> list[str]:
           "x0 = sel(k_ra, ra, sel(k_rb, rb, xc))",
           "bl0 = blo",
           "bh0 = bhi"]
-    x = "x0"
+    return L + _event_root(n) + _event_next(n) + _event_verdict(n)
+
+
+def _event_root(n: int) -> list[str]:
+    """:func:`_events`' root of the impact: Halley's iterations kept in the bracket, the state
+    there and where the peak pass looks."""
+    L, x = [], "x0"
     for it in range(NEWTON_POLY):   # Halley's iterations (cubic convergence)
         P2 = lambda d: _poly2("p", n, x, f"xx{it}", d)
         L += [f"xx{it} = {x} * {x}",
@@ -341,11 +347,16 @@ def _events(n: int) -> list[str]:
           "oe = sel(k_imp, omx, om2)",
           "need = sel(1.01 * (" + " + ".join(f"fabs(p{k})" for k in range(n + 1)) + ") < mx,"
           " 0.0, 1.0)"]
+    return L
+
+
+def _event_next(n: int) -> list[str]:
+    """:func:`_events`' next step, cut at its own order."""
     # the next step: after an impact (restitution, the other side), from the impact; else, where
     # this step ends short of the interval's end, from there; to the end of the interval, or
     # over a hop only (its parabola's length and a quarter: the hops of a block coming to rest,
     # each then a short step of a low order, instead of one over the rest of the interval)
-    L += ["ti = t + xi * h",
+    L = ["ti = t + xi * h",
           "sn = -side",
           "omn = eta * omx",
           "ue = u0s + u1s * xi",
@@ -371,10 +382,14 @@ def _events(n: int) -> list[str]:
     L += [line.replace("abs(", "fabs(") for line in rest]
     # the next step cut at its own order, which the next round takes (any order of the round
     # at or above it gives the same bits)
-    L += [f"low = fmin(r_own, {float(ORDERS[-1])!r})"]
+    return L + [f"low = fmin(r_own, {float(ORDERS[-1])!r})"]
+
+
+def _event_verdict(n: int) -> list[str]:
+    """:func:`_events`' outcome: a Zeno sequence's rest, ``ok`` and ``why``, the next state."""
     # a Zeno sequence: the hops left summed in closed form (rocking._core._zeno_rest), the block
     # at rest to the end of the interval unless the forcing may uplift it before
-    L += ["an = psq * (sa + sn * ue * ca)",
+    L = ["an = psq * (sa + sn * ue * ca)",
           "ao = psq * (sa - sn * ue * ca)",
           "k_pos = (an > 0.0) & (ao > 0.0)",
           "rest = sel(k_pos, ti + fdiv(2.0 * fabs(omn), 1.0 - eta * eta) * (fdiv(1.0, an)"

@@ -614,6 +614,26 @@ def _block_arrays(blocks):
     return tuple(np.array([getattr(b, k) for b in blocks], dtype=float) for k in ("p", "alpha", "eta"))
 
 
+def _runs(blocks, scales, grid):
+    """``(p, alpha, eta, scales, shape)``: :func:`simulate_many`'s runs as flat arrays, block by
+    scale (``grid``) or broadcast pairwise, and the shape its results take."""
+    p, alpha, eta = _block_arrays(blocks)
+    n_blocks = p.size
+    scales = np.atleast_1d(np.asarray(1.0 if scales is None else scales, dtype=float))
+    if not np.all(np.isfinite(scales)):
+        raise ValueError("scales must be finite")
+    if grid:
+        shape = (p.size, scales.size)
+        p, alpha, eta = (np.repeat(a, scales.size) for a in (p, alpha, eta))
+        scales = np.tile(scales, n_blocks)
+    else:
+        p, alpha, eta, scales = np.broadcast_arrays(p, alpha, eta, scales)
+        shape = p.shape
+    p, alpha, eta, scales = (np.ascontiguousarray(a, dtype=float).ravel()
+                             for a in (p, alpha, eta, scales))
+    return p, alpha, eta, scales, shape
+
+
 def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
                   model: str = "fast", method: str = "taylor",
                   threads: int | None = None, lanes: bool = True,
@@ -672,20 +692,7 @@ def simulate_many(blocks, excitation, scales=None, *, grid: bool = False,
             return dataclasses.replace(out, lifts_off=none, t_lift_off=np.full(none.shape, np.nan))
         vval, g_min, g_max = bounds
     linear = model == "linear"
-    p, alpha, eta = _block_arrays(blocks)
-    n_blocks = p.size
-    scales = np.atleast_1d(np.asarray(1.0 if scales is None else scales, dtype=float))
-    if not np.all(np.isfinite(scales)):
-        raise ValueError("scales must be finite")
-    if grid:
-        shape = (p.size, scales.size)
-        p, alpha, eta = (np.repeat(a, scales.size) for a in (p, alpha, eta))
-        scales = np.tile(scales, n_blocks)
-    else:
-        p, alpha, eta, scales = np.broadcast_arrays(p, alpha, eta, scales)
-        shape = p.shape
-    p, alpha, eta, scales = (np.ascontiguousarray(a, dtype=float).ravel()
-                             for a in (p, alpha, eta, scales))
+    p, alpha, eta, scales, shape = _runs(blocks, scales, grid)
     stepper = _check_method(method)
     ph_max = _default_ph_max(method)
     g = _grid(excitation, float(p.max()), linear, None, ph_max)
