@@ -39,7 +39,8 @@ def run(repeat: int = 5) -> dict:
     import matplotlib
 
     from pipeline.reports import plots
-    from pipeline.batch.record import Column, Options, _process
+    from pipeline.batch.record import _process
+from pipeline.batch.tasks import Column, Options
     from pipeline.batch.runner import make_tasks
 
     paths = sorted(str(p) for p in DATA.glob("*.sac"))

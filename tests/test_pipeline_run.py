@@ -16,7 +16,8 @@ import pulses
 import rocking
 from pipeline.reports import report
 from pipeline.batch import resume
-from pipeline.batch.record import FAILURE_FIELDS, Column, Options, record_ids
+from pipeline.batch.record import FAILURE_FIELDS
+from pipeline.batch.tasks import Column, Options, record_ids
 from pipeline.cli import main
 from pulses import G
 
@@ -691,7 +692,8 @@ def test_absurd_sizes_are_argument_errors(bad, tmp_path, capsys):
 
 def test_report_rows_must_match_their_declared_columns():
     """Writing a row with an undeclared key, or without a declared one, fails (no silent blank)."""
-    from pipeline.batch.record import FIELDS, RECORD_COLUMNS
+    from pipeline.batch.fitted import RECORD_COLUMNS
+    from pipeline.batch.row import FIELDS
 
     row = dict.fromkeys(FIELDS, 1.0)
     assert report.csv_text(FIELDS, [row]).count("\n") == 2

@@ -440,21 +440,21 @@ def test_design_takes_thorough_plots_all_or_none_and_numpy_integers(tmp_path):
     import numpy as np
 
     import pipeline
-    from pipeline import api
     from pipeline.cli import build_parser
+    from pipeline.plan import plan_from
     from pipeline.commands import run as run_command
 
     from .test_pipeline_run import write_good
 
     for plots, cli in (("all", ["--plots", "all"]), ("none", ["--no-plots"]), ("governing", []), (False, ["--no-plots"])):
-        plan = api._plan([tmp_path / "a.sac"], blocks="7.5x1.8", heights=None, pairs=None, directions=np.int64(3),
+        plan = plan_from([tmp_path / "a.sac"], blocks="7.5x1.8", heights=None, pairs=None, directions=np.int64(3),
                          vertical="auto", limit=None, restitution=None, jobs=np.int64(1), out=None, shapes=None,
                          weighting="background", units=None, dt=None, scale=None, plots=plots, force=False,
                          quiet=True, thorough=True)
         args = build_parser().parse_args(["run", "a.sac", "--block", "7.5x1.8", "--thorough", *cli])
         assert plan.options == run_command.options_from(args, **{k: getattr(plan.options, k) for k in (
             "shapes", "weighting", "vertical", "cap_mass_ratio", "fragility", "up_to", "limit")})
-        assert plan.directions == "3" and plan.jobs == 1
+        assert plan.directions == 3 and plan.jobs == 1
     record = write_good(tmp_path, 0, duration=2.0)
     run = pipeline.design([record], blocks="7.5x1.8", shapes="sine", directions=np.int64(0), jobs=np.int64(1))
     assert run.exit_code == 0 and len(run.design) == 1

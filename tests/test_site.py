@@ -15,7 +15,8 @@ import pytest
 import pulses
 import rocking
 from pipeline.cli import main as cli_main
-from pipeline.batch.site import NOT_PULSE_WARNING, directions
+from pipeline.batch.pairs import directions
+from pipeline.reports.pulse_row import NOT_PULSE_WARNING
 
 H, B = 2.0, 0.35  # a small column: the synthetic pulses (0.3-0.5 g) rock it
 
@@ -314,7 +315,8 @@ def test_suite_and_fragility_plots():
 
 
 def test_a_pair_whose_classification_fails_is_designed_in_its_components_and_says_why():
-    from pipeline.batch.site import classification_fields, directions
+    from pipeline.batch.pairs import directions
+    from pipeline.reports.pulse_row import classification_fields
 
     fields, warning = classification_fields(None, pair_fields={"error": "too short"})
     assert set(fields.values()) == {None}  # no pulse columns made up

@@ -10,7 +10,7 @@ import logging
 import os
 
 from .. import interrupts
-from ..args import ArgumentError
+from ..values import ArgumentError
 from . import memo, worker
 from .lifeline import lifeline
 from ..reports.figures import draw

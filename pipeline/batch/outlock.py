@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import os
 
-from ..args import ArgumentError
+from ..values import ArgumentError
 
 
 @contextlib.contextmanager

@@ -74,13 +74,6 @@ class PeerSource:
         return [self.download]
 
 
-def add_options(parser) -> None:
-    """``--peer-scales`` of ``pipeline run``."""
-    parser.add_argument("--peer-scales", action="store_true",
-                        help="PEER downloads: multiply each record by the search's scale factor "
-                             "(_SearchResults.csv); by default records are designed as recorded")
-
-
 def split_inputs(items, format: str | None = None) -> tuple[list[str], list[str]]:
     """``(PEER downloads, other inputs)``: a zip file, or a folder holding ``_SearchResults.csv``.
     With ``--format`` given, every file is a record of that format (a zip is no download)."""
@@ -120,21 +113,21 @@ def _fields(entry, scaled: bool) -> tuple:
 
 def scale_of(entry) -> float:
     """The search's scale factor of ``entry``, checked by the one rule of every scale
-    (:func:`pipeline.args.parse_scale`); :class:`ArgumentError` when it is missing or outside it
+    (:func:`pipeline.values.parse_scale`); :class:`ArgumentError` when it is missing or outside it
     (a factor of 1e6, 0 or nan was applied, or silently taken as 1)."""
-    from ..args import ArgumentError, parse_scale
+    from ..values import ArgumentError, parse_scale
 
     factor = entry.metadata.get("scale_factor")
     what = f"RSN {entry.rsn}: --peer-scales: the search's scale factor (_SearchResults.csv, line {entry.line})"
     if factor is None:
         raise ArgumentError(f"{what} is missing (blank, '-' or not finite): the record is not "
                             "designed rather than designed unscaled")
-    return parse_scale(repr(float(factor)), what)
+    return parse_scale(float(factor), what)
 
 
 def _why_not(d, e, scaled: bool) -> str:
     """Why the record ``e`` of download ``d`` cannot be designed (blank: it can)."""
-    from ..args import ArgumentError
+    from ..values import ArgumentError
 
     if e.h1 is None or e.h2 is None:
         return f"RSN {e.rsn}: the search report lists no {'Horizontal-1' if e.h1 is None else 'Horizontal-2'} file"
@@ -250,16 +243,6 @@ def read_vertical(task):
         return open_download(src.download).read_component(src.vertical), ""
     except RecordError as exc:
         return None, f"vertical not used: {exc}"
-
-
-def read_task(task):
-    """The ground motion of a PEER task: the pair's component in the task's direction, scaled."""
-    from pulses import check_pair, component
-
-    first, second, _ = read_components(task)
-    first, second = check_pair(first, second)
-    record = component(first, second, task.direction or 0.0)
-    return record.scaled(task.scale) if task.scale != 1.0 else record
 
 
 def fields(task) -> dict:

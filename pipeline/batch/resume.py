@@ -164,7 +164,7 @@ def report_rows_text(raw: bytes, fields=None) -> str | None:
 def _fields(options=None):
     """The columns of the reports of a run with ``options`` (None: ``--limit none``'s, the
     columns every run has)."""
-    from .record import FIELDS, fields_for
+    from .row import FIELDS, fields_for
 
     return FIELDS if options is None else fields_for(options)
 

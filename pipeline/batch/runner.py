@@ -18,8 +18,10 @@ from ..reports import design_table, figures, html_report, outfiles, report
 from .. import interrupts
 
 from . import joblog, outlock, passes, resume, risk, site
-from ..args import ArgumentError, output_folder
-from .record import FAILURE_COLUMNS, FAILURE_FIELDS, columns_for, failure, fields_for
+from ..reports import suite as suite_tables
+from ..values import ArgumentError, output_folder
+from .record import FAILURE_COLUMNS, FAILURE_FIELDS, failure
+from .row import columns_for, fields_for
 from . import executors
 from .executors import _serial, execute
 from .scheduler import ClusterLost
@@ -246,7 +248,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     n_failed = len(failures)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, len(tasks) - len(computed),
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else []),
+                          "suite": _as_written(list(suite_tables.SUITE_COLUMNS.names), suite_tables.suite_rows(rows) if rows else []),
                           "risk": risk_rows},
                          problems)
     if not quiet:
@@ -486,12 +488,12 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     outputs.write(report.SUMMARY, header + text)
     outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
     outputs.write(report.COLUMNS_MD, report.columns_markdown(columns_for(options), FAILURE_COLUMNS.columns)
-                  + site.columns_markdown() + design_table.columns_markdown(options.limit is not None,
+                  + suite_tables.columns_markdown() + design_table.columns_markdown(options.limit is not None,
                                                                            options.restitution is not None)
                   + (risk.columns_markdown() if options.risk is not None else ""))
     # the rows as the reports hold them, so that a resumed run writes the same files
     rows = resume.rows_from_text(text, fields_for(options))
-    site.write_outputs(outputs, rows, fields_for(options), options, failed, render)
+    suite_tables.write_tables(outputs, rows, fields_for(options), options, failed, render)
     answers, risk_rows = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
     if options.plots and rows:
         outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))

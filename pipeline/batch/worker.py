@@ -7,7 +7,8 @@ import os
 
 from . import joblog, memo
 from .quiet import quiet_now  # noqa: F401 (what the pools' initializers are given)
-from .record import failure, fields_for, process_record
+from .record import failure, process_record
+from .row import fields_for
 from .tasks import Task
 
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import time
 
-from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration,
-                    parse_column_block, parse_positive, parse_restitution)
+from ..args import ShapeNames, add_restitution_option, parse_acceleration
+from ..values import ArgumentError, parse_column_block, parse_positive, parse_restitution
 
 
 def _floats(text, what):

@@ -14,7 +14,8 @@ from __future__ import annotations
 import json
 import sys
 
-from ..args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
+from ..args import add_pair_options, add_record_options, record_options
+from ..values import ArgumentError, pair_files
 from ..reports.pulse_row import COLUMNS, RUN_COLUMNS, classify_fields, result_row  # noqa: F401 (this command's row)
 
 def add_parser(subparsers) -> None:

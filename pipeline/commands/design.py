@@ -9,9 +9,8 @@ import json
 import math
 import sys
 
-from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration,
-                   parse_column_block, parse_column_height, parse_friction, parse_positive,
-                   parse_restitution)
+from ..args import ShapeNames, add_restitution_option, parse_acceleration
+from ..values import ArgumentError, parse_column_block, parse_column_height, parse_friction, parse_positive, parse_restitution
 
 
 
