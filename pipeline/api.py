@@ -113,21 +113,12 @@ class DesignRun:
                       "out": None if self.out is None else str(self.out)})
 
 
-#: columns of names: the reports' rows read back from their text type a height's label ("12") or a
-#: record named "1063" as a number; the tables give them as the text the reports hold
-_NAMES = ("record", "column", "pair", "file")
-
-
 def _frame(rows, columns):
+    """A DataFrame of ``rows`` (dicts of typed values: text stays text, ``record`` ``"1063"``
+    included) with ``columns`` in order."""
     import pandas as pd
 
-    from .reports.report import fmt
-
-    def cell(row, c):
-        v = row.get(c)
-        return fmt(v) if c in _NAMES and v is not None and not isinstance(v, str) else v
-
-    return pd.DataFrame([[cell(r, c) for c in columns] for r in rows], columns=list(columns))
+    return pd.DataFrame([[r.get(c) for c in columns] for r in rows], columns=list(columns))
 
 
 def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 0, vertical: str = "auto",
@@ -139,15 +130,13 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     Parameters
     ----------
     records : path or list of paths
-        Record files (any format :func:`pulses.read_record` reads), folders of them, or PEER
-        NGA-West2 downloads (a ``.zip``, or a folder holding ``_SearchResults.csv``).  A file that
-        is missing or cannot be read is a row of :attr:`DesignRun.failures`, not an exception.
+        Record files (any format :func:`pulses.read_record` reads), folders of them, or PEER downloads
+        (docs/peer.md).  A file missing or unreadable is a row of :attr:`DesignRun.failures`.
     blocks : Block, str, (float, float) or a list of them
-        Columns as they stand: a :class:`rocking.Block`, ``"HxW"`` (full height x full width, m,
-        e.g. ``"7.5x1.8"``; ``"cyl:HxD"`` a circular column of diameter D) or ``(height, width)``
-        in m.  ``pipeline run --block``.
+        Columns as they stand (``--block``): a :class:`rocking.Block`, ``"HxW"`` (full height x full
+        width, m; ``"cyl:HxD"`` a circular column of diameter D) or ``(height, width)`` in m.
     heights : float or list of float
-        Heights (m) of columns whose width is only to be sized.  ``--height``.
+        Heights (m) of columns whose width is only to be sized (``--height``).
     pairs : {"none", "auto"} or list of (A, B) or (A, B, V)
         Horizontal components designed as pairs in every direction (``--pair``, ``--triplet`` with
         a vertical ``V``, ``--pairs auto``).  Default: every file alone.
@@ -156,44 +145,30 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     vertical : {"auto", "none"}
         Use a pair's known vertical component (``--vertical``).
     limit : float or None
-        The level R of the design width (``--limit``): max|theta|/alpha <= R, at least the verge
-        (no margin, ``overturning_width_m``); default 0.5, the paper's dependable design.  None
-        (or ``"none"``): the verge alone.
+        The level R of the design width (``--limit``): max|theta|/alpha <= R, at least the verge;
+        default 0.5, the paper's dependable design; None (or ``"none"``): the verge alone.
     restitution : str, float or rocking.restitution.Restitution, optional
-        ``--restitution``: a factor of Eq. 5 (``0.97``), ``"eta=0.9"``, ``"r=0.81"`` or a band
-        ``"0.95:1.05"`` whose design covers it; default Eq. 5.
-    jobs : int
-        Worker processes (0: one per CPU); the tables do not depend on it.
-    out : path, optional
-        Folder to write every report into, as ``pipeline run --out``; None (default): nothing is
-        written (the run uses a private temporary folder, removed at the end).
-    shapes : str or list of str, optional
-        Pulse shapes to fit (``--shapes``); default the fitter's set.
-    weighting : {"background", "plain"}
-        The pulse fit's least squares (``--weighting``).
-    units, dt : optional
-        What a file does not say (``--units``, ``--dt``).
-    scale : float, optional
-        A factor on every record (``--scale``).
+        ``--restitution``: ``0.97`` (a factor of Eq. 5), ``"eta=0.9"``, ``"r=0.81"`` or a band ``"0.95:1.05"``.
+    jobs, out : optional
+        Worker processes (0: one per CPU; the tables do not depend on it); the folder to write every
+        report into (``--out``; None, the default: nothing is written).
+    shapes, weighting : optional
+        Pulse shapes to fit (``--shapes``; default the fitter's set); the fit's least squares
+        (``--weighting``: ``"background"``, the default, or ``"plain"``).
+    units, dt, scale : optional
+        What a file does not say (``--units``, ``--dt``); a factor on every record (``--scale``).
     plots : bool or {"governing", "all", "none"}, optional
-        Draw the figures (default: when ``out`` is given): True or ``"governing"`` (for a pair in
-        several directions, its governing direction's), ``"all"`` (every direction's), False or
-        ``"none"``.  ``--plots [all]``, ``--no-plots``.
-    force : bool
-        Compute every record again instead of keeping an earlier run's reports in ``out``.
-    quiet : bool
-        No messages, no warnings and no table on stderr/stdout (default); False prints what
-        ``pipeline run`` prints.
-    thorough : bool
-        For pairs: the check above the search width (and the figures) in every direction
-        (``--thorough``); the same pair design width.
+        The figures (default: when ``out`` is given): True or ``"governing"`` (of a pair's governing
+        direction), ``"all"`` (of every direction), False or ``"none"``.  ``--plots``, ``--no-plots``.
+    force, quiet, thorough : bool
+        ``--force`` (compute every record again), ``--quiet`` (False prints what ``pipeline run``
+        prints), ``--thorough`` (a pair's check in every direction).
     **more
-        The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``,
-        ``scales``, ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``,
-        ``glob``, ``friction`` (docs/validity.md), ``fragility_limit`` (the level R of ``fragility``'s
-        critical scales; None, the default: collapse); risk at a site (docs/risk.md): ``hazard`` (a file
-        or a :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)), ``site_row``, ``imt``,
-        ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe`` (``"2%/50"``), ``risk_seed``.
+        The other options of ``pipeline run`` by their names: ``column``, ``format``, ``trace``, ``scales``,
+        ``peer_scales``, ``cap_mass_ratio``, ``fragility``, ``up_to``, ``dask``, ``log``, ``glob``, ``friction``
+        (docs/validity.md), ``fragility_limit`` (the level R of the critical scales; None: collapse); risk
+        (docs/risk.md): ``hazard`` (a file or a :class:`rocking.risk.HazardCurve`), ``site`` ((lon, lat)),
+        ``site_row``, ``imt``, ``hazard_units``, ``years``, ``age``, ``target_rate``, ``target_poe``, ``risk_seed``.
 
     Returns
     -------
@@ -202,15 +177,12 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
 
     Raises
     ------
-    TypeError
-        An argument of a type not accepted (the message names the accepted forms).
-    ValueError
-        A value out of range (a negative height, an unknown shape ...), refused with the words
-        ``pipeline run`` uses for it.
+    TypeError, ValueError
+        An argument of a type not accepted (the message names the forms accepted), a value out of
+        range (a negative height, an unknown shape ...), in the words ``pipeline run`` uses for it.
     RuntimeError
         ``jobs > 1`` (or ``dask="local"``) at the top level of a script without the ``if __name__
-        == "__main__":`` guard: the workers import the script again (docs/notebook.md; a notebook
-        needs nothing).
+        == "__main__":`` guard (docs/notebook.md; a notebook needs nothing).
 
     Examples
     --------
@@ -225,18 +197,17 @@ def design(records, *, blocks=None, heights=None, pairs=None, directions: int = 
     ...
     TypeError: blocks: expected a rocking.Block, a 'HxW' string in m (e.g. '7.5x1.8') or a (height, width) pair of numbers in m; got float 7.5
     """
-    plan = plan_from(records, blocks=blocks, heights=heights, pairs=pairs, directions=directions,
-                     vertical=vertical, limit=limit, restitution=restitution, jobs=jobs, out=out, shapes=shapes,
-                     weighting=weighting, units=units, dt=dt, scale=scale, plots=plots, force=force,
-                     quiet=quiet, thorough=thorough, **more)
-    return run_plan(plan)
+    return run_plan(plan_from(records, blocks=blocks, heights=heights, pairs=pairs, directions=directions,
+                              vertical=vertical, limit=limit, restitution=restitution, jobs=jobs, out=out,
+                              shapes=shapes, weighting=weighting, units=units, dt=dt, scale=scale, plots=plots,
+                              force=force, quiet=quiet, thorough=thorough, **more))
 
 
 def _paths(plan, say):
     """``(downloads, record paths)`` of a run's inputs; the files of its folders that are plainly
     not records are skipped with a note."""
     from .batch import peer_inputs
-    from .reports.report import display
+    from .reports.cells import display
     from .batch.tasks import expand_inputs, skipped_note
 
     if not plan.records and not plan.pair:
@@ -306,7 +277,7 @@ def _run_plan(plan) -> DesignRun:
                       lists={NOT_DOWNLOADED: not_downloaded_text(absent)})
     t = summary.tables
     if not plan.quiet and plan.out is None:
-        from .reports.design_table import table_text
+        from .reports.answer import table_text
 
         print(table_text(t["design"], t["failures"], t["summary"]), end="")
     return DesignRun(t["design"], t["summary"], t["failures"], t["suite"], summary.n_records,

@@ -111,7 +111,7 @@ def pair_files(pairs, what: str = "--pair") -> list[tuple[str, str]]:
             except (OSError, ValueError):
                 pass
         if same:
-            from .reports.report import display
+            from .reports.cells import display
 
             raise ArgumentError(f"{what} {display(a)} {display(b)}: both name one file; a pair is "
                                 "two components of one station")
@@ -311,7 +311,7 @@ def parse_shapes(items):
 
 def output_folder(path, what: str = "--out") -> pathlib.Path:
     """An output folder, created if needed and checked writable before any work is done."""
-    from .reports.report import display
+    from .reports.cells import display
 
     if path is None or not str(path).strip():  # pathlib would make "" the current folder
         raise ArgumentError(f"{what}: an empty folder name; name a folder (. for this one)")

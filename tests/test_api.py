@@ -10,7 +10,7 @@ import pytest
 
 import pipeline
 import rocking
-from pipeline.reports import report
+from pipeline.reports import cells
 from pipeline.batch.margin import DEFAULT_LIMIT
 from pipeline.batch.row import FIELDS, fields_for
 from pipeline.batch.tasks import Options
@@ -31,11 +31,11 @@ def _cells(path) -> list[list[str]]:
 
 
 def _frame_cells(df, fields) -> list[list[str]]:
-    """A DataFrame's cells as the CSV writer formats them (report.fmt), under the header."""
+    """A DataFrame's cells as the CSV writer formats them (cells.fmt), under the header."""
     import math
 
     def cell(v):
-        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else report.fmt(v)
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else cells.fmt(v)
 
     assert list(df.columns) == list(fields)
     return [list(fields)] + [[cell(v) for v in row] for row in df.itertuples(index=False)]
@@ -211,12 +211,12 @@ def test_a_loop_with_the_governing_pulse_gives_pipeline_runs_eq31_widths():
         rows = []
         for path in paths:
             gov = rocking.governing_pulse(pulses.fit_pulse(pulses.read_record(path)), 7.5)
-            rows.append([gov.candidate.shape, report.fmt(gov.candidate.ap_g), report.fmt(gov.candidate.tp),
-                         report.fmt(gov.width)])
+            rows.append([gov.candidate.shape, cells.fmt(gov.candidate.ap_g), cells.fmt(gov.candidate.tp),
+                         cells.fmt(gov.width)])
         # the best fit alone is not the rule: on the demo it gives another shape on some record
         best = [pulses.fit_pulse(pulses.read_record(p)).best.shape for p in paths]
     table = run.design[["governing_shape", "governing_ap_g", "governing_tp_s", "eq31_width_m"]]
-    assert [[r[0]] + [report.fmt(x) for x in r[1:]] for r in table.itertuples(index=False)] == rows
+    assert [[r[0]] + [cells.fmt(x) for x in r[1:]] for r in table.itertuples(index=False)] == rows
     assert best != [r[0] for r in rows]
 
 

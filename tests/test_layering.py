@@ -118,10 +118,10 @@ def test_checker_finds_a_cycle():
 
 def test_checker_sees_imports_inside_functions(tmp_path):
     src = tmp_path / "m.py"
-    src.write_text("def f():\n    from . import runner\n    from .record import Task\n    from ..reports import plots\n"
+    src.write_text("def f():\n    from . import runner\n    from .record import Task\n    from ..reports import figures\n"
                    "    import rocking.lanes\n")
     assert imports(src, "pipeline.batch") >= {"pipeline.batch.runner", "pipeline.batch.record",
-                                              "pipeline.reports.plots", "rocking.lanes"}
+                                              "pipeline.reports.figures", "rocking.lanes"}
 
 
 def test_checker_sees_names_of_a_lazy_table(tmp_path):

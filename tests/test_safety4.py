@@ -474,31 +474,31 @@ def test_a_full_disk_at_a_figure_still_writes_design_csv_and_report_html(tmp_pat
     """When the disk filled at a figure, design.csv and report.html were never written."""
     import errno
 
-    from pipeline.reports import report
+    from pipeline.reports import files, outfiles
 
     from .test_pipeline_run import write_good
 
     records = [str(write_good(tmp_path, k, duration=2.0)) for k in range(2)]
-    real = report.Outputs.write
+    real = files.Outputs.write
 
     def full_at_figures(self, rel, data):
-        if str(rel) == report.SUMMARY_PLOT:
+        if str(rel) == outfiles.SUMMARY_PLOT:
             raise OSError(errno.ENOSPC, f"No space left on device: '{rel}'")
         return real(self, rel, data)
 
-    monkeypatch.setattr(report.Outputs, "write", full_at_figures)
+    monkeypatch.setattr(files.Outputs, "write", full_at_figures)
     out = tmp_path / "out"
     assert main(["run", *records, "--block", "7.5x1.8", "--shapes", "sine", "--out", str(out)]) == 1
     assert "No space left on device" in capsys.readouterr().err
     assert (out / "design.csv").is_file() and (out / "report.html").is_file()
-    assert not (out / report.SUMMARY_PLOT).exists()
+    assert not (out / outfiles.SUMMARY_PLOT).exists()
     monkeypatch.undo()
     assert main(["run", *records, "--block", "7.5x1.8", "--shapes", "sine", "--out", str(out), "-q"]) == 0
-    assert (out / report.SUMMARY_PLOT).is_file()
+    assert (out / outfiles.SUMMARY_PLOT).is_file()
 
 
 def test_a_batch_whose_every_record_failed_draws_no_empty_figure(tmp_path):
-    from pipeline.reports import report
+    from pipeline.reports import files, outfiles
 
     bad = tmp_path / "bad.sac"
     bad.write_bytes(b"not a record")
@@ -506,7 +506,7 @@ def test_a_batch_whose_every_record_failed_draws_no_empty_figure(tmp_path):
     assert main(["run", str(bad), "--block", "7.5x1.8", "--out", str(out), "-q"]) == 1
     assert (out / "design.csv").is_file() and (out / "report.html").is_file()
     assert not list(out.rglob("*.png"))
-    assert not (out / report.SUMMARY_PLOT).exists()
+    assert not (out / outfiles.SUMMARY_PLOT).exists()
 
 
 def test_the_suite_table_is_rounded_as_suite_csv(tmp_path):

@@ -294,7 +294,7 @@ def test_suite_and_fragility_plots():
 
     from matplotlib.image import imread
 
-    from pipeline.reports.plot_site import fragility_figure_png, suite_figure, suite_figure_png
+    from pipeline.reports.figures.site import fragility_figure_png, suite_figure, suite_figure_png
 
     rows = [{"column": "2x0.35", "pair": p, "design_width_m": w, "eq31_width_m": e}
             for p, w, e in (("a", 0.30, 0.2), ("a", 0.41, 0.25), ("b", 0.22, 0.3), ("c", 0.50, 0.1))]

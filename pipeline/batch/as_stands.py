@@ -4,13 +4,13 @@ answered).
 """
 from __future__ import annotations
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, FLAG, TEXT, WHOLE
 
 
 COLUMN_COLUMNS = Columns(
-    ("column", "-", "The column as given: `HxW` for `--block`, `H` for `--height`."),
+    ("column", "-", "The column as given: `HxW` for `--block`, `H` for `--height`.", TEXT),
     ("column_kind", "-", "`block` (a column as it stands, `--block`) or `height` (only the width a "
-                         "column of this height needs, `--height`; the as-it-stands fields are blank)."),
+                         "column of this height needs, `--height`; the as-it-stands fields are blank).", TEXT),
     ("height_m", "m", "Full height H of the column."),
 )
 
@@ -22,13 +22,13 @@ def column_fields(col) -> dict:
 
 AS_STANDS_COLUMNS = Columns(
     ("eq31_adequate", "-", "The column as it stands satisfies Eq. 31 for the governing pulse "
-                           "(tan_alpha >= governing_eq31_tan_alpha)."),
-    ("overturns", "-", "The column as it stands overturns (|theta| reaches pi/2) under the full record."),
-    ("exceeds_alpha", "-", "|theta| of the column as it stands passes alpha at some time under the full record."),
+                           "(tan_alpha >= governing_eq31_tan_alpha).", FLAG),
+    ("overturns", "-", "The column as it stands overturns (|theta| reaches pi/2) under the full record.", FLAG),
+    ("exceeds_alpha", "-", "|theta| of the column as it stands passes alpha at some time under the full record.", FLAG),
     ("max_theta_ratio", "-", "max|theta|/alpha of the column as it stands under the full record (at "
                              "least pi/(2 alpha) when it overturns)."),
-    ("n_impacts", "-", "Number of impacts of the column as it stands under the full record."),
-    ("model", "-", "Solver model that answered for the column as it stands (`rocking.simulate`, model=auto)."),
+    ("n_impacts", "-", "Number of impacts of the column as it stands under the full record.", WHOLE),
+    ("model", "-", "Solver model that answered for the column as it stands (`rocking.simulate`, model=auto).", TEXT),
 )
 
 

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from . import memo, peer_inputs, site
 from .stages import stage
-from ..reports.report import FIT_TOLERANCE, Columns, shape_list
+from ..reports.columns import Columns, TEXT, WHOLE
+from ..reports.shapes import FIT_TOLERANCE, shape_list
 
 
 def to_g(x):
@@ -22,22 +23,22 @@ RECORD_COLUMNS = Columns(
     ("record", "-", "Record id: the file name without its extension, made file-system safe (other "
                     "characters become `_`; a name longer than 96 characters is cut and ends in a "
                     "short hash of the whole name) and unique in input order (`-2`, `-3`, ...). The "
-                    "per-record report is `<record>.csv`."),
+                    "per-record report is `<record>.csv`.", TEXT),
     ("file", "-", "The record's path as given on the command line (bytes that are not UTF-8 written "
-                  "as `\\xff`)."),
-    ("station", "-", "Station code from the file header (blank when the format has none)."),
-    ("component", "-", "Component or channel from the file header."),
-    ("event", "-", "Event name from the file header."),
-    ("format", "-", "File format the record was read as."),
+                  "as `\\xff`).", TEXT),
+    ("station", "-", "Station code from the file header (blank when the format has none).", TEXT),
+    ("component", "-", "Component or channel from the file header.", TEXT),
+    ("event", "-", "Event name from the file header.", TEXT),
+    ("format", "-", "File format the record was read as.", TEXT),
     ("units", "-", "Units of the samples, as stated by the file header or given with `--units`; "
-                   "samples are converted to m/s^2."),
+                   "samples are converted to m/s^2.", TEXT),
     ("dt_s", "s", "Sampling interval."),
-    ("npts", "-", "Number of samples."),
+    ("npts", "-", "Number of samples.", WHOLE),
     ("duration_s", "s", "Time from the first to the last sample."),
     ("pga_g", "g", "Peak absolute ground acceleration."),
     ("pgv_m_s", "m/s", "Peak absolute ground velocity (from the fitter, after its baseline correction)."),
-    ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated."),
-    ("pulse_shape", "-", f"Best-fitting pulse shape: {shape_list()}."),
+    ("warnings", "-", "Warnings raised while reading the record (such as a peak over 5 g), `; `-separated.", TEXT),
+    ("pulse_shape", "-", f"Best-fitting pulse shape: {shape_list()}.", TEXT),
     ("pulse_ap_g", "g", "Amplitude ap of the best-fitting pulse, signed by its polarity."),
     ("pulse_tp_s", "s", "Period Tp of the best-fitting pulse (for the Rickers, the period at the peak "
                         "of the Fourier amplitude)."),
@@ -52,11 +53,11 @@ RECORD_COLUMNS = Columns(
                          "the record lacks."),
     ("pulse_fit", "-", "The least squares that fitted the pulses: `background` (weighted by the "
                        "background's spectrum estimated from the record, the default) or `plain` "
-                       "(where the record does not support the weighting)."),
+                       "(where the record does not support the weighting).", TEXT),
     ("pulse_correlation", "-", "Correlation between the best pulse and the record within the pulse "
                                "window (-1 to 1)."),
     ("shapes_fitting", "-", f"Shapes that fit the record almost equally well (score at least "
-                            f"{FIT_TOLERANCE:g} x the best score), best first, `;`-separated."),
+                            f"{FIT_TOLERANCE:g} x the best score), best first, `;`-separated.", TEXT),
 )
 
 

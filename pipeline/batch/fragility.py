@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from . import margin
-from ..reports.report import Columns
+from ..reports.columns import Columns, TEXT
 
 FRAGILITY_COLUMNS = Columns(
     ("critical_scale", "-", "`--fragility`: smallest factor k (on this row's record, already scaled "
@@ -19,7 +19,7 @@ FRAGILITY_COLUMNS = Columns(
                             "without `--fragility`."),
     ("critical_pga_g", "g", "PGA of the record at its critical scale."),
     ("critical_islands", "-", "Factor ranges above `critical_scale` where the column survives again "
-                              "(`a-b`, `;`-separated; the last may end at `fragility_up_to`)."),
+                              "(`a-b`, `;`-separated; the last may end at `fragility_up_to`).", TEXT),
     ("uplift_scale", "-", "Below this factor the column never uplifts (g tan(alpha) / PGA)."),
     ("fragility_up_to", "-", "Largest factor examined."),
 )

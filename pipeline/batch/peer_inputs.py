@@ -18,16 +18,16 @@ import functools
 import os
 from dataclasses import dataclass
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, FLAG, TEXT, WHOLE
 
 PEER_COLUMNS = Columns(
     ("peer_rsn", "-", "PEER record sequence number (RSN) of the record, from the download's "
-                      "`_SearchResults.csv`; blank for records that do not come from a PEER download."),
-    ("peer_event", "-", "Earthquake name as the search report writes it (PEER writes `_` for commas)."),
-    ("peer_year", "-", "Year of the earthquake (search report)."),
-    ("peer_station", "-", "Station name (search report)."),
+                      "`_SearchResults.csv`; blank for records that do not come from a PEER download.", WHOLE),
+    ("peer_event", "-", "Earthquake name as the search report writes it (PEER writes `_` for commas).", TEXT),
+    ("peer_year", "-", "Year of the earthquake (search report).", WHOLE),
+    ("peer_station", "-", "Station name (search report).", TEXT),
     ("peer_magnitude", "-", "Moment magnitude (search report)."),
-    ("peer_mechanism", "-", "Fault mechanism (search report)."),
+    ("peer_mechanism", "-", "Fault mechanism (search report).", TEXT),
     ("peer_rjb_km", "km", "Joyner-Boore distance Rjb (search report)."),
     ("peer_rrup_km", "km", "Rupture distance Rrup (search report)."),
     ("peer_vs30_m_s", "m/s", "Vs30 of the station (search report)."),
@@ -35,9 +35,9 @@ PEER_COLUMNS = Columns(
                                          "report): pulses much longer than its inverse are not in the data."),
     ("peer_scale_factor", "-", "The search's scale factor for the record (`Scale Factor` of the report)."),
     ("peer_scaled", "-", "True when `--peer-scales` applied `peer_scale_factor` (then in `scale`); "
-                         "False: the record as recorded, unscaled (the default)."),
+                         "False: the record as recorded, unscaled (the default).", FLAG),
     ("peer_vertical_file", "-", "The record's vertical component as the report lists it (blank: none); "
-                                "with `--vertical auto` it is used in the vertical_* columns."),
+                                "with `--vertical auto` it is used in the vertical_* columns.", TEXT),
 )
 #: the report's metadata key behind each column (pulses.io.peer.METADATA)
 _KEYS = {"peer_rsn": "rsn", "peer_event": "event", "peer_year": "year", "peer_station": "station",
@@ -155,7 +155,7 @@ NOT_DOWNLOADED_FIELDS = ["download", "peer_rsn", "line", "peer_event", "peer_sta
 
 def not_downloaded_text(rows) -> str | None:
     """The text of :data:`NOT_DOWNLOADED` (None when no download was given)."""
-    from ..reports.report import csv_text
+    from ..reports.columns import csv_text
 
     return None if rows is None else csv_text(NOT_DOWNLOADED_FIELDS, rows)
 

@@ -18,7 +18,7 @@ from .read import read_task
 from .row import fields_for
 from .stages import StageError, stage
 from .tasks import Task
-from ..reports.report import Columns
+from ..reports.columns import Columns
 
 
 def process_record(task: Task) -> dict:
@@ -53,7 +53,7 @@ def _process_record(task: Task) -> dict:
         out["failure"] = failure(task, "internal", exc)
         return out
     if task.options.plots and task.plot:
-        from ..reports.plots import run_figure_png
+        from ..reports.figures.record import run_figure_png
 
         try:
             out["plot"] = stage("plot", run_figure_png, task.record_id, *fit_parts)
@@ -66,7 +66,7 @@ def _process_record(task: Task) -> dict:
 
 def _friction_png(record_id, frictions, mu):
     """``plots/friction/<record>.png``: the friction each column's responses need against time."""
-    from ..reports.plot_friction import friction_png
+    from ..reports.figures.friction import friction_png
 
     return friction_png(record_id, frictions, mu)
 
@@ -74,7 +74,7 @@ def _friction_png(record_id, frictions, mu):
 def _widths_png(record_id, designs):
     """``plots/widths/<record>.png`` where the check above a search width found failing widths
     (docs/slivers.md); None elsewhere."""
-    from ..reports.plot_widths import record_widths_png
+    from ..reports.figures.widths import record_widths_png
 
     return record_widths_png(record_id, {(f"{k:g} m" if not isinstance(k, tuple) else
                                           f"{k[1]} {k[0]:g} m"): v for k, v in designs.items()})

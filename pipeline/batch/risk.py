@@ -144,7 +144,7 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
     risk.csv)``: the answers for design.csv and the printed answer (:func:`answer_fields`)."""
     from rocking.risk import nrml, rows as risk_rows
 
-    from ..reports import report
+    from ..reports import columns
     from ..reports.figures import draw
 
     if getattr(options, "risk", None) is None:
@@ -162,7 +162,7 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
         if name == RISK_CSV:
             made[name] += [_error_row(label, text, options) for label, text in results.items()
                            if isinstance(text, str)]
-        outputs.write(name, report.csv_text(list(cols.names), made[name]))
+        outputs.write(name, columns.csv_text(list(cols.names), made[name]))
     functions = [f for f in (nrml.functions_of(r, label) for label, r in results.items()
                              if not isinstance(r, str) and r.width is not None) if f is not None]
     if functions:
@@ -170,10 +170,10 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
     elif outputs.owned(FRAGILITY_XML):
         outputs.remove(FRAGILITY_XML)
     if options.plots:
-        outputs.write(RISK_WIDTHS_PLOT, render("plot_risk:widths_figure_png", made[RISK_WIDTHS_CSV],
+        outputs.write(RISK_WIDTHS_PLOT, render("risk:widths_figure_png", made[RISK_WIDTHS_CSV],
                                                made[RISK_CSV]))
         c = options.risk.curve
-        outputs.write(RISK_DISAGG_PLOT, render("plot_risk:disaggregation_figure_png",
+        outputs.write(RISK_DISAGG_PLOT, render("risk:disaggregation_figure_png",
                                                made[RISK_DISAGG_CSV], f"{c.measure} ({c.units})"))
     return {label: answer_fields(r, options) for label, r in results.items()}, made[RISK_CSV]
 
@@ -209,26 +209,3 @@ def answer_fields(result, options) -> dict:
                      + (f"{t.width:.3f} m" if t.width is not None else f"not found ({t.note})"))
     return {"site_rate_per_year": rate, "target_width_m": None if t is None else t.width,
             "text": "; ".join(parts)}
-
-
-def columns_markdown() -> str:
-    """The sections of ``columns.md`` for the risk files."""
-    from rocking.risk import rows
-
-    cell = lambda text: text.replace("|", "\\|")  # noqa: E731
-    out = []
-    for name, intro, cols in (
-            (RISK_CSV, "One row per column and failure mode as it stands, and one for the width for "
-                       "the target. `fragility.xml`: each column's fragility as an OpenQuake NRML "
-                       "fragility model (continuous logncdf; mean and stddev of the measure).",
-             rows.RISK_COLUMNS),
-            (RISK_RECORDS_CSV, "The critical values the fragilities are fitted to, record by record.",
-             rows.RECORD_COLUMNS),
-            (RISK_WIDTHS_CSV, "Every width computed for the target (`plots/risk_widths.png`).",
-             rows.WIDTH_COLUMNS),
-            (RISK_DISAGG_CSV, "The rate per interval of the hazard curve "
-                              "(`plots/risk_disaggregation.png`).", rows.DISAGGREGATION_COLUMNS)):
-        out += ["", f"## Columns of `{name}` (`--hazard`)", "", intro, "",
-                "| column | unit | meaning |", "|---|---|---|"]
-        out += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in cols.columns]
-    return "\n".join(out) + "\n"

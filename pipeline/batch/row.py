@@ -29,29 +29,34 @@ Adding a report column
 from __future__ import annotations
 
 from . import as_stands, fitted, fragility, margin, peer_inputs, rules, site, validity, vertical, widths
-from ..reports.report import SHAPE_NAMES
+from ..reports.columns import Columns
+from ..reports.shapes import SHAPE_NAMES
 
-_TO_DESIGN_WIDTH = (fitted.RECORD_COLUMNS.columns + site.SITE_COLUMNS.columns + peer_inputs.PEER_COLUMNS.columns
-                    + as_stands.COLUMN_COLUMNS.columns + rules.AS_STANDS_DESIGN_COLUMNS.columns
-                    + rules.GOVERNING_COLUMNS.columns
-                    + sum((rules.SHAPE_COLUMNS[s].columns for s in SHAPE_NAMES), ())
-                    + as_stands.AS_STANDS_COLUMNS.columns + rules.EQ31_DESIGN_COLUMNS.columns
-                    + widths.DESIGN_WIDTH_COLUMNS.columns)
-_FROM_CHECK = (widths.CHECK_COLUMNS.columns + rules.ENVELOPE_COLUMNS.columns + fragility.FRAGILITY_COLUMNS.columns
-               + vertical.VERTICAL_COLUMNS.columns + validity.VALIDITY_COLUMNS.columns)
-#: the columns every run's per-record reports and ``summary.csv`` have, in order: (name, unit,
-#: meaning); :func:`columns_for` adds those of a run's options
+_TO_DESIGN_WIDTH = Columns.joined(fitted.RECORD_COLUMNS, site.SITE_COLUMNS, peer_inputs.PEER_COLUMNS,
+                                  as_stands.COLUMN_COLUMNS, rules.AS_STANDS_DESIGN_COLUMNS, rules.GOVERNING_COLUMNS,
+                                  *(rules.SHAPE_COLUMNS[s] for s in SHAPE_NAMES), as_stands.AS_STANDS_COLUMNS,
+                                  rules.EQ31_DESIGN_COLUMNS, widths.DESIGN_WIDTH_COLUMNS)
+_FROM_CHECK = Columns.joined(widths.CHECK_COLUMNS, rules.ENVELOPE_COLUMNS, fragility.FRAGILITY_COLUMNS,
+                             vertical.VERTICAL_COLUMNS, validity.VALIDITY_COLUMNS)
+#: the columns every run's per-record reports and ``summary.csv`` have, in order;
+#: :func:`columns_for` adds those of a run's options
 COLUMNS = _TO_DESIGN_WIDTH + _FROM_CHECK
-FIELDS = [name for name, _, _ in COLUMNS]
+FIELDS = list(COLUMNS.names)
 
 
-def columns_for(options) -> tuple:
+def columns_for(options) -> Columns:
     """The columns of the reports of a run with ``options``: :data:`COLUMNS` with, after the design
     width's, the margin's under a level and the restitution's with ``--restitution``
     (:func:`pipeline.batch.margin.extra_columns`)."""
-    return _TO_DESIGN_WIDTH + margin.extra_columns(options) + _FROM_CHECK
+    return Columns.joined(_TO_DESIGN_WIDTH, *margin.extra_columns(options), _FROM_CHECK)
 
 
 def fields_for(options) -> list:
     """The names of :func:`columns_for`."""
-    return [name for name, _, _ in columns_for(options)]
+    return list(columns_for(options).names)
+
+
+def rows_of(text: str, options) -> list[dict]:
+    """The rows of the reports' ``text`` (no header) of a run with ``options``, each value read by
+    its column's kind (:meth:`pipeline.reports.columns.Columns.read`)."""
+    return columns_for(options).read(text)

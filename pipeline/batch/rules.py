@@ -16,7 +16,8 @@ import math
 
 from . import margin, memo
 from .fitted import to_g
-from ..reports.report import SHAPE_NAMES, Columns, _shape_key as shape_key
+from ..reports.columns import Columns, FLAG, TEXT
+from ..reports.shapes import _shape_key as shape_key, SHAPE_NAMES
 
 
 AS_STANDS_DESIGN_COLUMNS = Columns(
@@ -53,7 +54,7 @@ def as_stands_design(col, block, best, exact) -> dict:
 
 
 GOVERNING_COLUMNS = Columns(
-    ("governing_shape", "-", "Shape of the governing pulse (the rule is stated in `columns.md`)."),
+    ("governing_shape", "-", "Shape of the governing pulse (the rule is stated in `columns.md`).", TEXT),
     ("governing_ap_g", "g", "Amplitude of the governing pulse, signed."),
     ("governing_tp_s", "s", "Period of the governing pulse."),
     ("governing_eq31_tan_alpha", "-", "Eq. 31 minimum tan(alpha) for the governing pulse at the column's p."),
@@ -76,7 +77,7 @@ def shape_columns(shape: str) -> Columns:
     k = shape_key(shape)
     return Columns(
         (f"{k}_fits", "-", f"Whether the `{shape}` shape fits the record (see `shapes_fitting`); "
-                           "blank when the shape was not tried (`--shapes`)."),
+                           "blank when the shape was not tried (`--shapes`).", FLAG),
         (f"{k}_ap_g", "g", f"Amplitude of the best `{shape}` pulse, signed."),
         (f"{k}_tp_s", "s", f"Period of the best `{shape}` pulse."),
         (f"{k}_score", "-", f"Fit quality (score) of the best `{shape}` pulse."),
@@ -117,9 +118,9 @@ EQ31_DESIGN_COLUMNS = Columns(
     ("eq31_width_m", "m", "Width a column of this height needs by Eq. 31 for the governing pulse "
                           "(fixed point in B, since p depends on B; `rocking.required_width`, rule eq31)."),
     ("eq31_width_tan_alpha", "-", "tan(alpha) of the Eq. 31 design, eq31_width_m / height_m."),
-    ("eq31_width_overturns", "-", "The Eq. 31 design overturns under the full record."),
+    ("eq31_width_overturns", "-", "The Eq. 31 design overturns under the full record.", FLAG),
     ("eq31_width_max_theta_ratio", "-", "max|theta|/alpha of the Eq. 31 design under the full record."),
-    ("eq31_width_model", "-", "Solver model that answered for the Eq. 31 design."),
+    ("eq31_width_model", "-", "Solver model that answered for the Eq. 31 design.", TEXT),
 )
 
 
@@ -165,7 +166,7 @@ ENVELOPE_COLUMNS = Columns(
     ("envelope_width_m", "m", "Width a column of this height needs by the envelope rule "
                               "(`rocking.required_width`, rule envelope, with each fitting shape's "
                               "factor; fixed point in B): the widest over the shapes that fit."),
-    ("envelope_width_overturns", "-", "The envelope design overturns under the full record."),
+    ("envelope_width_overturns", "-", "The envelope design overturns under the full record.", FLAG),
 )
 
 

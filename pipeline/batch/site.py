@@ -13,23 +13,23 @@ from __future__ import annotations
 from . import peer_inputs
 from .peer_inputs import PEER_TP
 from ..reports.pulse_row import RUN_PULSE_COLUMNS, classification_fields
-from ..reports.report import Columns
+from ..reports.columns import Columns, TEXT
 
 
 # -- report columns ----------------------------------------------------------------------------------
 SITE_COLUMNS = Columns(
     ("pair", "-", "The record this row belongs to in the suite: for a pair of components "
                   "(`--pair`, `--pairs auto`) the pair's id (the first file's id, `+`, what differs "
-                  "in the second's), one per direction row; for a single component its record id."),
+                  "in the second's), one per direction row; for a single component its record id.", TEXT),
     ("file2", "-", "The second component's path for a pair (the first is `file`); blank for a single "
-                   "component."),
+                   "component.", TEXT),
     ("direction_deg", "deg", "Direction of the ground motion designed for, from the first component "
                              "towards the second (0..180; the component at theta is "
                              "a1 cos(theta) + a2 sin(theta)); blank for a single component."),
     ("direction_kind", "-", "Why this direction: `component-1`, `component-2` (the recorded "
                             "components), `pulse` (the strongest velocity pulse's direction, "
                             "`orientation_deg`), `pulse-normal` (90 deg from it) or `even` "
-                            "(`--directions N`); blank for a single component."),
+                            "(`--directions N`); blank for a single component.", TEXT),
     ("direction_azimuth_deg", "deg", "Azimuth of that direction, clockwise from north (0..180), where "
                                      "the files state the components' azimuths; else blank."),
     ("scale", "-", "Factor every sample of the record was multiplied by (`--scale`, `--scales`; 1 "

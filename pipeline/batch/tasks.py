@@ -194,7 +194,7 @@ def plainly_not_a_record(path) -> bool:
 def skipped_note(skipped, glob_option=True) -> str:
     """The note that ``run`` and ``classify`` print for the files of folders left out by
     :func:`expand_inputs` (the first five named; ``glob_option``: the command has ``--glob``)."""
-    from ..reports.report import display
+    from ..reports.cells import display
 
     shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
     return (f"{len(skipped)} file(s) of the folders skipped, plainly not records ({shown}); name a "

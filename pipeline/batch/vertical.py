@@ -15,25 +15,25 @@ from __future__ import annotations
 
 import dataclasses
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, FLAG, TEXT
 
 VERTICAL_COLUMNS = Columns(
     ("vertical_file", "-", "The vertical component used with this record (`--vertical auto`: a PEER "
                            "record's vertical, a `--triplet`, or the vertical `--pairs auto` found "
-                           "for the pair); blank when none was used (then every vertical_* is blank)."),
+                           "for the pair); blank when none was used (then every vertical_* is blank).", TEXT),
     ("vertical_polarity", "-", "`UP` or `DWN`, as the vertical's file name and header state it (a "
-                               "`DWN` record is multiplied by -1 to give the upward acceleration)."),
+                               "`DWN` record is multiplied by -1 to give the upward acceleration).", TEXT),
     ("vertical_pga_g", "g", "Peak absolute vertical acceleration (scaled as the record, `scale`)."),
     ("vertical_min_effective_gravity", "-", "Smallest 1 + av/g over the record (av upward): below 0 "
                                             "the ground falls away faster than gravity (free flight)."),
     ("vertical_overturns", "-", "The column as it stands overturns under the horizontal motion of this "
                                 "row together with the vertical (docs/theory.md section 10); compare "
-                                "`overturns` (horizontal alone). Blank for `--height`."),
+                                "`overturns` (horizontal alone). Blank for `--height`.", FLAG),
     ("vertical_max_theta_ratio", "-", "max|theta|/alpha of the column as it stands with the vertical; "
                                       "compare `max_theta_ratio`."),
     ("vertical_lifts_off", "-", "g + av < 0 before the response ended: the block leaves the ground, "
                                 "which the rocking model does not describe; the response with the "
-                                "vertical stops there and its verdict is not a verdict."),
+                                "vertical stops there and its verdict is not a verdict.", FLAG),
     ("vertical_t_lift_off_s", "s", "First time of g + av < 0 (blank when it never happens)."),
     ("vertical_design_width_m", "m", "Design width with the vertical (`rocking.required_width`, "
                                        "rule exact, `vertical=`): the smallest width surviving the "
@@ -44,7 +44,7 @@ VERTICAL_COLUMNS = Columns(
                                        "reaches -g (the block would leave the ground)."),
     ("vertical_model", "-", "Model that answered with the vertical: `fast-vertical` (the compiled "
                             "engine, `rocking.simulate(..., vertical=)`; `rest` if the column never "
-                            "uplifts)."),
+                            "uplifts).", TEXT),
 )
 
 

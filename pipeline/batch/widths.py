@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from . import vertical
 from .stages import stage
-from ..reports.design_table import check_bin_words, check_reach_words
-from ..reports.report import Columns
+from ..reports.answer import check_bin_words, check_reach_words
+from ..reports.columns import Columns, FLAG, TEXT, WHOLE
 
 
 DESIGN_WIDTH_COLUMNS = Columns(
@@ -25,13 +25,13 @@ DESIGN_WIDTH_COLUMNS = Columns(
     ("design_adequate", "-", "The column as it stands is at least as wide as the design width "
                                "(blank for `--height`). A column that survives (`overturns` False) "
                                "but is not design-adequate stands on a safe island: some slightly "
-                               "wider column of the same height overturns under the same record."),
+                               "wider column of the same height overturns under the same record.", FLAG),
     ("search_width_m", "m", "Diagnostic: the search's first transition (the smallest width above "
                             "which every width the search examined survives; `search_width`), "
                             "before the check above it; the design width is at least this."),
     ("design_governed_by", "-", "Which motion sets the design width: `horizontal` (the horizontal "
                                 "motion alone) or `with vertical` (the horizontal motion with the "
-                                "record's vertical); blank without a vertical."),
+                                "record's vertical); blank without a vertical.", TEXT),
     ("design_limit", "-", "The performance level of the design (`--limit` R: max|theta|/alpha <= R); "
                           "blank: overturning, the paper's question."),
     ("overturning_width_m", "m", "With `--limit` R: the overturning design of the same column and "
@@ -77,7 +77,7 @@ CHECK_COLUMNS = Columns(
                                     "above it."),
     ("check_runs", "-", "Number of widths (solver runs) of the check above the search width: 300 "
                         "and more where the response varies (0: not checked; in a direction of a pair, "
-                        "those above a lower bound of the pair's design width, docs/site.md)."),
+                        "those above a lower bound of the pair's design width, docs/site.md).", WHOLE),
 )
 
 

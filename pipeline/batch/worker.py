@@ -105,7 +105,7 @@ TEXT = "text"
 def rows_text(rows, options):
     """``<record>.csv``'s text of ``rows`` (the columns of the run's ``options``), or None where
     they do not match the columns (the main process then fails as it did)."""
-    from ..reports.report import ReportError, csv_text
+    from ..reports.columns import csv_text, ReportError
 
     try:
         return csv_text(fields_for(options), rows)

@@ -14,7 +14,7 @@ import sys
 
 from ..args import ShapeNames, add_record_options, add_weighting_option, record_options
 from ..values import parse_shapes
-from ..reports.report import text_cell
+from ..reports.cells import text_cell
 
 
 def add_parser(subparsers) -> None:

@@ -24,7 +24,8 @@ import struct
 import zlib
 
 from ..values import ArgumentError
-from .report import NotOurs, display, write_atomic
+from .cells import display
+from .files import NotOurs, write_atomic
 
 #: the ``Software`` text chunk of the PNG files this package writes (no version: the bytes of a
 #: figure do not change with it)
@@ -170,7 +171,7 @@ def mark_png(raw: bytes) -> bytes:
 
 def write_output(path, data, kind: str, *, what: str = "output", inputs=()) -> pathlib.Path:
     """Write an output file atomically, unless a file this package did not write is there (or
-    it is an input): :class:`pipeline.reports.report.NotOurs` (an :class:`OSError`) naming it, the file
+    it is an input): :class:`pipeline.reports.files.NotOurs` (an :class:`OSError`) naming it, the file
     left as it is.  PNG data gets this package's mark."""
     path = pathlib.Path(path)
     same = _same(path, inputs)

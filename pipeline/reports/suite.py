@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import math
 
-from .report import (FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT,
-                     Columns)
+from .columns import TEXT, WHOLE, Columns
+from .outfiles import FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, PAIRS_CSV, SUITE_CSV, SUITE_PLOT
 
 
 PAIR_COLUMNS = Columns(
@@ -43,13 +43,13 @@ def governing_rows(rows, failed=None) -> list[dict]:
 
 
 SUITE_COLUMNS = Columns(
-    ("column", "-", "The column as given (`HxW` or `H`)."),
-    ("column_kind", "-", "`block` or `height` (as in `summary.csv`)."),
+    ("column", "-", "The column as given (`HxW` or `H`).", TEXT),
+    ("column_kind", "-", "`block` or `height` (as in `summary.csv`).", TEXT),
     ("height_m", "m", "Full height of the column."),
     ("width_m", "m", "Full width of the column as it stands (blank for `--height`)."),
     ("cap_mass_ratio", "-", "Cap beam mass over the columns' mass (0: a lone column)."),
-    ("n_records", "-", "Records of the suite with results: a pair counts once, whatever its directions."),
-    ("n_rows", "-", "Record directions with results (rows of `summary.csv` for this column)."),
+    ("n_records", "-", "Records of the suite with results: a pair counts once, whatever its directions.", WHOLE),
+    ("n_rows", "-", "Record directions with results (rows of `summary.csv` for this column).", WHOLE),
     ("width_all_m", "m", "Width that survives every record in every direction: the largest design "
                          "width of the suite."),
     ("width_all_but_one_m", "m", "Width that survives all records but one (each record counted by its "
@@ -214,48 +214,20 @@ def write_tables(outputs, rows, fields, options, failed=None, render=None) -> No
     files, from every row of the run (``failed``: ``{pair: directions that failed}``); ``render(fn,
     *args)`` draws a figure (default: here; pipeline.batch.executors.renderer); ``options``: the
     run's (``plots``, ``fragility``, ``fragility_limit``)."""
-    from . import report
+    from . import columns
     from .figures import draw
 
     render = render or draw
 
     pair_fields = list(PAIR_COLUMNS.names) + list(fields)
-    outputs.write(PAIRS_CSV, report.csv_text(pair_fields, governing_rows(rows, failed)))
+    outputs.write(PAIRS_CSV, columns.csv_text(pair_fields, governing_rows(rows, failed)))
     suite = suite_rows(rows) if rows else []
-    outputs.write(SUITE_CSV, report.csv_text(list(SUITE_COLUMNS.names), suite))
+    outputs.write(SUITE_CSV, columns.csv_text(list(SUITE_COLUMNS.names), suite))
     if options.plots and rows:
-        outputs.write(SUITE_PLOT, render("plot_site:suite_figure_png", rows, suite))
+        outputs.write(SUITE_PLOT, render("site:suite_figure_png", rows, suite))
     if options.fragility:
         summary, curve, fits = fragility_tables(rows, options.fragility_limit)
-        outputs.write(FRAGILITY_CSV, report.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
-        outputs.write(FRAGILITY_CURVE_CSV, report.csv_text(list(FRAGILITY_CURVE_COLUMNS.names), curve))
+        outputs.write(FRAGILITY_CSV, columns.csv_text(list(FRAGILITY_SUMMARY_COLUMNS.names), summary))
+        outputs.write(FRAGILITY_CURVE_CSV, columns.csv_text(list(FRAGILITY_CURVE_COLUMNS.names), curve))
         if options.plots and fits:
-            outputs.write(FRAGILITY_PLOT, render("plot_site:fragility_figure_png", fits))
-
-
-def columns_markdown() -> str:
-    """The sections of ``columns.md`` for the site files."""
-    cell = lambda text: text.replace("|", "\\|")
-
-    def table(title, intro, columns):
-        lines = ["", f"## {title}", "", intro, "", "| column | unit | meaning |", "|---|---|---|"]
-        return lines + [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in columns]
-
-    lines = table("Columns of `pairs.csv`",
-                  "One row per record of the suite (a pair, or a single component) and column: the "
-                  "row of `summary.csv` of its governing direction (the widest design width), "
-                  "after these two columns.", PAIR_COLUMNS.columns)
-    lines += table("Columns of `suite.csv`",
-                   "One row per column, over every record of the suite (failed records left out; "
-                   "they are in `failures.csv`). A record's *governing* design width is the widest "
-                   "over its directions. `plots/suite.png`: share of the records whose governing "
-                   "design width is at most a given width, with the column's width and the Eq. 31 "
-                   "widths marked.", SUITE_COLUMNS.columns)
-    lines += table("Columns of `fragility.csv` (`--fragility`)",
-                   "One row per column as it stands: the lognormal collapse fragility of the suite. "
-                   "`fragility_curve.csv` gives the fitted curves point by point, and "
-                   "`plots/fragility.png` draws them with the records' critical values.",
-                   FRAGILITY_SUMMARY_COLUMNS.columns)
-    lines += table("Columns of `fragility_curve.csv`", "The fitted curves, 60 points each "
-                   "(median x exp(z beta), z from -2.5 to 2.5).", FRAGILITY_CURVE_COLUMNS.columns)
-    return "\n".join(lines) + "\n"
+            outputs.write(FRAGILITY_PLOT, render("site:fragility_figure_png", fits))
