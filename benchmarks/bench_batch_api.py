@@ -72,7 +72,7 @@ def cpu_jobs1(recs, tmp, repeats):
 
 
 def _same_table(path, frame) -> bool:
-    from pipeline.reports.report import fmt
+    from pipeline.reports.cells import fmt
 
     with open(path, newline="", encoding="utf-8") as fh:
         rows = list(csv.reader(fh))

@@ -130,7 +130,7 @@ def measure(paths, heights, settings=None, cache=None, level=True, misses=False,
 
     import pulses
     import rocking
-    from pipeline.batch.record import design_width
+    from pipeline.batch.widths import design_width
     from pulses import G
     from rocking.search import DEFAULT_SETTINGS
 

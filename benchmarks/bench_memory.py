@@ -70,7 +70,7 @@ def memory(n: int = 2000) -> dict:
 
 
 def _timed(paths, out, **kw):
-    from pipeline.batch.record import Column, Options
+    from pipeline.batch.tasks import Column, Options
     from pipeline.batch.runner import run
 
     t0 = time.perf_counter()

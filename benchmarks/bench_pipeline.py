@@ -59,7 +59,8 @@ def make_records(folder, n, durations, dt=0.01, seed=0):
 
 def stage_split(paths, plots=True) -> dict:
     """Median seconds per record spent in each stage (``process_record``'s ``seconds``), one process."""
-    from pipeline.batch.record import Column, Options, process_record
+    from pipeline.batch.record import process_record
+    from pipeline.batch.tasks import Column, Options
     from pipeline.batch.runner import make_tasks
 
     tasks = make_tasks(paths, [Column(7.5, 1.8), Column(6.0, 1.2)], Options(plots=plots))

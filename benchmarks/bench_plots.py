@@ -38,8 +38,9 @@ def run(repeat: int = 5) -> dict:
     """Measure; return (and print) a dict of seconds and PNG sizes."""
     import matplotlib
 
-    from pipeline.reports import plots
-    from pipeline.batch.record import Column, Options, _process
+    from pipeline.reports.figures import record as plots
+    from pipeline.batch.record import _process
+from pipeline.batch.tasks import Column, Options
     from pipeline.batch.runner import make_tasks
 
     paths = sorted(str(p) for p in DATA.glob("*.sac"))

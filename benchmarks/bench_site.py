@@ -31,7 +31,8 @@ def shared_pairs():
 
 def cost(pair, columns, n_even, fragility):
     from pipeline.batch import pairs
-    from pipeline.batch.record import Options, process_record
+    from pipeline.batch.record import process_record
+    from pipeline.batch.tasks import Options
 
     opts = Options(plots=False, fragility=fragility)
     tasks = pairs.pair_tasks([], [pair], "none", columns, opts, n_even, say=lambda m: None)
@@ -45,12 +46,12 @@ def cost(pair, columns, n_even, fragility):
 def miss(pair, heights, n_even):
     import pulses
     import rocking
-    from pipeline.batch import site
+    from pipeline.batch import pairs
 
     first, second = pulses.read_pair(*pair)
     orient = pulses.classify_pulse(first, second).orientation
-    default = site.directions(orient)
-    full = site.directions(orient, n_even)
+    default = pairs.directions(orient)
+    full = pairs.directions(orient, n_even)
     out = []
     for H in heights:
         widths = {a: float(rocking.required_width(H, pulses.component(first, second, a), rule="exact").width)
@@ -69,7 +70,7 @@ def main(argv=None):
     ap.add_argument("--skip-cost", action="store_true")
     ap.add_argument("--skip-miss", action="store_true")
     args = ap.parse_args(argv)
-    from pipeline.batch.record import Column
+    from pipeline.batch.tasks import Column
 
     pairs = shared_pairs()
     print(f"{len(pairs)} pairs in {SHARED}")

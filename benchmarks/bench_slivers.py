@@ -170,7 +170,7 @@ def figure(path, name="RSN879_LANDERS_LCN345.AT2", n=6000):
     widths from 0.6 to 1.6 times the search width and the check's own widths."""
     import pulses
     import rocking
-    from pipeline.reports.plot_widths import widths_figure_png
+    from pipeline.reports.figures.widths import widths_figure_png
 
     record = pulses.read_record(RECORDS / name)
     v = rocking.required_width(HEIGHT, record, rule="exact")

@@ -10,7 +10,7 @@ import importlib
 import os
 import sys
 
-from .args import ArgumentError
+from .values import ArgumentError
 
 #: sub-command modules, in the order ``pipeline --help`` lists them
 COMMANDS = ["simulate", "fit", "convert", "design", "spectrum", "chart", "run", "demo", "classify"]

@@ -10,13 +10,13 @@ import pytest
 
 import pipeline
 import rocking
-from pipeline.reports import report
-from pipeline import api
+from pipeline.reports import cells
 from pipeline.batch.margin import DEFAULT_LIMIT
-from pipeline.batch.record import FIELDS, fields_for
+from pipeline.batch.row import FIELDS, fields_for
 from pipeline.batch.tasks import Options
 from pipeline.cli import main
 from pipeline.commands.demo import bundled_records
+from pipeline.plan import _limit, _restitution, plan_from
 from pipeline.reports.design_table import DESIGN_FIELDS, design_columns
 
 from .vertical_cases import DOWNLOAD
@@ -31,11 +31,11 @@ def _cells(path) -> list[list[str]]:
 
 
 def _frame_cells(df, fields) -> list[list[str]]:
-    """A DataFrame's cells as the CSV writer formats them (report.fmt), under the header."""
+    """A DataFrame's cells as the CSV writer formats them (cells.fmt), under the header."""
     import math
 
     def cell(v):
-        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else report.fmt(v)
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else cells.fmt(v)
 
     assert list(df.columns) == list(fields)
     return [list(fields)] + [[cell(v) for v in row] for row in df.itertuples(index=False)]
@@ -50,8 +50,8 @@ def _same_as_cli(tmp_path, inputs, cli_args, **kw):
     run = pipeline.design(inputs, **kw)
     assert run.exit_code == code
     # the columns of the run's options: a level's margin (the default), a restitution's
-    opts = Options(limit=api._limit(kw.get("limit", DEFAULT_LIMIT)),
-                   restitution=api._restitution(kw.get("restitution")))
+    opts = Options(limit=_limit(kw.get("limit", DEFAULT_LIMIT)),
+                   restitution=_restitution(kw.get("restitution")))
     design_fields = [n for n, _, _ in design_columns(opts.limit is not None, opts.restitution is not None)]
     assert _frame_cells(run.design, design_fields) == _cells(out / "design.csv")
     assert _frame_cells(run.summary, fields_for(opts)) == _cells(out / "summary.csv")
@@ -93,7 +93,7 @@ def test_a_restitution_band_flows_through(tmp_path):
     assert row["restitution"] == "0.95:1.05" and row["restitution_values_run"] == BAND_VALUES
     widths = [float(p.split("=")[1]) for p in row["restitution_design_widths_m"].split("; ")]
     assert len(widths) == BAND_VALUES and row["design_width_m"] == max(widths)
-    assert api._plan([], blocks=None, heights=7.5, pairs=None, directions=0, vertical="auto", limit=0.5,
+    assert plan_from([], blocks=None, heights=7.5, pairs=None, directions=0, vertical="auto", limit=0.5,
                      restitution="eta=0.9", jobs=1, out=None, shapes=None, weighting="background",
                      units=None, dt=None, scale=None, plots=None, force=False, thorough=False,
                      quiet=True).options.restitution == Restitution(0.9, kind="eta")
@@ -115,7 +115,7 @@ def test_a_peer_download_gives_pipeline_runs_design_csv(tmp_path):
 
 
 def test_the_forms_of_a_column():
-    from pipeline.api import columns_from
+    from pipeline.plan import columns_from
     from pipeline.batch.tasks import Column
 
     block = rocking.Block.from_dimensions(7.5, 1.8)
@@ -211,12 +211,12 @@ def test_a_loop_with_the_governing_pulse_gives_pipeline_runs_eq31_widths():
         rows = []
         for path in paths:
             gov = rocking.governing_pulse(pulses.fit_pulse(pulses.read_record(path)), 7.5)
-            rows.append([gov.candidate.shape, report.fmt(gov.candidate.ap_g), report.fmt(gov.candidate.tp),
-                         report.fmt(gov.width)])
+            rows.append([gov.candidate.shape, cells.fmt(gov.candidate.ap_g), cells.fmt(gov.candidate.tp),
+                         cells.fmt(gov.width)])
         # the best fit alone is not the rule: on the demo it gives another shape on some record
         best = [pulses.fit_pulse(pulses.read_record(p)).best.shape for p in paths]
     table = run.design[["governing_shape", "governing_ap_g", "governing_tp_s", "eq31_width_m"]]
-    assert [[r[0]] + [report.fmt(x) for x in r[1:]] for r in table.itertuples(index=False)] == rows
+    assert [[r[0]] + [cells.fmt(x) for x in r[1:]] for r in table.itertuples(index=False)] == rows
     assert best != [r[0] for r in rows]
 
 

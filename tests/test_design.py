@@ -443,7 +443,7 @@ def test_min_slenderness_top_bisection_same_answer():
     """refine="top" with ksection 2 and pipeline run's EXACT_KSECTION against the default full
     refinement, including a case with a safe island below the answer (symmetric Ricker,
     Rinaldi): within 2e-9, twice the 1e-9 brackets each ends in."""
-    from pipeline.batch.record import EXACT_KSECTION
+    from pipeline.batch.rules import EXACT_KSECTION
 
     cases = [("ricker-sym", [1.381 * 0.8, 2.5], [0.71, 0.4]), ("sine", [1.1, 3.0], [0.3, 0.8])]
     for shape, ptp, apg in cases:

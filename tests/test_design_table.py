@@ -1,6 +1,7 @@
 """The answer rows of design.csv and the printed table: a pair's widest failing width and its
 verdict with the vertical, from rows of summary.csv."""
-from pipeline.reports.design_table import design_rows, excess_text, failing_text, metadata_text, table_text
+from pipeline.reports.answer import excess_text, failing_text, metadata_text, table_text
+from pipeline.reports.design_table import design_rows
 
 
 def _row(direction, design, failing, overturns=False, vertical=None, search=None):
@@ -105,7 +106,7 @@ def test_eq31_safe_island_and_the_suite_answer():
 def test_the_motion_that_governs_is_marked_where_it_is_the_vertical():
     """A design width set by the response with the vertical reads ``(vertical)`` beside it, in the
     printed table and the page; one set by the horizontal motion alone carries no mark."""
-    from pipeline.reports.design_table import table_cells
+    from pipeline.reports.answer import table_cells
 
     vert = dict(_row(0, 1.553, None, search=1.5), design_governed_by="with vertical",
                 record="v", pair="v")

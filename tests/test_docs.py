@@ -45,13 +45,13 @@ def test_readme_is_a_first_page():
 def test_readme_table_is_a_real_run():
     """The table pasted in the README is the demo's, as ``pipeline run`` prints it (the rows of
     the demo computed by tests/test_html_report.py's run are compared there; here its format)."""
-    from pipeline.reports import design_table
+    from pipeline.reports import answer
 
     text = README.read_text(encoding="utf-8")
     table = re.search(r"^```text\n(record .*?)^pipeline run: ", text, re.S | re.M).group(1)
     head = table.splitlines()[0]
     assert head.split("  ")[0].strip() == "record"
-    for h in design_table.HEADERS:
+    for h in answer.HEADERS:
         assert h in head
 
 

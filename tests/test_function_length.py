@@ -13,7 +13,7 @@ MAX_LINES = 100
 #: functions allowed over the limit for a while, each with its length then (none may grow); none now
 KNOWN_LONG: dict[str, int] = {}
 #: packages already held to the house's limits: (lines a function, lines a module)
-PACKAGE_LIMITS = {"pulses": (80, 600)}
+PACKAGE_LIMITS = {"pulses": (80, 600), "pipeline": (80, 600)}
 
 
 def function_lengths():

@@ -22,7 +22,7 @@ import tempfile
 
 import pytest
 
-from pipeline.reports import design_table, html_report
+from pipeline.reports import answer, design_table, html_report
 from pipeline.commands.demo import bundled_records
 
 CHROMIUM = shutil.which("chromium") or ("/usr/bin/chromium" if os.path.exists("/usr/bin/chromium") else None)
@@ -197,8 +197,8 @@ def test_design_rows_of_a_pair():
     assert d["record"] == "A+B" and d["direction_deg"] == 90.0 and d["design_width_m"] == 1.9
     assert d["n_directions"] == 3 and d["n_directions_failed"] == 1
     assert d["survives"] is False and d["design_adequate"] is False and d["max_theta_ratio"] == 5.0
-    assert design_table.survives_text(d) == "NO" and d["verdict"] == "NO"
-    text = design_table.table_text([d])
+    assert answer.survives_text(d) == "NO" and d["verdict"] == "NO"
+    text = answer.table_text([d])
     assert "A+B @90deg" in text and "1.900 m" in text
 
 

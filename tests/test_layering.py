@@ -118,10 +118,10 @@ def test_checker_finds_a_cycle():
 
 def test_checker_sees_imports_inside_functions(tmp_path):
     src = tmp_path / "m.py"
-    src.write_text("def f():\n    from . import runner\n    from .record import Task\n    from ..reports import plots\n"
+    src.write_text("def f():\n    from . import runner\n    from .record import Task\n    from ..reports import figures\n"
                    "    import rocking.lanes\n")
     assert imports(src, "pipeline.batch") >= {"pipeline.batch.runner", "pipeline.batch.record",
-                                              "pipeline.reports.plots", "rocking.lanes"}
+                                              "pipeline.reports.figures", "rocking.lanes"}
 
 
 def test_checker_sees_names_of_a_lazy_table(tmp_path):
@@ -184,7 +184,8 @@ def test_imports_go_one_way():
 
 #: the groups of ``pipeline`` and those each must not import: the commands use the batch engine and
 #: the reports; the batch engine writes through the reports; the reports use neither.  The top-level
-#: modules (``cli``, ``api``, ``args``, ``interrupts``) are shared by all three.
+#: modules are shared: ``cli``, ``api`` and ``plan`` (the run checked, as the batch's values) stand
+#: above the groups; ``args``, ``values`` and ``interrupts`` are leaves every group may use.
 PIPELINE_ROLES = {"batch": ("commands",), "reports": ("commands", "batch")}
 
 
@@ -197,5 +198,16 @@ def test_pipeline_groups_import_one_way():
             bad = dep.split(".")[0] in PIPELINE_ROLES.get(group, ())
             assert not bad, f"pipeline.{name} imports pipeline.{dep}"
     top = {n for n in graph if "." not in n and n not in ("commands", "batch", "reports")}
-    for name in top - {"cli", "api", "__main__", ""}:  # the shared leaves use no group but reports
+    for name in top - {"cli", "api", "plan", "__main__", ""}:  # the shared leaves use no group but reports
         assert not {d for d in graph[name] if d.split(".")[0] in ("commands", "batch")}, name
+
+
+def test_the_batch_takes_values_not_the_command_line():
+    """The batch engine imports neither argparse nor the command line's parsers (pipeline.args):
+    the commands read their options into values (pipeline.values' rules), the batch takes them."""
+    mods = _modules("pipeline")
+    batch = {n: p for n, p in mods.items() if n == "batch" or n.startswith("batch.")}
+    assert len(batch) > 20  # the batch's modules were read
+    for name, path in batch.items():
+        bad = {i for i in imports(path, _package_of("pipeline", name)) if i in ("argparse", "pipeline.args")}
+        assert not bad, f"pipeline/{name.replace('.', '/')}.py imports {sorted(bad)}"

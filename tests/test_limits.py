@@ -171,7 +171,7 @@ def test_fragility_table_counts_failures_at_the_level_in_their_own_column():
     """fragility.csv: without a level the records that fail count as overturned; with --limit R
     (critical scales where max|theta|/alpha first exceeds R) they go to n_failed_at_level and
     n_overturned is blank (a level's critical scale does not say the column overturns)."""
-    from pipeline.batch.site import fragility_tables
+    from pipeline.reports.suite import fragility_tables
 
     def rows(limit):
         # four records of one column, three with a critical scale (log-moments: a fit exists)
@@ -296,7 +296,7 @@ def test_level_with_the_vertical_at_least_each_overturning_design():
     motion's level width, is the one computed apart where it is wider than that width, and the
     reported overturning width is the wider of the two; the design width keeps max|theta|/alpha
     <= 0.5 with and without the vertical (independent runs)."""
-    from pipeline.batch.record import design_width
+    from pipeline.batch.widths import design_width
 
     if not DOWNLOAD.is_dir():
         pytest.skip(f"the PEER download is absent: {DOWNLOAD}")

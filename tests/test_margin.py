@@ -240,7 +240,8 @@ def test_the_options_hold_a_restitution_object():
 
 
 def test_the_printed_cells_of_the_margin():
-    from pipeline.reports.design_table import design_rows, table_text
+    from pipeline.reports.answer import table_text
+    from pipeline.reports.design_table import design_rows
 
     row = {"record": "a", "pair": "a", "column": "7.5x1.8", "column_kind": "block", "direction_deg": None,
            "design_width_m": 2.0, "widest_failing_width_m": None, "overturns": False,

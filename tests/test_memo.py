@@ -158,7 +158,7 @@ def test_a_level_and_its_overturning_design_are_both_kept_between_passes(kept, m
     """`pipeline run --limit`'s design of a column (pipeline.batch.record.design_width): a later
     pass (the check on) finds both searches, the overturning design's and the level's, kept from
     the first pass (no search runs again), and answers as a fresh computation."""
-    from pipeline.batch.record import design_width
+    from pipeline.batch.widths import design_width
     from rocking import widths
 
     record = _synthetic(0.4, 3)
@@ -182,23 +182,25 @@ def test_a_pair_is_read_once_per_worker_and_again_once_its_file_changes(tmp_path
     written since is read again, and the records are the file's as it is then."""
     from types import SimpleNamespace
 
-    from pipeline.batch import site
+    from pipeline.batch.read import read_task
+    from pipeline.batch.tasks import ReadOptions
 
     a, b = _pair(tmp_path, "STM", 0.45, 0.3, 3)
     calls = []
     real = pulses.read_pair
     monkeypatch.setattr(pulses, "read_pair", lambda *p, **k: calls.append(p) or real(*p, **k))
-    opts = SimpleNamespace(format=None, units=None, dt=None, column=None, trace=None)
-    task = lambda d: SimpleNamespace(peer=None, options=opts, path=a, path2=b, direction=d, scale=1.0)  # noqa: E731
+    opts = SimpleNamespace(read=ReadOptions(), vertical="auto")
+    task = lambda d: SimpleNamespace(peer=None, options=opts, path=a, path2=b, direction=d, scale=1.0,  # noqa: E731
+                                     vertical=None)
     memo.on()
     try:
-        r0, r30 = site.read_task(task(0.0)), site.read_task(task(30.0))
+        r0, r30 = read_task(task(0.0))[0], read_task(task(30.0))[0]
         assert len(calls) == 1
         assert np.array_equal(r30.acc, pulses.component(*real(a, b), 30.0).acc)
         rec = pulses.read_record(a)
         pulses.write_sac(pulses.Record(2.0 * rec.acc, rec.dt, rec.name, 0.0, rec.metadata), a)
         os.utime(a, ns=(os.stat(a).st_atime_ns, os.stat(a).st_mtime_ns + 10**9))
-        r0_new = site.read_task(task(0.0))
+        r0_new = read_task(task(0.0))[0]
         assert len(calls) == 2
         # the first component doubled, as written (0 degrees is the first file's azimuth)
         np.testing.assert_allclose(r0_new.acc, 2.0 * r0.acc, rtol=1e-6)

@@ -10,7 +10,7 @@ import csv
 import pytest
 
 from pipeline.batch import passes
-from pipeline.batch.record import CHECK_COLUMNS
+from pipeline.batch.widths import CHECK_COLUMNS
 from pipeline.cli import main as cli_main
 from rocking.search import DEFAULT_SETTINGS
 

@@ -14,9 +14,10 @@ import pytest
 
 import pulses
 import rocking
-from pipeline.reports import report
+from pipeline.reports import columns, files, outfiles
 from pipeline.batch import resume
-from pipeline.batch.record import FAILURE_FIELDS, Column, Options, record_ids
+from pipeline.batch.record import FAILURE_FIELDS
+from pipeline.batch.tasks import Column, Options, record_ids
 from pipeline.cli import main
 from pulses import G
 
@@ -183,7 +184,7 @@ def test_record_plot_same_bytes_drawn_first_or_after_others(tmp_path):
     assert (after / name).read_bytes() == png
     # in this process: drawn first, then again after the other records drew four pulses and three
     # curves a panel; the target also with one pulse and one curve fewer a panel
-    from pipeline.reports import plots
+    from pipeline.reports.figures import record as plots
     from pipeline.batch.record import _process
     from pipeline.batch.runner import make_tasks
 
@@ -218,14 +219,14 @@ def test_all_good_exits_0_and_bad_arguments_exit_2(tmp_path, capsys):
 
 def test_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
     target = tmp_path / "summary.csv"
-    report.write_atomic(target, "old\n")
+    files.write_atomic(target, "old\n")
 
     def boom(*a, **k):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(os, "replace", boom)
     with pytest.raises(KeyboardInterrupt):
-        report.write_atomic(target, "new content\n")
+        files.write_atomic(target, "new content\n")
     assert target.read_text() == "old\n"
     assert [p.name for p in tmp_path.iterdir()] == ["summary.csv"]
 
@@ -254,7 +255,7 @@ def test_ctrl_c_leaves_only_complete_reports(batch20, tmp_path):
     files = [p for p in out.rglob("*") if p.is_file()]
     assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
     # the list of files written and the resume journal, not reports
-    files = [p for p in files if p.name not in (report.MANIFEST, resume.RESUME)]
+    files = [p for p in files if p.name not in (outfiles.MANIFEST, resume.RESUME)]
     for path in files:  # every report written is whole: the header and one row
         rows = read_csv(path)
         assert len(rows) == 1 and rows[0]["design_adequate"] in ("True", "False")
@@ -691,18 +692,19 @@ def test_absurd_sizes_are_argument_errors(bad, tmp_path, capsys):
 
 def test_report_rows_must_match_their_declared_columns():
     """Writing a row with an undeclared key, or without a declared one, fails (no silent blank)."""
-    from pipeline.batch.record import FIELDS, RECORD_COLUMNS
+    from pipeline.batch.fitted import RECORD_COLUMNS
+    from pipeline.batch.row import FIELDS
 
     row = dict.fromkeys(FIELDS, 1.0)
-    assert report.csv_text(FIELDS, [row]).count("\n") == 2
+    assert columns.csv_text(FIELDS, [row]).count("\n") == 2
     for bad in ({**row, "typo_column": 1.0}, {k: v for k, v in row.items() if k != "pga_g"}):
-        with pytest.raises(report.ReportError):
-            report.csv_text(FIELDS, [bad])
+        with pytest.raises(columns.ReportError):
+            columns.csv_text(FIELDS, [bad])
     values = dict.fromkeys(RECORD_COLUMNS.names)
     assert list(RECORD_COLUMNS.row(values)) == list(RECORD_COLUMNS.names)
-    with pytest.raises(report.ReportError):
+    with pytest.raises(columns.ReportError):
         RECORD_COLUMNS.row({**values, "extra": 1})
-    with pytest.raises(report.ReportError):
+    with pytest.raises(columns.ReportError):
         RECORD_COLUMNS.row({k: v for k, v in values.items() if k != "event"})
 
 
@@ -773,7 +775,7 @@ def _check_reports_whole(out):
     files = [p for p in out.rglob("*") if p.is_file()]
     assert not [p for p in files if p.name.startswith(".") or "tmp" in p.name]
     for path in files:
-        if path.name not in (report.MANIFEST, resume.RESUME):
+        if path.name not in (outfiles.MANIFEST, resume.RESUME):
             rows = read_csv(path)
             assert len(rows) == 1 and rows[0]["design_adequate"] in ("True", "False")
 

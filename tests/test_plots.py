@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pipeline.reports import plots
-from pipeline.batch.record import Column, Options, _process
+from pipeline.reports.figures import record as plots
+from pipeline.batch.record import _process
+from pipeline.batch.tasks import Column, Options
 from pipeline.batch.runner import make_tasks
 from pulses import G
 

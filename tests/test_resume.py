@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from pipeline.reports import report
+from pipeline.reports import columns, outfiles
 
 from pipeline.batch import resume
 from pipeline.cli import main
@@ -100,7 +100,7 @@ def test_stale_reports_failures_and_force_are_computed_again(batch, whole, tmp_p
     from pipeline.batch.tasks import Options
 
     fields = resume._fields(Options())   # the columns of the run's options (the default level's)
-    assert summary == report.csv_text(fields, []) + "".join(
+    assert summary == columns.csv_text(fields, []) + "".join(
         resume.report_rows_text(again[f"good{k:02d}.csv"], fields) for k in range(4))
     # another column height: a different option, so nothing is kept
     assert main(["run", *paths, *args, "--block", "6x1.2"]) == 1
@@ -146,8 +146,8 @@ def test_a_report_with_the_column_names_of_an_earlier_version_is_computed_again(
     out = tmp_path / "out"
     assert main(["run", batch[0], *BATCH_ARGS, "--out", str(out)]) == 0
     first = tree(out)
-    name = report.record_csv_name("good00")
-    manifest = out / report.MANIFEST
+    name = outfiles.record_csv_name("good00")
+    manifest = out / outfiles.MANIFEST
     for rel in (name, "summary.csv"):  # as the earlier run wrote them, and listed in its manifest
         head, _, rows = first[rel].decode("utf-8").partition("\n")
         assert "design_width_m" in head.split(",") and "verified_width_m" not in head.split(",")

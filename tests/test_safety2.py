@@ -17,7 +17,7 @@ import time
 
 import pytest
 
-from pipeline.reports import report
+from pipeline.reports import files, outfiles
 
 from pipeline.batch import resume
 from pipeline.cli import main
@@ -55,7 +55,7 @@ def test_a_second_run_into_a_busy_out_is_refused_and_nothing_is_lost(recs, alone
     first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 120
     # the first run holds the folder once it has written its first report
-    while time.time() < deadline and not (out / report.MANIFEST).exists() and first.poll() is None:
+    while time.time() < deadline and not (out / outfiles.MANIFEST).exists() and first.poll() is None:
         time.sleep(0.02)
     # stopped halfway (SIGSTOP), so that the second surely runs while the first is in the folder
     first.send_signal(signal.SIGSTOP)
@@ -88,15 +88,15 @@ def test_the_lock_goes_with_the_run(recs, tmp_path, capsys):
 
 
 # -- 2. a run started on a full disk ----------------------------------------------------------------
-@pytest.mark.parametrize("left", [b"", report._MANIFEST_HEADER.encode()[:17]], ids=["empty", "cut"])
-@pytest.mark.parametrize("name", [report.MANIFEST, resume.RESUME])
+@pytest.mark.parametrize("left", [b"", files._MANIFEST_HEADER.encode()[:17]], ids=["empty", "cut"])
+@pytest.mark.parametrize("name", [outfiles.MANIFEST, resume.RESUME])
 def test_an_empty_or_cut_journal_does_not_lock_the_folder(name, left, recs, tmp_path):
     """What a full disk leaves (a 0-byte manifest, a header cut short) holds nothing: the next run
     goes on and writes whole journals; a file that is not one of ours is still refused."""
     out = tmp_path / "out"
     out.mkdir()
-    header = (report._MANIFEST_HEADER if name == report.MANIFEST else resume._HEADER).encode()
-    (out / name).write_bytes(left if name == report.MANIFEST else header[:len(left)])
+    header = (files._MANIFEST_HEADER if name == outfiles.MANIFEST else resume._HEADER).encode()
+    (out / name).write_bytes(left if name == outfiles.MANIFEST else header[:len(left)])
     assert main(["run", recs[0], *SAFE_ARGS, "--out", str(out)]) == 0
     text = (out / name).read_bytes()
     assert text.startswith(header) and len(text.splitlines()) >= 2
@@ -109,9 +109,9 @@ def test_an_empty_or_cut_journal_does_not_lock_the_folder(name, left, recs, tmp_
 def test_append_to_a_cut_journal_starts_it_again(tmp_path):
     path = tmp_path / "j.txt"
     path.write_bytes(b"# head")
-    report.append_line(path, "# header\n", "a line\n")
+    files.append_line(path, "# header\n", "a line\n")
     assert path.read_text() == "# header\na line\n"
-    report.append_line(path, "# header\n", "b\n")
+    files.append_line(path, "# header\n", "b\n")
     assert path.read_text() == "# header\na line\nb\n"
 
 
@@ -120,9 +120,9 @@ def test_a_full_disk_error_names_the_file(recs, tmp_path, monkeypatch, capsys):
     def full(*a, **k):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(report.os, "replace", full)
+    monkeypatch.setattr(files.os, "replace", full)
     with pytest.raises(OSError, match="No space left on device: .*summary.csv"):
-        report.write_atomic(tmp_path / "summary.csv", "x\n")
+        files.write_atomic(tmp_path / "summary.csv", "x\n")
     assert os.listdir(tmp_path) == []  # no temporary file left
     monkeypatch.undo()
 
@@ -144,11 +144,11 @@ def test_a_full_disk_error_names_the_file(recs, tmp_path, monkeypatch, capsys):
         def write(self, data):
             raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(report.os, "fdopen", lambda *a, **k: Full(real_fdopen(*a, **k)))
+    monkeypatch.setattr(files.os, "fdopen", lambda *a, **k: Full(real_fdopen(*a, **k)))
     out = tmp_path / "out"
     code = main(["run", recs[0], *SAFE_ARGS, "--out", str(out)])
     err = capsys.readouterr().err
-    assert code == 1 and "No space left on device" in err and report.MANIFEST in err, err
+    assert code == 1 and "No space left on device" in err and outfiles.MANIFEST in err, err
     monkeypatch.undo()
     assert main(["run", recs[0], *SAFE_ARGS, "--out", str(out)]) == 0  # space freed: usable
 
@@ -182,7 +182,7 @@ def test_run_log_never_onto_an_input_or_the_runs_own_files(tmp_path, capsys):
     assert main(["run", str(a), str(b), *SAFE_ARGS, "--log", str(a), "--out", str(out)]) == 2
     assert "is one of the input records" in _one_line_error(capsys)
     assert a.read_bytes() == before
-    for own in (report.SUMMARY, "good02.csv", report.MANIFEST):
+    for own in (outfiles.SUMMARY, "good02.csv", outfiles.MANIFEST):
         assert main(["run", str(b), *SAFE_ARGS, "--log", str(out / own), "--out", str(out)]) == 2
         assert "one of this run's own outputs" in _one_line_error(capsys)
     assert not out.exists() or not any(out.iterdir())  # refused before anything was written

@@ -440,21 +440,21 @@ def test_design_takes_thorough_plots_all_or_none_and_numpy_integers(tmp_path):
     import numpy as np
 
     import pipeline
-    from pipeline import api
     from pipeline.cli import build_parser
+    from pipeline.plan import plan_from
     from pipeline.commands import run as run_command
 
     from .test_pipeline_run import write_good
 
     for plots, cli in (("all", ["--plots", "all"]), ("none", ["--no-plots"]), ("governing", []), (False, ["--no-plots"])):
-        plan = api._plan([tmp_path / "a.sac"], blocks="7.5x1.8", heights=None, pairs=None, directions=np.int64(3),
+        plan = plan_from([tmp_path / "a.sac"], blocks="7.5x1.8", heights=None, pairs=None, directions=np.int64(3),
                          vertical="auto", limit=None, restitution=None, jobs=np.int64(1), out=None, shapes=None,
                          weighting="background", units=None, dt=None, scale=None, plots=plots, force=False,
                          quiet=True, thorough=True)
         args = build_parser().parse_args(["run", "a.sac", "--block", "7.5x1.8", "--thorough", *cli])
         assert plan.options == run_command.options_from(args, **{k: getattr(plan.options, k) for k in (
             "shapes", "weighting", "vertical", "cap_mass_ratio", "fragility", "up_to", "limit")})
-        assert plan.directions == "3" and plan.jobs == 1
+        assert plan.directions == 3 and plan.jobs == 1
     record = write_good(tmp_path, 0, duration=2.0)
     run = pipeline.design([record], blocks="7.5x1.8", shapes="sine", directions=np.int64(0), jobs=np.int64(1))
     assert run.exit_code == 0 and len(run.design) == 1
@@ -474,31 +474,31 @@ def test_a_full_disk_at_a_figure_still_writes_design_csv_and_report_html(tmp_pat
     """When the disk filled at a figure, design.csv and report.html were never written."""
     import errno
 
-    from pipeline.reports import report
+    from pipeline.reports import files, outfiles
 
     from .test_pipeline_run import write_good
 
     records = [str(write_good(tmp_path, k, duration=2.0)) for k in range(2)]
-    real = report.Outputs.write
+    real = files.Outputs.write
 
     def full_at_figures(self, rel, data):
-        if str(rel) == report.SUMMARY_PLOT:
+        if str(rel) == outfiles.SUMMARY_PLOT:
             raise OSError(errno.ENOSPC, f"No space left on device: '{rel}'")
         return real(self, rel, data)
 
-    monkeypatch.setattr(report.Outputs, "write", full_at_figures)
+    monkeypatch.setattr(files.Outputs, "write", full_at_figures)
     out = tmp_path / "out"
     assert main(["run", *records, "--block", "7.5x1.8", "--shapes", "sine", "--out", str(out)]) == 1
     assert "No space left on device" in capsys.readouterr().err
     assert (out / "design.csv").is_file() and (out / "report.html").is_file()
-    assert not (out / report.SUMMARY_PLOT).exists()
+    assert not (out / outfiles.SUMMARY_PLOT).exists()
     monkeypatch.undo()
     assert main(["run", *records, "--block", "7.5x1.8", "--shapes", "sine", "--out", str(out), "-q"]) == 0
-    assert (out / report.SUMMARY_PLOT).is_file()
+    assert (out / outfiles.SUMMARY_PLOT).is_file()
 
 
 def test_a_batch_whose_every_record_failed_draws_no_empty_figure(tmp_path):
-    from pipeline.reports import report
+    from pipeline.reports import files, outfiles
 
     bad = tmp_path / "bad.sac"
     bad.write_bytes(b"not a record")
@@ -506,7 +506,7 @@ def test_a_batch_whose_every_record_failed_draws_no_empty_figure(tmp_path):
     assert main(["run", str(bad), "--block", "7.5x1.8", "--out", str(out), "-q"]) == 1
     assert (out / "design.csv").is_file() and (out / "report.html").is_file()
     assert not list(out.rglob("*.png"))
-    assert not (out / report.SUMMARY_PLOT).exists()
+    assert not (out / outfiles.SUMMARY_PLOT).exists()
 
 
 def test_the_suite_table_is_rounded_as_suite_csv(tmp_path):

@@ -15,7 +15,8 @@ import pytest
 import pulses
 import rocking
 from pipeline.cli import main as cli_main
-from pipeline.batch.site import NOT_PULSE_WARNING, directions
+from pipeline.batch.pairs import directions
+from pipeline.reports.pulse_row import NOT_PULSE_WARNING
 
 H, B = 2.0, 0.35  # a small column: the synthetic pulses (0.3-0.5 g) rock it
 
@@ -293,7 +294,7 @@ def test_suite_and_fragility_plots():
 
     from matplotlib.image import imread
 
-    from pipeline.reports.plot_site import fragility_figure_png, suite_figure, suite_figure_png
+    from pipeline.reports.figures.site import fragility_figure_png, suite_figure, suite_figure_png
 
     rows = [{"column": "2x0.35", "pair": p, "design_width_m": w, "eq31_width_m": e}
             for p, w, e in (("a", 0.30, 0.2), ("a", 0.41, 0.25), ("b", 0.22, 0.3), ("c", 0.50, 0.1))]
@@ -314,7 +315,8 @@ def test_suite_and_fragility_plots():
 
 
 def test_a_pair_whose_classification_fails_is_designed_in_its_components_and_says_why():
-    from pipeline.batch.site import classification_fields, directions
+    from pipeline.batch.pairs import directions
+    from pipeline.reports.pulse_row import classification_fields
 
     fields, warning = classification_fields(None, pair_fields={"error": "too short"})
     assert set(fields.values()) == {None}  # no pulse columns made up

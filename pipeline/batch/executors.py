@@ -10,7 +10,7 @@ import logging
 import os
 
 from .. import interrupts
-from ..args import ArgumentError
+from ..values import ArgumentError
 from . import memo, worker
 from .lifeline import lifeline
 from ..reports.figures import draw
@@ -40,21 +40,12 @@ def _size(task) -> int:
 
 
 def _pool(tasks, jobs, more=None):
-    import multiprocessing
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-    from concurrent.futures.process import BrokenProcessPool
+    """The results of ``tasks`` (and of the passes ``more`` gives) from a pool of ``jobs`` worker
+    processes, as they come; a worker that dies makes its records suspects, each run once more
+    alone, so that only the record that kills its worker fails."""
+    from concurrent.futures import ProcessPoolExecutor
 
-    plots = any(t.options.plots for t in tasks)
-    # Not plain fork: the parent may already run threads (the solver's batch threads), and
-    # forking such a process is unsafe.  The fork server starts clean, imports the package once
-    # and forks the workers from there (cheap).
-    methods = multiprocessing.get_all_start_methods()
-    ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    if ctx.get_start_method() == "forkserver":
-        preload = ["pipeline.batch.record", "pipeline.batch.runner", "pulses", "rocking"]
-        if plots:
-            preload.append("pipeline.reports.plots")  # matplotlib: ~0.2 s a worker otherwise
-        ctx.set_forkserver_preload(preload)
+    ctx = _pool_context(any(t.options.plots for t in tasks))
     others = _child_processes()
     # the largest files first (longer records take longer), so that no long record is left alone at
     # the end while the other workers idle; results are placed by index, so the reports do not
@@ -63,12 +54,9 @@ def _pool(tasks, jobs, more=None):
     # records in the pool when a worker process died: each is run once more alone, so that the
     # one that kills its worker is known and fails, and the others complete
     suspects = collections.deque()
-    # at most this many submissions (chunks of records, worker.chunk_size) at once: a few queued per
-    # worker keep them busy, and a dead worker makes only their records suspects (and the pool
-    # holds no future per record of a long batch)
-    window = 2 * jobs
     pool = None
     finished = False
+
     def new_pool():
         return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_pool_worker,
                                    initargs=(os.environ.get(TEST_KILL_ENV), lifeline(), worker.quiet_now()))
@@ -78,47 +66,13 @@ def _pool(tasks, jobs, more=None):
             if pool is None:
                 pool = new_pool()
             if suspects:  # one record alone in the pool
-                task = suspects.popleft()
-                fut = pool.submit(work, task)
-                while not wait([fut], timeout=0.25)[0]:
-                    interrupts.check()
-                try:
-                    yield fut.result()
-                except BrokenProcessPool as exc:  # its second death: a worker failure
+                res, broken = _alone(pool, suspects.popleft())
+                if broken:  # its second death: a worker failure
                     pool.shutdown(wait=True)
                     pool = None
-                    yield worker_failure(task, exc)
-                except Exception as exc:
-                    yield worker_failure(task, exc)
+                yield res
                 continue
-            running: dict = {}
-            broken = False
-            while (queue or running) and not broken:
-                while queue and len(running) < window:
-                    chunk = [queue.popleft() for _ in range(worker.chunk_size(len(queue), jobs))]
-                    try:
-                        running[pool.submit(work_many, chunk)] = chunk
-                    except BrokenProcessPool:
-                        queue.extendleft(reversed(chunk))
-                        broken = True
-                        break
-                # a short wait, so that an interrupt whose exception was swallowed still stops the run
-                done, _ = wait(running, timeout=0.25, return_when=FIRST_COMPLETED)
-                interrupts.check()
-                for fut in done:
-                    chunk = running.pop(fut)
-                    try:
-                        yield from fut.result()
-                    except BrokenProcessPool:
-                        suspects.extend(chunk)
-                        broken = True
-                    except Exception as exc:  # e.g. a result that cannot be sent back
-                        if len(chunk) > 1:  # each again alone: only the record at fault fails
-                            suspects.extend(chunk)
-                        else:
-                            yield worker_failure(chunk[0], exc)
-                if more is not None and done:  # a pair's next pass as soon as it has none out
-                    queue.extendleft(reversed(more()))
+            running, broken = yield from _in_chunks(pool, queue, suspects, jobs, more)
             if broken:  # every record still in the broken pool is a suspect
                 for fut, chunk in running.items():
                     if fut.done() and not fut.cancelled() and fut.exception() is None:
@@ -134,6 +88,82 @@ def _pool(tasks, jobs, more=None):
                 pool.shutdown(wait=True)
             else:  # interrupted, or the caller stopped early: nothing more is wanted from the workers
                 _stop(pool, others)
+
+
+def _pool_context(plots: bool):
+    """The multiprocessing context of the pool: the fork server, the package preloaded in it (and
+    matplotlib where there are figures), or spawn where there is no fork server."""
+    import multiprocessing
+
+    # Not plain fork: the parent may already run threads (the solver's batch threads), and
+    # forking such a process is unsafe.  The fork server starts clean, imports the package once
+    # and forks the workers from there (cheap).
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+    if ctx.get_start_method() == "forkserver":
+        preload = ["pipeline.batch.record", "pipeline.batch.runner", "pulses", "rocking"]
+        if plots:
+            preload.append("pipeline.reports.figures.record")  # matplotlib: ~0.2 s a worker otherwise
+        ctx.set_forkserver_preload(preload)
+    return ctx
+
+
+def _alone(pool, task):
+    """``(result, pool broken)`` of ``task`` run alone in ``pool`` (a suspect): its worker dying
+    again makes it a worker failure."""
+    from concurrent.futures import wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    fut = pool.submit(work, task)
+    while not wait([fut], timeout=0.25)[0]:
+        interrupts.check()
+    try:
+        return fut.result(), False
+    except BrokenProcessPool as exc:
+        return worker_failure(task, exc), True
+    except Exception as exc:
+        return worker_failure(task, exc), False
+
+
+def _in_chunks(pool, queue, suspects, jobs, more):
+    """Yield the results of ``queue``'s records sent to ``pool`` in chunks (:func:`worker.chunk_size`)
+    until the queue is done or the pool breaks; return ``(the submissions still running, broken)``."""
+    from concurrent.futures import FIRST_COMPLETED, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    # at most this many submissions (chunks of records, worker.chunk_size) at once: a few queued per
+    # worker keep them busy, and a dead worker makes only their records suspects (and the pool
+    # holds no future per record of a long batch)
+    window = 2 * jobs
+    running: dict = {}
+    broken = False
+    while (queue or running) and not broken:
+        while queue and len(running) < window:
+            chunk = [queue.popleft() for _ in range(worker.chunk_size(len(queue), jobs))]
+            try:
+                running[pool.submit(work_many, chunk)] = chunk
+            except BrokenProcessPool:
+                queue.extendleft(reversed(chunk))
+                broken = True
+                break
+        # a short wait, so that an interrupt whose exception was swallowed still stops the run
+        done, _ = wait(running, timeout=0.25, return_when=FIRST_COMPLETED)
+        interrupts.check()
+        for fut in done:
+            chunk = running.pop(fut)
+            try:
+                yield from fut.result()
+            except BrokenProcessPool:
+                suspects.extend(chunk)
+                broken = True
+            except Exception as exc:  # e.g. a result that cannot be sent back
+                if len(chunk) > 1:  # each again alone: only the record at fault fails
+                    suspects.extend(chunk)
+                else:
+                    yield worker_failure(chunk[0], exc)
+        if more is not None and done:  # a pair's next pass as soon as it has none out
+            queue.extendleft(reversed(more()))
+    return running, broken
 
 
 def _refill(queue, more) -> bool:

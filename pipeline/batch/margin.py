@@ -9,7 +9,7 @@ default, ``--limit 0.5``), the restitution's with ``--restitution``; with ``--li
 """
 from __future__ import annotations
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, TEXT, WHOLE
 
 #: the performance level a run designs for unless told otherwise (``--limit``): the paper's
 #: dependable design, the peaks at or below alpha/2 (its section 5.3)
@@ -31,26 +31,26 @@ RESTITUTION_COLUMNS = Columns(
     ("restitution", "-", "`--restitution` as given: a factor of Eq. 5 (`0.97`: 0.97 times "
                          "Housner's eta at each width), `eta=V` (the velocity ratio at impact, the "
                          "same at every width) or `r=V` (the energy ratio, eta squared); `LOW:HIGH` "
-                         "a band, whose design covers it."),
+                         "a band, whose design covers it.", TEXT),
     ("restitution_values_run", "-", "Single values of the restitution run for this row: 1, or for a "
-                                    "band its values evenly spaced, ends included (`rocking.band.BAND_VALUES`)."),
+                                    "band its values evenly spaced, ends included (`rocking.band.BAND_VALUES`).", WHOLE),
     ("restitution_governing", "-", "The value (as `restitution` states it) whose design width governs: "
-                                   "the widest of the band's (the lowest restitution of equal widths)."),
+                                   "the widest of the band's (the lowest restitution of equal widths).", TEXT),
     ("restitution_design_widths_m", "m", "Each value's design width, `value=width` and `;`-separated "
-                                         "(for a band, in the order run); the design width is the widest."),
+                                         "(for a band, in the order run); the design width is the widest.", TEXT),
     ("design_r", "-", "The energy ratio r = eta^2 at impact at the design width, for the value that "
                       "governs (`design_eta` squared)."),
 )
 
 
-def extra_columns(options) -> tuple:
-    """The columns this run's options add to every row, after the design width's (none with
-    ``--limit none`` and no ``--restitution``)."""
-    out = ()
+def extra_columns(options) -> list:
+    """The groups of columns this run's options add to every row, after the design width's (none
+    with ``--limit none`` and no ``--restitution``)."""
+    out = []
     if options.limit is not None:
-        out += MARGIN_COLUMNS.columns
+        out.append(MARGIN_COLUMNS)
     if options.restitution is not None:
-        out += RESTITUTION_COLUMNS.columns
+        out.append(RESTITUTION_COLUMNS)
     return out
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import os
 
-from ..args import ArgumentError
+from ..values import ArgumentError
 
 
 @contextlib.contextmanager
@@ -23,7 +23,7 @@ def locked(folder, what: str = "--out"):
     Raises :class:`ArgumentError` when another process holds it.  Where the file system has no
     such locks (some network file systems) the run goes on unlocked, as before.
     """
-    from ..reports.report import display
+    from ..reports.cells import display
 
     try:
         import fcntl

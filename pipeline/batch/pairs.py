@@ -20,7 +20,7 @@ import sys
 from . import peer_inputs
 
 from ..reports import pulse_row
-from ..args import MAX_DIRECTIONS, ArgumentError, pair_files, parse_directions, parse_scale  # noqa: F401 (MAX_DIRECTIONS: also here)
+from ..values import ArgumentError, pair_files, parse_scale
 from .tasks import Task, make_tasks, record_ids
 
 #: directions closer than this (deg, modulo 180) are one direction
@@ -28,47 +28,47 @@ ANGLE_TOL_DEG = 1e-6
 
 
 
-# -- the command line --------------------------------------------------------------------------------
-def tasks_from_args(args, downloads, paths, columns, options, absent: list | None = None):
-    """Every task of ``pipeline run``: the files' (one per file, or pairs), then the PEER downloads';
-    None when there are no pairs, scales or downloads (the runner's own tasks, one per file)."""
+# -- the run's tasks ---------------------------------------------------------------------------------
+def tasks_for(plan, downloads, paths, absent: list | None = None):
+    """Every task of a run's ``plan`` (:class:`pipeline.plan.Plan`: its pairs, directions and scales
+    as values): the files' (one per file, or pairs), then the PEER downloads'; None when there are
+    no pairs, scales or downloads (the runner's own tasks, one per file)."""
+    columns, options = plan.columns, plan.options
     if not downloads:
-        if args.peer_scales:
+        if plan.peer_scales:
             raise ArgumentError("--peer-scales applies to PEER downloads (a .zip, or a folder holding "
                                 "_SearchResults.csv); none was given")
-        return _file_tasks(args, paths, columns, options)
-    n, scale, scales = settings_from_args(args)
-    if scales is not None and args.peer_scales:
+        return _file_tasks(plan, paths)
+    scale, scales = _scales(plan)
+    if scales is not None and plan.peer_scales:
         raise ArgumentError("give --scales or --peer-scales, not both")
-    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=sys.stderr))
+    say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
     others = []
-    if paths or args.pair:
-        others = _file_tasks(args, paths, columns, options)
+    if paths or plan.pair:
+        others = _file_tasks(plan, paths)
         if others is None:
             others = make_tasks(paths, columns, options)
-    return combine(others, peer_tasks(downloads, columns, options, n, scale, scales, args.peer_scales, say,
-                                      absent))
+    return combine(others, peer_tasks(downloads, columns, options, plan.directions, scale, scales,
+                                      plan.peer_scales, say, absent))
 
 
-def _file_tasks(args, paths, columns, options):
-    """The tasks of ``pipeline run`` when pairs or scales are asked for; None otherwise (the
-    runner's own tasks, one per file)."""
-    n, scale, scales = settings_from_args(args)
-    if not args.pair and args.pairs == "none" and scale == 1.0 and scales is None:
+def _file_tasks(plan, paths):
+    """The tasks of the files when pairs or scales are asked for; None otherwise (the runner's own
+    tasks, one per file)."""
+    scale, scales = _scales(plan)
+    if not plan.pair and plan.pairs == "none" and scale == 1.0 and scales is None:
         return None
-    say = (lambda msg: None) if args.quiet else (lambda msg: print(msg, file=sys.stderr))
-    return pair_tasks(paths, pair_files(args.pair), args.pairs, columns, options, n, scale,
-                      scales, say=say, jobs=getattr(args, "jobs", None))
+    say = (lambda msg: None) if plan.quiet else (lambda msg: print(msg, file=sys.stderr))
+    return pair_tasks(paths, pair_files(plan.pair), plan.pairs, plan.columns, plan.options, plan.directions,
+                      scale, scales, say=say, jobs=plan.jobs)
 
 
-def settings_from_args(args):
-    """``(directions N, --scale factor, --scales table or None)``, checked."""
-    n = parse_directions(args.directions)
-    if args.scale is not None and args.scales is not None:
+def _scales(plan):
+    """``(the --scale factor, the --scales table or None)`` of ``plan``, the table read."""
+    if plan.scale is not None and plan.scales is not None:
         raise SiteError("give --scale or --scales, not both")
-    scale = 1.0 if args.scale is None else parse_scale(args.scale, "--scale")
-    scales = None if args.scales is None else read_scales(args.scales)
-    return n, scale, scales
+    scale = 1.0 if plan.scale is None else plan.scale
+    return scale, None if plan.scales is None else read_scales(plan.scales)
 
 
 # -- pairs and their directions ----------------------------------------------------------------------------
@@ -159,8 +159,7 @@ def pair_tasks(paths, pairs, pairs_mode, columns, options, n_directions=0, scale
     """
     import pulses
 
-    opts = dict(format=options.format, units=options.units, dt=options.dt, column=options.column,
-                trace=options.trace)
+    opts = options.read.kwargs()
     paired = {p for ab in pairs for p in ab}
     rest = [p for p in paths if p not in paired]
     units = [(a, b, True) for a, b in pairs]  # (first, second or None, named with --pair)

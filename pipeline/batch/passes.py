@@ -47,7 +47,6 @@ from __future__ import annotations
 import collections
 import dataclasses
 
-from ..reports.report import fmt
 
 #: a check whose top lies within this share of the design width is run all the same (the rows'
 #: numbers are read back from text, with their rounding)
@@ -135,7 +134,8 @@ class Plan:
         self.done: list = []
 
     def note(self, task, rows) -> None:
-        """Record what ``task`` (as computed, with its switches) gave: its rows (empty: failed)."""
+        """Record what ``task`` (as computed, with its switches) gave: its rows as its report holds
+        them (:func:`pipeline.batch.row.rows_of`; empty: failed)."""
         if not staged(task, self.options):
             return
         from .site import pair_of
@@ -150,10 +150,8 @@ class Plan:
             group.pop(task.index, None)
             return
         cols = {}
-        for r in rows:
-            # as the report holds them (6 digits): a resumed run decides as the first did
-            w, H, pga, widest = (None if r.get(k) in (None, "") else float(fmt(float(r[k])))
-                                 for k in ("design_width_m", "height_m", "pga_g", "widest_failing_width_m"))
+        for r in rows:  # as the report holds them (6 digits): a resumed run decides as the first did
+            w, H, pga, widest = (r.get(k) for k in ("design_width_m", "height_m", "pga_g", "widest_failing_width_m"))
             # the widest design width its check could set (above the reach of its rounds)
             cols[r["column"]] = (w, self.step * min(self.span * w, H * pga), widest)
         full = bool(task.check) and not (self.separable and any(task.check_above))

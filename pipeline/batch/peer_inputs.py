@@ -18,16 +18,16 @@ import functools
 import os
 from dataclasses import dataclass
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, FLAG, TEXT, WHOLE
 
 PEER_COLUMNS = Columns(
     ("peer_rsn", "-", "PEER record sequence number (RSN) of the record, from the download's "
-                      "`_SearchResults.csv`; blank for records that do not come from a PEER download."),
-    ("peer_event", "-", "Earthquake name as the search report writes it (PEER writes `_` for commas)."),
-    ("peer_year", "-", "Year of the earthquake (search report)."),
-    ("peer_station", "-", "Station name (search report)."),
+                      "`_SearchResults.csv`; blank for records that do not come from a PEER download.", WHOLE),
+    ("peer_event", "-", "Earthquake name as the search report writes it (PEER writes `_` for commas).", TEXT),
+    ("peer_year", "-", "Year of the earthquake (search report).", WHOLE),
+    ("peer_station", "-", "Station name (search report).", TEXT),
     ("peer_magnitude", "-", "Moment magnitude (search report)."),
-    ("peer_mechanism", "-", "Fault mechanism (search report)."),
+    ("peer_mechanism", "-", "Fault mechanism (search report).", TEXT),
     ("peer_rjb_km", "km", "Joyner-Boore distance Rjb (search report)."),
     ("peer_rrup_km", "km", "Rupture distance Rrup (search report)."),
     ("peer_vs30_m_s", "m/s", "Vs30 of the station (search report)."),
@@ -35,9 +35,9 @@ PEER_COLUMNS = Columns(
                                          "report): pulses much longer than its inverse are not in the data."),
     ("peer_scale_factor", "-", "The search's scale factor for the record (`Scale Factor` of the report)."),
     ("peer_scaled", "-", "True when `--peer-scales` applied `peer_scale_factor` (then in `scale`); "
-                         "False: the record as recorded, unscaled (the default)."),
+                         "False: the record as recorded, unscaled (the default).", FLAG),
     ("peer_vertical_file", "-", "The record's vertical component as the report lists it (blank: none); "
-                                "with `--vertical auto` it is used in the vertical_* columns."),
+                                "with `--vertical auto` it is used in the vertical_* columns.", TEXT),
 )
 #: the report's metadata key behind each column (pulses.io.peer.METADATA)
 _KEYS = {"peer_rsn": "rsn", "peer_event": "event", "peer_year": "year", "peer_station": "station",
@@ -72,13 +72,6 @@ class PeerSource:
         if os.path.isdir(self.download):
             return [os.path.join(self.download, n) for n in (self.h1, self.h2, self.vertical) if n]
         return [self.download]
-
-
-def add_options(parser) -> None:
-    """``--peer-scales`` of ``pipeline run``."""
-    parser.add_argument("--peer-scales", action="store_true",
-                        help="PEER downloads: multiply each record by the search's scale factor "
-                             "(_SearchResults.csv); by default records are designed as recorded")
 
 
 def split_inputs(items, format: str | None = None) -> tuple[list[str], list[str]]:
@@ -120,21 +113,21 @@ def _fields(entry, scaled: bool) -> tuple:
 
 def scale_of(entry) -> float:
     """The search's scale factor of ``entry``, checked by the one rule of every scale
-    (:func:`pipeline.args.parse_scale`); :class:`ArgumentError` when it is missing or outside it
+    (:func:`pipeline.values.parse_scale`); :class:`ArgumentError` when it is missing or outside it
     (a factor of 1e6, 0 or nan was applied, or silently taken as 1)."""
-    from ..args import ArgumentError, parse_scale
+    from ..values import ArgumentError, parse_scale
 
     factor = entry.metadata.get("scale_factor")
     what = f"RSN {entry.rsn}: --peer-scales: the search's scale factor (_SearchResults.csv, line {entry.line})"
     if factor is None:
         raise ArgumentError(f"{what} is missing (blank, '-' or not finite): the record is not "
                             "designed rather than designed unscaled")
-    return parse_scale(repr(float(factor)), what)
+    return parse_scale(float(factor), what)
 
 
 def _why_not(d, e, scaled: bool) -> str:
     """Why the record ``e`` of download ``d`` cannot be designed (blank: it can)."""
-    from ..args import ArgumentError
+    from ..values import ArgumentError
 
     if e.h1 is None or e.h2 is None:
         return f"RSN {e.rsn}: the search report lists no {'Horizontal-1' if e.h1 is None else 'Horizontal-2'} file"
@@ -162,7 +155,7 @@ NOT_DOWNLOADED_FIELDS = ["download", "peer_rsn", "line", "peer_event", "peer_sta
 
 def not_downloaded_text(rows) -> str | None:
     """The text of :data:`NOT_DOWNLOADED` (None when no download was given)."""
-    from ..reports.report import csv_text
+    from ..reports.columns import csv_text
 
     return None if rows is None else csv_text(NOT_DOWNLOADED_FIELDS, rows)
 
@@ -250,16 +243,6 @@ def read_vertical(task):
         return open_download(src.download).read_component(src.vertical), ""
     except RecordError as exc:
         return None, f"vertical not used: {exc}"
-
-
-def read_task(task):
-    """The ground motion of a PEER task: the pair's component in the task's direction, scaled."""
-    from pulses import check_pair, component
-
-    first, second, _ = read_components(task)
-    first, second = check_pair(first, second)
-    record = component(first, second, task.direction or 0.0)
-    return record.scaled(task.scale) if task.scale != 1.0 else record
 
 
 def fields(task) -> dict:

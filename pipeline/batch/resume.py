@@ -11,8 +11,10 @@ computed again.  Records that failed have no line and are always computed again.
 
 The per-record reports hold exactly the rows of ``summary.csv`` (the same header and formatting),
 so ``summary.csv`` is rebuilt from the reports' text, and the files computed from the rows
-(``suite.csv``, ``pairs.csv``, the plots) from the rows read back from that text (numbers at the
-reports' 6 digits) in every run: a resumed run and an uninterrupted one write the same bytes.
+(``suite.csv``, ``pairs.csv``, ``design.csv``, the plots) from the rows read back from that text in
+every run, each cell by its column's declared kind (:meth:`pipeline.reports.columns.Columns.read`:
+numbers at the reports' 6 digits, flags, whole numbers, text as written, blanks as None; never
+guessed from how a cell looks): a resumed run and an uninterrupted one write the same bytes.
 """
 from __future__ import annotations
 
@@ -25,10 +27,10 @@ import os
 import pathlib
 import re
 
-from ..reports import report
+from ..reports import cells, columns, files, outfiles
 
 #: the resume journal in ``--out`` (written by ``pipeline run`` alone, like the manifest)
-RESUME = report.RESUME
+RESUME = outfiles.RESUME
 _HEADER = ("# pipeline run: records whose reports may be kept by a later run (key of input, options "
            "and version; sha256 of the report; sha256 of the figure or -; record id)\n")
 _LINE = re.compile(r"^([0-9a-f]{64})  ([0-9a-f]{64})  ([0-9a-f]{64}|-)  (\S+)(?:  (\S+))?$")
@@ -156,7 +158,7 @@ def report_rows_text(raw: bytes, fields=None) -> str | None:
     not the present one."""
     text = raw.decode("utf-8", "surrogateescape")
     head, sep, rest = text.partition("\n")
-    if not sep or head + "\n" != report.csv_text(fields or _fields(), []):
+    if not sep or head + "\n" != columns.csv_text(fields or _fields(), []):
         return None
     return rest
 
@@ -164,31 +166,9 @@ def report_rows_text(raw: bytes, fields=None) -> str | None:
 def _fields(options=None):
     """The columns of the reports of a run with ``options`` (None: ``--limit none``'s, the
     columns every run has)."""
-    from .record import FIELDS, fields_for
+    from .row import FIELDS, fields_for
 
     return FIELDS if options is None else fields_for(options)
-
-
-def typed(cell: str):
-    """A cell of a report as the value it was written from: blank -> None, True/False -> bool, a
-    number -> float when it is written back as the same text (so ``1e5`` or ``007`` in a name stay
-    text), else the text."""
-    if cell == "":
-        return None
-    if cell in ("True", "False"):
-        return cell == "True"
-    try:
-        value = float(cell)
-    except ValueError:
-        return cell
-    return value if report.fmt(value) == cell else cell
-
-
-def rows_from_text(rows_text: str, fields=None) -> list[dict]:
-    """Rows (dicts of :func:`typed` values) of report text without its header (``fields``: its
-    columns; default those every run has)."""
-    fields = fields or _fields()
-    return [{f: typed(c) for f, c in zip(fields, cells)} for cells in csv.reader(io.StringIO(rows_text))]
 
 
 def form_text(task) -> str:
@@ -227,7 +207,7 @@ class Journal:
         self.entries: dict[str, tuple[str, str, str]] = {}  # record id -> (key, report, figure)
         self.forms: dict[str, str] = {}  # record id -> form_text of the task its report is of
         self.pairs: dict[str, str] = {}  # sha256 of a pair's name -> digest of its entries
-        text = report.read_journal(self.path, _HEADER)
+        text = files.read_journal(self.path, _HEADER)
         if text is not None:
             for line in text.splitlines()[1:]:  # a line cut by a killed run does not match
                 m = _LINE.match(line)
@@ -246,11 +226,11 @@ class Journal:
         entry = self.entries.get(task.record_id)
         if key is None or entry is None or entry[0] != key:
             return None
-        raw = report._regular_file_bytes(self.folder / report.record_csv_name(task.record_id))
+        raw = files._regular_file_bytes(self.folder / outfiles.record_csv_name(task.record_id))
         if raw is None or _digest(raw) != entry[1]:
             return None
         if plots:
-            fig = report._regular_file_bytes(self.folder / report.record_plot_name(task.record_id))
+            fig = files._regular_file_bytes(self.folder / outfiles.record_plot_name(task.record_id))
             if fig is None or entry[2] == "-" or _digest(fig) != entry[2]:
                 return None
         return report_rows_text(raw, _fields(task.options))
@@ -264,7 +244,7 @@ class Journal:
         self.forms.pop(record_id, None)
         if form:
             self.forms[record_id] = form
-        report.append_line(self.path, _HEADER, self._line(record_id))
+        files.append_line(self.path, _HEADER, self._line(record_id))
 
     def _line(self, record_id: str) -> str:
         e, form = self.entries[record_id], self.forms.get(record_id)
@@ -293,7 +273,7 @@ class Journal:
         if digest is None or self.pairs.get(name) == digest:
             return
         self.pairs[name] = digest
-        report.append_line(self.path, _HEADER, f"pair  {name}  {digest}\n")
+        files.append_line(self.path, _HEADER, f"pair  {name}  {digest}\n")
 
     def settled(self, pair: str) -> str | None:
         """The digest noted when ``pair``'s passes were done (:meth:`settle`), or None."""
@@ -309,7 +289,7 @@ class Journal:
             if digest is not None and self.settled(pair) == digest:
                 lines.append(f"pair  {_pair_name(pair)}  {digest}\n")
         if lines or os.path.lexists(self.path):
-            report.write_atomic(self.path, _HEADER + "".join(lines))
+            files.write_atomic(self.path, _HEADER + "".join(lines))
 
 
 def _pair_name(pair: str) -> str:
@@ -319,7 +299,7 @@ def _pair_name(pair: str) -> str:
 
 def remove_stale_temporaries(folder, names) -> int:
     """Remove temporary files a killed run left in ``folder`` while writing one of ``names``
-    (paths relative to ``folder``): ``.<name>.XXXXXXXX.tmp``, as :func:`report.write_atomic` makes
+    (paths relative to ``folder``): ``.<name>.XXXXXXXX.tmp``, as :func:`files.write_atomic` makes
     them.  Returns how many were removed."""
     folder = pathlib.Path(folder)
     prefixes: dict[pathlib.Path, set[str]] = {}
@@ -328,7 +308,7 @@ def remove_stale_temporaries(folder, names) -> int:
         prefixes.setdefault(p.parent, set()).add(f".{p.name[:40]}.")
     removed = 0
     for parent, starts in prefixes.items():
-        if not report._real_folder(parent, folder):  # a link out of the folder: not ours to clean
+        if not files._real_folder(parent, folder):  # a link out of the folder: not ours to clean
             continue
         try:
             listing = os.listdir(parent)

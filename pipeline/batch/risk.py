@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..args import ArgumentError
+from ..values import ArgumentError, as_number, as_whole
 from ..reports.outfiles import (FRAGILITY_XML, RISK_CSV, RISK_DISAGG_CSV, RISK_DISAGG_PLOT,  # noqa: F401
                                 RISK_RECORDS_CSV, RISK_WIDTHS_CSV, RISK_WIDTHS_PLOT)
 
@@ -34,77 +34,21 @@ class RiskOptions:
     seed: int = 0
 
 
-def add_options(parser) -> None:
-    """The risk options of ``pipeline run``."""
-    g = parser.add_argument_group("risk at a site (docs/risk.md)")
-    g.add_argument("--hazard", metavar="FILE",
-                   help="the site's hazard curve: an OpenQuake hazard_curve CSV, an nshmp-haz "
-                        "curves/<IMT>/total.csv, a USGS hazard web service JSON, or a two-column CSV "
-                        "(level, annual rate); gives each column's annual rate of overturning")
-    g.add_argument("--site", metavar="LON,LAT", help="--hazard with several sites: the site's location")
-    g.add_argument("--site-row", metavar="N", help="--hazard with several sites: the site's row (from 1)")
-    g.add_argument("--imt", metavar="MEASURE",
-                   help="--hazard: the measure (PGA, PGV, SA(T)) where the file does not say, or the "
-                        "one to take from a file of several")
-    g.add_argument("--hazard-units", metavar="UNITS",
-                   help="--hazard: the levels' units where the file does not say (g, m/s2, cm/s2; "
-                        "cm/s, m/s for PGV); --units is the records'")
-    g.add_argument("--years", metavar="N", default="50",
-                   help="--hazard: the probability of failure in N years (default 50)")
-    g.add_argument("--age", metavar="A", help="--hazard: also the probability of having stood A years")
-    target = g.add_mutually_exclusive_group()
-    target.add_argument("--target-rate", metavar="X",
-                        help="--hazard: the narrowest width whose annual rate of failure is at most X "
-                             "(e.g. 1e-4)")
-    target.add_argument("--target-poe", metavar="P%/N",
-                        help="--hazard: the same for a probability P in N years (e.g. 2%%/50)")
-    g.add_argument("--risk-seed", metavar="S", default="0",
-                   help="--hazard: seed of the restitution drawn per record from its band (default 0)")
-
-
-def _positive(text, what):
+def _positive(value, what):
+    """``value`` (a number, or text read as one) if positive and finite, else an ArgumentError."""
     try:
-        v = float(str(text))
+        v = as_number(value)
     except ValueError:
-        raise ArgumentError(f"{what}: expected a number, got {text!r}") from None
+        raise ArgumentError(f"{what}: expected a number, got {value!r}") from None
     if not (math.isfinite(v) and v > 0):
-        raise ArgumentError(f"{what} must be a positive number, got {text!r}")
+        raise ArgumentError(f"{what} must be a positive number, got {value!r}")
     return v
-
-
-def _site(text):
-    parts = str(text).replace(" ", "").split(",")
-    try:
-        lon, lat = (float(p) for p in parts)
-    except ValueError:
-        raise ArgumentError(f"--site: expected LON,LAT in degrees (e.g. -118.25,34.05), got {text!r}") from None
-    return lon, lat
-
-
-def options_from_args(args, restitution=None) -> RiskOptions | None:
-    """The checked :class:`RiskOptions` (None without ``--hazard``); ``restitution``: the run's
-    :class:`rocking.restitution.Restitution` (``--restitution``), sampled per record."""
-    hazard = getattr(args, "hazard", None)
-    others = [o for o, v in (("--site", args.site), ("--site-row", args.site_row), ("--imt", args.imt),
-                             ("--hazard-units", args.hazard_units), ("--age", args.age),
-                             ("--target-rate", args.target_rate), ("--target-poe", args.target_poe))
-              if v is not None]
-    if hazard is None:
-        if others:
-            raise ArgumentError(f"{others[0]} needs --hazard FILE (the site's hazard curve)")
-        return None
-    return risk_options(hazard, site=None if args.site is None else _site(args.site),
-                        site_row=None if args.site_row is None else args.site_row, imt=args.imt,
-                        units=args.hazard_units, years=args.years, age=args.age,
-                        target_rate=args.target_rate, target_poe=args.target_poe,
-                        restitution=restitution if restitution is not None else getattr(args, "restitution", None),
-                        seed=args.risk_seed)
 
 
 def risk_options(hazard, *, site=None, site_row=None, imt=None, units=None, years=50, age=None,
                  target_rate=None, target_poe=None, restitution=None, seed=0) -> RiskOptions:
     """:class:`RiskOptions` from values (``pipeline.design(..., hazard=)`` and the command line);
-    :class:`pipeline.args.ArgumentError` in one line for anything wrong, the curve included."""
+    :class:`pipeline.values.ArgumentError` in one line for anything wrong, the curve included."""
     from rocking.restitution import Restitution
     from rocking.risk import HazardError, read_hazard
     from rocking.risk.curve import HazardCurve
@@ -112,7 +56,7 @@ def risk_options(hazard, *, site=None, site_row=None, imt=None, units=None, year
 
     if site_row is not None:
         try:
-            site_row = int(str(site_row))
+            site_row = as_whole(site_row)
         except ValueError:
             raise ArgumentError(f"--site-row: expected a whole number from 1, got {site_row!r}") from None
     try:
@@ -128,7 +72,7 @@ def risk_options(hazard, *, site=None, site_row=None, imt=None, units=None, year
         elif target_poe is not None:
             p, n = parse_poe(target_poe)
             rate, text = rate_for(p, n), f"{100 * p:g}% in {n:g} years"
-        seed = int(str(seed))
+        seed = as_whole(seed)
     except (HazardError, ValueError) as exc:
         raise ArgumentError(str(exc)) from None
     return RiskOptions(str(getattr(curve, "source", "") if isinstance(hazard, HazardCurve) else hazard),
@@ -145,6 +89,7 @@ def suite_of(tasks, rows, measure, say):
     from rocking.risk.suite import Member
 
     from . import site
+    from .read import horizontal_only, read_task
 
     done = {r["record"] for r in rows}
     groups = {}
@@ -154,7 +99,7 @@ def suite_of(tasks, rows, measure, say):
     members, skipped = [], []
     for pair, ts in groups.items():
         try:
-            comps = [site.read_task(t) for t in ts]
+            comps = [read_task(horizontal_only(t))[0] for t in ts]
             if ts[0].direction is None:
                 im = intensity(comps[0], measure)
             else:
@@ -199,7 +144,7 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
     risk.csv)``: the answers for design.csv and the printed answer (:func:`answer_fields`)."""
     from rocking.risk import nrml, rows as risk_rows
 
-    from ..reports import report
+    from ..reports import columns
     from ..reports.figures import draw
 
     if getattr(options, "risk", None) is None:
@@ -217,7 +162,7 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
         if name == RISK_CSV:
             made[name] += [_error_row(label, text, options) for label, text in results.items()
                            if isinstance(text, str)]
-        outputs.write(name, report.csv_text(list(cols.names), made[name]))
+        outputs.write(name, columns.csv_text(list(cols.names), made[name]))
     functions = [f for f in (nrml.functions_of(r, label) for label, r in results.items()
                              if not isinstance(r, str) and r.width is not None) if f is not None]
     if functions:
@@ -225,10 +170,10 @@ def write_outputs(outputs, tasks, rows, options, render=None, jobs=1, say=print)
     elif outputs.owned(FRAGILITY_XML):
         outputs.remove(FRAGILITY_XML)
     if options.plots:
-        outputs.write(RISK_WIDTHS_PLOT, render("plot_risk:widths_figure_png", made[RISK_WIDTHS_CSV],
+        outputs.write(RISK_WIDTHS_PLOT, render("risk:widths_figure_png", made[RISK_WIDTHS_CSV],
                                                made[RISK_CSV]))
         c = options.risk.curve
-        outputs.write(RISK_DISAGG_PLOT, render("plot_risk:disaggregation_figure_png",
+        outputs.write(RISK_DISAGG_PLOT, render("risk:disaggregation_figure_png",
                                                made[RISK_DISAGG_CSV], f"{c.measure} ({c.units})"))
     return {label: answer_fields(r, options) for label, r in results.items()}, made[RISK_CSV]
 
@@ -264,26 +209,3 @@ def answer_fields(result, options) -> dict:
                      + (f"{t.width:.3f} m" if t.width is not None else f"not found ({t.note})"))
     return {"site_rate_per_year": rate, "target_width_m": None if t is None else t.width,
             "text": "; ".join(parts)}
-
-
-def columns_markdown() -> str:
-    """The sections of ``columns.md`` for the risk files."""
-    from rocking.risk import rows
-
-    cell = lambda text: text.replace("|", "\\|")  # noqa: E731
-    out = []
-    for name, intro, cols in (
-            (RISK_CSV, "One row per column and failure mode as it stands, and one for the width for "
-                       "the target. `fragility.xml`: each column's fragility as an OpenQuake NRML "
-                       "fragility model (continuous logncdf; mean and stddev of the measure).",
-             rows.RISK_COLUMNS),
-            (RISK_RECORDS_CSV, "The critical values the fragilities are fitted to, record by record.",
-             rows.RECORD_COLUMNS),
-            (RISK_WIDTHS_CSV, "Every width computed for the target (`plots/risk_widths.png`).",
-             rows.WIDTH_COLUMNS),
-            (RISK_DISAGG_CSV, "The rate per interval of the hazard curve "
-                              "(`plots/risk_disaggregation.png`).", rows.DISAGGREGATION_COLUMNS)):
-        out += ["", f"## Columns of `{name}` (`--hazard`)", "", intro, "",
-                "| column | unit | meaning |", "|---|---|---|"]
-        out += [f"| `{n}` | {u} | {cell(d)} |" for n, u, d in cols.columns]
-    return "\n".join(out) + "\n"

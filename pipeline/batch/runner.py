@@ -13,13 +13,15 @@ import pathlib
 import sys
 from dataclasses import dataclass
 
-from ..reports import design_table, figures, html_report, outfiles, report
+from ..reports import answer, cells, columns, columns_md, design_table, figures, files, html_report, outfiles
 
 from .. import interrupts
 
 from . import joblog, outlock, passes, resume, risk, site
-from ..args import ArgumentError, output_folder
-from .record import FAILURE_COLUMNS, FAILURE_FIELDS, columns_for, failure, fields_for
+from ..reports import suite as suite_tables
+from ..values import ArgumentError, output_folder
+from .record import FAILURE_COLUMNS, FAILURE_FIELDS, failure
+from .row import columns_for, fields_for, rows_of
 from . import executors
 from .executors import _serial, execute
 from .scheduler import ClusterLost
@@ -46,15 +48,15 @@ class RunSummary:
 
 
 # -- the output folder -------------------------------------------------------------------------------
-def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> report.Outputs:
+def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> files.Outputs:
     """Check the output folder before any work is done (:class:`ArgumentError` otherwise): a folder
     (created if needed) that can be written to; no input among the files the run would write; and
     its fixed reports (``summary.csv`` ...), where present, written by an earlier run."""
     out = output_folder(out)
-    shown = report.display(out)
+    shown = cells.display(out)
     try:
-        outputs = report.Outputs(out)
-    except report.NotOurs as exc:
+        outputs = files.Outputs(out)
+    except files.NotOurs as exc:
         raise ArgumentError(f"--out {shown}: {exc}; choose another folder") from None
     fixed = outfiles.fixed_files(dataclasses.replace(options, plots=plots))
     written = fixed + [n for t in tasks for n in outfiles.record_files(t.record_id, plots)]
@@ -72,34 +74,34 @@ def prepare_output(out, tasks, plots: bool, options: Options = Options()) -> rep
         except (OSError, ValueError):
             continue
         if (st.st_dev, st.st_ino) in inputs:
-            raise ArgumentError(f"the report {report.display(out / rel)} would overwrite the input "
-                                f"{report.display(inputs[(st.st_dev, st.st_ino)])}; choose another --out")
-    for rel in (f for f in fixed if f != report.MANIFEST):  # the manifest vouches for the rest
+            raise ArgumentError(f"the report {cells.display(out / rel)} would overwrite the input "
+                                f"{cells.display(inputs[(st.st_dev, st.st_ino)])}; choose another --out")
+    for rel in (f for f in fixed if f != outfiles.MANIFEST):  # the manifest vouches for the rest
         try:
             outputs.check(rel)
-        except report.NotOurs as exc:
+        except files.NotOurs as exc:
             raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
     return outputs
 
 
-def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, say) -> None:
+def _write_record(outputs: files.Outputs, task: Task, res: dict, plots: bool, say) -> None:
     """Write (or remove, for a failed record) the record's own report and figure; a problem doing so
     makes the record a failure of stage ``write`` (the batch goes on)."""
     rid = res["record"]
     problems = []
     try:
         if res["rows"]:
-            outputs.write(report.record_csv_name(rid), res.get(TEXT) or report.csv_text(fields_for(task.options), res["rows"]))
+            outputs.write(outfiles.record_csv_name(rid), res.get(TEXT) or columns.csv_text(fields_for(task.options), res["rows"]))
         else:  # a report from an earlier run would look like this record's
-            outputs.remove(report.record_csv_name(rid))
+            outputs.remove(outfiles.record_csv_name(rid))
     except OSError as exc:
         problems.append(exc)
     if plots:
         # the record's figure, and the barcode of the check above the search width where it
         # found failing widths; a figure not drawn this time is removed (an earlier run's)
-        for name, data in ((report.record_plot_name(rid), res.get("plot")),
-                           (report.record_widths_plot_name(rid), res.get("widths_plot")),
-                           (report.record_friction_plot_name(rid), res.get("friction_plot"))):
+        for name, data in ((outfiles.record_plot_name(rid), res.get("plot")),
+                           (outfiles.record_widths_plot_name(rid), res.get("widths_plot")),
+                           (outfiles.record_friction_plot_name(rid), res.get("friction_plot"))):
             try:
                 if data:
                     outputs.write(name, data)
@@ -110,7 +112,7 @@ def _write_record(outputs: report.Outputs, task: Task, res: dict, plots: bool, s
     res["widths_plot"] = res["friction_plot"] = None
     res["plot"] = None  # thousands of records: keep only the rows in memory
     for exc in problems:
-        say(f"pipeline run: {rid}: {report.display(exc)}")
+        say(f"pipeline run: {rid}: {cells.display(exc)}")
     if problems and not res["failure"]:
         res["failure"] = failure(task, "write", problems[0])
 
@@ -161,15 +163,7 @@ def _check_log(log, out, tasks, own) -> None:
 
 def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log, lists) -> RunSummary:
     """:func:`run`, the folder locked."""
-    outputs = prepare_output(out, tasks, options.plots, options)
-    own = outfiles.own_files(tasks, options) + list(lists)   # lists: such as peer-not-downloaded.csv
-    _check_log(log, out, tasks, own)
-    try:
-        journal = resume.Journal(out)
-    except report.NotOurs as exc:
-        raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
-    resume.remove_stale_temporaries(out, own)  # left by a run killed while writing
-
+    outputs, journal = _open(out, tasks, options, log, lists)
     # what each record's rows are (text as in its report), and why it failed; nothing else is kept
     # per record, so that memory stays flat over a long batch
     tasks, held = passes.first_pass(tasks, options)
@@ -179,25 +173,10 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     plan.sent(todo)
     failures: list[dict | None] = [None] * len(tasks)
     computed = set()  # the tasks computed (in any pass); the others were reused
-    try:
-        log = joblog.JobLog(log)
-    except OSError as exc:
-        raise ArgumentError(f"--log {report.display(log)}: {report.display(exc.strerror or exc)}") from None
-    for t in tasks:
-        if texts[t.index]:
-            log.record(None, t.record_id, reused=True)
-
+    log = _job_log(log, tasks, texts)
     bar = _progress_bar(len(todo) + len(held), quiet, progress)
-
-    def say(msg):
-        if quiet:
-            return
-        if bar is not None:
-            bar.write(msg, file=sys.stderr)
-        else:
-            print(msg, file=sys.stderr)
-
-    header = report.csv_text(fields_for(options), [])
+    say = _sayer(quiet, bar)
+    header = columns.csv_text(fields_for(options), [])
     stream = _serial([])
 
     more = _passes(plan, tasks, journal, keys, texts, options, by_pair, force, bar)
@@ -230,14 +209,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     failures = [f for f in failures if f]
     text = "".join(texts)
     del texts
-    for rel, listed in lists.items():  # e.g. the records of a PEER search not in its download
-        try:
-            if listed is not None:
-                outputs.write(rel, listed)
-            elif outputs.owned(rel):
-                outputs.remove(rel)
-        except report.NotOurs as exc:
-            say(f"pipeline run: note: {exc}")
+    _write_lists(outputs, lists, say)
     with executors.renderer(bool(dask) or bool(jobs and jobs > 1)) as render:
         design, rows, problems, risk_rows = _write_tables(outputs, out, tasks, header, text, failures,
                                                           failed, options, render, jobs=jobs, say=say)
@@ -246,7 +218,7 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     n_failed = len(failures)
     summary = RunSummary(len(tasks), len(tasks) - n_failed, n_failed, out, len(tasks) - len(computed),
                          {"design": design, "summary": rows, "failures": failures,
-                          "suite": _as_written(list(site.SUITE_COLUMNS.names), site.suite_rows(rows) if rows else []),
+                          "suite": suite_tables.SUITE_COLUMNS.as_written(suite_tables.suite_rows(rows) if rows else []),
                           "risk": risk_rows},
                          problems)
     if not quiet:
@@ -254,13 +226,55 @@ def _run_locked(out, tasks, *, options, jobs, dask, quiet, progress, force, log,
     return summary
 
 
-def _as_written(fields, rows) -> list[dict]:
-    """``rows`` as their CSV file holds them (6 significant digits), read back."""
-    import csv
-    import io
+def _open(out, tasks, options, log, lists):
+    """``(outputs, journal)`` of the run's folder ``out``, checked (:func:`prepare_output`, the
+    ``--log`` file), the temporaries a killed run left there removed."""
+    outputs = prepare_output(out, tasks, options.plots, options)
+    own = outfiles.own_files(tasks, options) + list(lists)   # lists: such as peer-not-downloaded.csv
+    _check_log(log, out, tasks, own)
+    try:
+        journal = resume.Journal(out)
+    except files.NotOurs as exc:
+        raise ArgumentError(f"--out: {exc}; move it away or choose another folder") from None
+    resume.remove_stale_temporaries(out, own)  # left by a run killed while writing
+    return outputs, journal
 
-    text = report.csv_text(fields, rows)
-    return [{f: resume.typed(c) for f, c in zip(fields, cells)} for cells in list(csv.reader(io.StringIO(text)))[1:]]
+
+def _job_log(log, tasks, texts):
+    """The ``--log`` of the run (:class:`pipeline.batch.joblog.JobLog`), the reused records noted."""
+    try:
+        log = joblog.JobLog(log)
+    except OSError as exc:
+        raise ArgumentError(f"--log {cells.display(log)}: {cells.display(exc.strerror or exc)}") from None
+    for t in tasks:
+        if texts[t.index]:
+            log.record(None, t.record_id, reused=True)
+    return log
+
+
+def _sayer(quiet, bar):
+    """``say(msg)``: a message on stderr (above the progress bar ``bar``; none with ``quiet``)."""
+    def say(msg):
+        if quiet:
+            return
+        if bar is not None:
+            bar.write(msg, file=sys.stderr)
+        else:
+            print(msg, file=sys.stderr)
+    return say
+
+
+def _write_lists(outputs, lists, say) -> None:
+    """The files the inputs add (``{name: text}``; None: an earlier run's removed), such as the
+    records of a PEER search not in its download."""
+    for rel, listed in lists.items():
+        try:
+            if listed is not None:
+                outputs.write(rel, listed)
+            elif outputs.owned(rel):
+                outputs.remove(rel)
+        except files.NotOurs as exc:
+            say(f"pipeline run: note: {exc}")
 
 
 def _print_end(summary, tasks, failed, n_computed, design, failures, rows) -> None:
@@ -273,9 +287,9 @@ def _print_end(summary, tasks, failed, n_computed, design, failures, rows) -> No
                f"{summary.n_records} tasks)")
     msg += f" ({summary.n_reused} reused from an earlier run, {n_computed} computed)"
     if summary.n_failed:
-        msg += f", {summary.n_failed} failed (see {report.display(summary.out / report.FAILURES)})"
-    print(design_table.table_text(design, failures, rows), end="")
-    print(f"{msg}; reports in {report.display(summary.out)}")
+        msg += f", {summary.n_failed} failed (see {cells.display(summary.out / outfiles.FAILURES)})"
+    print(answer.table_text(design, failures, rows), end="")
+    print(f"{msg}; reports in {cells.display(summary.out)}")
 
 
 def _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, say) -> None:
@@ -287,9 +301,9 @@ def _not_computed(exc, tasks, texts, failures, computed, outputs, journal, log, 
         computed.add(t.index)
         failures[t.index] = failure(t, "cluster", reason)
         journal.drop(t.record_id)
-        for name in (report.record_csv_name(t.record_id), report.record_plot_name(t.record_id),
-                     report.record_widths_plot_name(t.record_id)):
-            with contextlib.suppress(OSError, report.NotOurs):
+        for name in (outfiles.record_csv_name(t.record_id), outfiles.record_plot_name(t.record_id),
+                     outfiles.record_widths_plot_name(t.record_id)):
+            with contextlib.suppress(OSError, files.NotOurs):
                 if outputs.owned(name):
                     outputs.remove(name)
         log.record({"failure": failures[t.index]}, t.record_id)
@@ -304,9 +318,10 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
     task = tasks[i]
     figure = res.get("plot")
     _write_record(outputs, task, res, options.plots and task.plot, say)
-    texts[i] = (res.get(TEXT) or report.csv_text(fields_for(task.options), res["rows"]))[len(header):]  # made by the worker
+    texts[i] = (res.get(TEXT) or columns.csv_text(fields_for(task.options), res["rows"]))[len(header):]  # made by the worker
     failures[i] = res["failure"]
-    plan.note(task, res["rows"])
+    if passes.staged(task, options):  # the plan decides on the rows as the report holds them
+        plan.note(task, rows_of(texts[i], options))
     if res["failure"] or not res["rows"] or keys[i] is None:
         journal.drop(task.record_id)
     else:
@@ -315,7 +330,7 @@ def _handle(res, tasks, outputs, journal, keys, texts, failures, options, plan, 
                     resume.form_text(task) if passes.staged(task, options) else None)
     if res["failure"]:
         f = res["failure"]
-        say(f"pipeline run: {res['record']}: failed ({f['stage']}): {report.display(f['reason'])}")
+        say(f"pipeline run: {res['record']}: failed ({f['stage']}): {cells.display(f['reason'])}")
 
 
 def _reuse(t, journal, force, version):
@@ -369,14 +384,14 @@ def _reusable(tasks, journal, force: bool, options, plan, by_pair):
         kept = {} if force else _settled_pair(tasks, indices, journal, version)
         for i, (form, keys[i], texts[i]) in kept.items():
             tasks[i] = form
-            plan.note(form, resume.rows_from_text(texts[i], fields_for(options)))
+            plan.note(form, rows_of(texts[i], options))
         plan.held -= set(kept)
     for t in list(tasks):
         if t.index in plan.held or texts[t.index]:
             continue
         keys[t.index], texts[t.index] = _reuse(t, journal, force, version)
         if texts[t.index]:
-            plan.note(t, resume.rows_from_text(texts[t.index], fields_for(options)))
+            plan.note(t, rows_of(texts[t.index], options))
         else:
             journal.drop(t.record_id)
             todo.append(t)
@@ -425,7 +440,7 @@ def _later_pass(plan, tasks, journal, keys, texts, options, force):
             else:
                 tasks[t.index] = t
                 texts[t.index] = kept
-                plan.note(t, resume.rows_from_text(kept, fields_for(options)))
+                plan.note(t, rows_of(kept, options))
                 found = True
         if todo or not found:
             plan.sent(todo)
@@ -466,13 +481,13 @@ class _Figures:
             return self.outputs.write(rel, data)
         except OSError as exc:
             self.problems += 1
-            self.say(f"pipeline run: {report.display(exc)}; the figure is left out")
+            self.say(f"pipeline run: {cells.display(exc)}; the figure is left out")
             self.drop(rel)  # not an earlier run's in its place
             return None
 
     def drop(self, rel) -> None:
         """No figure at ``rel`` this run: an earlier run's is removed (where it is the tool's)."""
-        with contextlib.suppress(OSError, report.NotOurs):
+        with contextlib.suppress(OSError, files.NotOurs):
             if self.outputs.owned(rel):
                 self.outputs.remove(rel)
 
@@ -483,20 +498,19 @@ def _write_tables(outputs, out, tasks, header, text, failures, failed, options, 
     reports hold them, below ``header``); return the design rows, the rows of summary.csv, how
     many figures could not be written and the rows of risk.csv."""
     outputs = _Figures(outputs, say)
-    outputs.write(report.SUMMARY, header + text)
-    outputs.write(report.FAILURES, report.csv_text(FAILURE_FIELDS, failures))
-    outputs.write(report.COLUMNS_MD, report.columns_markdown(columns_for(options), FAILURE_COLUMNS.columns)
-                  + site.columns_markdown() + design_table.columns_markdown(options.limit is not None,
-                                                                           options.restitution is not None)
-                  + (risk.columns_markdown() if options.risk is not None else ""))
+    outputs.write(outfiles.SUMMARY, header + text)
+    outputs.write(outfiles.FAILURES, columns.csv_text(FAILURE_FIELDS, failures))
+    outputs.write(outfiles.COLUMNS_MD, columns_md.columns_md(
+        columns_for(options).columns, FAILURE_COLUMNS.columns, margin=options.limit is not None,
+        restitution=options.restitution is not None, risk=options.risk is not None))
     # the rows as the reports hold them, so that a resumed run writes the same files
-    rows = resume.rows_from_text(text, fields_for(options))
-    site.write_outputs(outputs, rows, fields_for(options), options, failed, render)
+    rows = rows_of(text, options)
+    suite_tables.write_tables(outputs, rows, fields_for(options), options, failed, render)
     answers, risk_rows = risk.write_outputs(outputs, tasks, rows, options, render, jobs, say)  # --hazard
     if options.plots and rows:
-        outputs.write(report.SUMMARY_PLOT, (render or figures.draw)("plots:summary_figure_png", rows))
+        outputs.write(outfiles.SUMMARY_PLOT, (render or figures.draw)("record:summary_figure_png", rows))
     elif options.plots:  # every record failed: no empty figures
-        for rel in (report.SUMMARY_PLOT, report.SUITE_PLOT, report.FRAGILITY_PLOT):
+        for rel in (outfiles.SUMMARY_PLOT, outfiles.SUITE_PLOT, outfiles.FRAGILITY_PLOT):
             outputs.drop(rel)
     design = write_answer(outputs, out, tasks, rows, failures, failed, options, answers)
     outputs.finish()
@@ -508,12 +522,12 @@ def write_answer(outputs, out, tasks, rows, failures, failed, options, answers=N
     """Write ``design.csv`` and ``report.html``; return the design rows (printed after the run).
     ``answers``: each column's risk at the site (pipeline.batch.risk.write_outputs)."""
     design = design_table.design_rows(rows, failed, answers)
-    outputs.write(design_table.DESIGN_CSV, report.csv_text(design_table.design_fields(rows), design))
+    outputs.write(outfiles.DESIGN_CSV, columns.csv_text(design_table.design_fields(rows), design))
     ids = [t.record_id for t in tasks]
     this_run = set(outfiles.fixed_files(options))  # a figure of an earlier run with other options is not shown
-    names = {k: rel for k, rel in (("summary", report.SUMMARY_PLOT), ("suite", report.SUITE_PLOT),
-                                   ("fragility", report.FRAGILITY_PLOT), ("risk_widths", risk.RISK_WIDTHS_PLOT),
+    names = {k: rel for k, rel in (("summary", outfiles.SUMMARY_PLOT), ("suite", outfiles.SUITE_PLOT),
+                                   ("fragility", outfiles.FRAGILITY_PLOT), ("risk_widths", risk.RISK_WIDTHS_PLOT),
                                    ("risk_disaggregation", risk.RISK_DISAGG_PLOT)) if k == "summary" or rel in this_run}
     figures = html_report.figures_in(out, ids, options.plots, names)
-    outputs.write(html_report.REPORT_HTML, html_report.report_html(design, rows, failures, ids, figures))
+    outputs.write(outfiles.REPORT_HTML, html_report.report_html(design, rows, failures, ids, figures))
     return design

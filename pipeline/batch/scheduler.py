@@ -22,7 +22,7 @@ import socket
 import struct
 import time
 
-from ..args import ArgumentError
+from ..values import ArgumentError
 
 #: seconds to connect to the scheduler and to read its greeting
 PROBE_S = 5.0

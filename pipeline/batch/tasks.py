@@ -36,15 +36,34 @@ class Column:
 
 
 @dataclass(frozen=True)
+class ReadOptions:
+    """How a run's records are read: what a file may not say, for :func:`pulses.read_record` (the
+    options of :func:`pipeline.args.add_record_options`, checked by :mod:`pipeline.values`)."""
+
+    #: the file format when not detected from the content (``"at2"``, ``"text"``, an obspy format)
+    format: str | None = None
+    #: the samples' units where the file states none (canonical: ``"cm/s2"``, not ``"gal"``)
+    units: str | None = None
+    #: the sampling interval, s, of a text file without a time column
+    dt: float | None = None
+    #: a text file's acceleration column, counted from 1
+    column: int | None = None
+    #: the trace of a file holding several: an index from 0, a trace id or a channel
+    trace: int | str | None = None
+
+    def kwargs(self) -> dict:
+        """The keyword arguments of :func:`pulses.read_record` (and :func:`pulses.read_pair`)."""
+        return {"format": self.format, "units": self.units, "dt": self.dt, "column": self.column,
+                "trace": self.trace}
+
+
+@dataclass(frozen=True)
 class Options:
     shapes: tuple | None = None
     #: the pulse fit's least squares (``pulses.fit_pulse``'s ``weighting``)
     weighting: str = "background"
-    units: str | None = None
-    dt: float | None = None
-    column: int | None = None
-    format: str | None = None
-    trace: str | None = None
+    #: how the records are read (``--units``, ``--dt``, ``--column``, ``--format``, ``--trace``)
+    read: ReadOptions = ReadOptions()
     plots: bool = True
     #: ``--plots all``: a figure for every direction of a pair (default: its governing direction
     #: only, pipeline.batch.passes)
@@ -175,7 +194,7 @@ def plainly_not_a_record(path) -> bool:
 def skipped_note(skipped, glob_option=True) -> str:
     """The note that ``run`` and ``classify`` print for the files of folders left out by
     :func:`expand_inputs` (the first five named; ``glob_option``: the command has ``--glob``)."""
-    from ..reports.report import display
+    from ..reports.cells import display
 
     shown = ", ".join(display(os.path.basename(p)) for p in skipped[:5]) + (" ..." if len(skipped) > 5 else "")
     return (f"{len(skipped)} file(s) of the folders skipped, plainly not records ({shown}); name a "

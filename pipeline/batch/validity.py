@@ -9,16 +9,16 @@ up that does not (``rocking.sliding_width``), or says that none does.
 """
 from __future__ import annotations
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, FLAG, TEXT
 
 VALIDITY_COLUMNS = Columns(
     ("body", "-", "The body that rocks: `rectangular` (`--block HxW`), `cylinder (planar rocking)` "
                   "(`--block cyl:HxD`: a solid circular column of diameter D rocking in a plane, "
-                  "no wobbling or rolling; docs/theory.md, \"Bodies\")."),
+                  "no wobbling or rolling; docs/theory.md, \"Bodies\").", TEXT),
     ("impact_rule", "-", "The restitution the responses used, in words: `Eq. 5` (Housner's rule "
                          "for the body, the largest for which it rocks; the cylinder's own rule for "
                          "a cylinder), a factor of it (`0.97 x Eq. 5`) or the value given "
-                         "(`--restitution`, whose text is in `restitution`)."),
+                         "(`--restitution`, whose text is in `restitution`).", TEXT),
     ("eta", "-", "The velocity ratio at impact eta of the column as it stands (the energy ratio "
                  "is r = eta^2); blank for `--height`."),
     ("design_eta", "-", "eta of the column at its design width (Eq. 5 follows the width)."),
@@ -45,11 +45,11 @@ VALIDITY_COLUMNS = Columns(
                          "judged against; blank: not judged."),
     ("slides", "-", "With `--friction`: the column as it stands needs more than MU at some "
                     "instant: it slides, which the rocking model does not describe (its verdict "
-                    "is then not a verdict)."),
+                    "is then not a verdict).", FLAG),
     ("t_slide_s", "s", "When the column as it stands first needs more than MU."),
-    ("eq31_width_slides", "-", "With `--friction`: the Eq. 31 design slides."),
+    ("eq31_width_slides", "-", "With `--friction`: the Eq. 31 design slides.", FLAG),
     ("design_slides", "-", "With `--friction`: the column at its design width slides: the design "
-                           "width is not valid (see `friction_width_m`)."),
+                           "width is not valid (see `friction_width_m`).", FLAG),
     ("design_t_slide_s", "s", "When the column at its design width first needs more than MU."),
     ("friction_width_m", "m", "With `--friction` where the design width slides: the narrowest "
                               "width from the design width up at which the column does not slide "
@@ -57,7 +57,7 @@ VALIDITY_COLUMNS = Columns(
                               "(`validity` says why) or where the design width holds."),
     ("validity", "-", "Which model answered and its checks, in words: the body, the restitution, "
                       "friction (demand, and with `--friction` passed or failed and when), "
-                      "lift-off with the vertical (passed, failed and when, or no vertical)."),
+                      "lift-off with the vertical (passed, failed and when, or no vertical).", TEXT),
 )
 
 

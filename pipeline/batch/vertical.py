@@ -15,25 +15,25 @@ from __future__ import annotations
 
 import dataclasses
 
-from ..reports.report import Columns
+from ..reports.columns import Columns, FLAG, TEXT
 
 VERTICAL_COLUMNS = Columns(
     ("vertical_file", "-", "The vertical component used with this record (`--vertical auto`: a PEER "
                            "record's vertical, a `--triplet`, or the vertical `--pairs auto` found "
-                           "for the pair); blank when none was used (then every vertical_* is blank)."),
+                           "for the pair); blank when none was used (then every vertical_* is blank).", TEXT),
     ("vertical_polarity", "-", "`UP` or `DWN`, as the vertical's file name and header state it (a "
-                               "`DWN` record is multiplied by -1 to give the upward acceleration)."),
+                               "`DWN` record is multiplied by -1 to give the upward acceleration).", TEXT),
     ("vertical_pga_g", "g", "Peak absolute vertical acceleration (scaled as the record, `scale`)."),
     ("vertical_min_effective_gravity", "-", "Smallest 1 + av/g over the record (av upward): below 0 "
                                             "the ground falls away faster than gravity (free flight)."),
     ("vertical_overturns", "-", "The column as it stands overturns under the horizontal motion of this "
                                 "row together with the vertical (docs/theory.md section 10); compare "
-                                "`overturns` (horizontal alone). Blank for `--height`."),
+                                "`overturns` (horizontal alone). Blank for `--height`.", FLAG),
     ("vertical_max_theta_ratio", "-", "max|theta|/alpha of the column as it stands with the vertical; "
                                       "compare `max_theta_ratio`."),
     ("vertical_lifts_off", "-", "g + av < 0 before the response ended: the block leaves the ground, "
                                 "which the rocking model does not describe; the response with the "
-                                "vertical stops there and its verdict is not a verdict."),
+                                "vertical stops there and its verdict is not a verdict.", FLAG),
     ("vertical_t_lift_off_s", "s", "First time of g + av < 0 (blank when it never happens)."),
     ("vertical_design_width_m", "m", "Design width with the vertical (`rocking.required_width`, "
                                        "rule exact, `vertical=`): the smallest width surviving the "
@@ -44,19 +44,8 @@ VERTICAL_COLUMNS = Columns(
                                        "reaches -g (the block would leave the ground)."),
     ("vertical_model", "-", "Model that answered with the vertical: `fast-vertical` (the compiled "
                             "engine, `rocking.simulate(..., vertical=)`; `rest` if the column never "
-                            "uplifts)."),
+                            "uplifts).", TEXT),
 )
-
-
-def add_options(parser) -> None:
-    """``--vertical`` and ``--triplet`` of ``pipeline run``."""
-    parser.add_argument("--vertical", choices=["auto", "none"], default="auto",
-                        help="auto (default): where a record's vertical is known (PEER downloads, "
-                             "--triplet, --pairs auto), add the response of each column as it stands "
-                             "with it (vertical_* columns); none: horizontal motion only")
-    parser.add_argument("--triplet", nargs=3, action="append", default=[], metavar=("H1", "H2", "V"),
-                        help="design H1 and H2 as a pair (as --pair) with V as their vertical; V must "
-                             "state its polarity (UP or DWN in its name or header); repeatable")
 
 
 def attach(tasks, verticals: dict) -> list:
@@ -68,7 +57,7 @@ def attach(tasks, verticals: dict) -> list:
     return out
 
 
-def auto_verticals(paths, opts: dict, say) -> dict:
+def auto_verticals(paths, read, say) -> dict:
     """``{(first, second): vertical}`` for ``--pairs auto``: a pair with exactly one vertical of the
     same station (as :func:`pulses.pair_files` groups them)."""
     import pulses
@@ -77,7 +66,7 @@ def auto_verticals(paths, opts: dict, say) -> dict:
     meta = {}
     for p in paths:
         try:
-            meta[p] = pulses.read_record(p, **opts).metadata
+            meta[p] = pulses.read_record(p, **read.kwargs()).metadata
         except Exception:
             pass
     found = pulses.pair_files(paths, metadata=meta)
@@ -95,54 +84,6 @@ def auto_verticals(paths, opts: dict, say) -> dict:
 
 
 # -- in the worker -----------------------------------------------------------------------------------
-def read_task(task):
-    """``(horizontal record, upward vertical or None, note or None)`` of a task: the component in
-    the task's direction, and the vertical on its time axis, both scaled by ``task.scale``."""
-    import pulses
-
-    from . import peer_inputs, site
-
-    want = task.options.vertical != "none"
-    src = getattr(task, "peer", None)
-    note = None
-    if src is not None:
-        first, second, vname = peer_inputs.read_components(task)
-        vert, note = peer_inputs.read_vertical(task) if want else (None, "")
-        note = note or None
-    elif want and getattr(task, "vertical", None) and task.path2 is not None:
-        o = task.options
-        kw = dict(format=o.format, units=o.units, dt=o.dt, column=o.column, trace=o.trace)
-        first, second = (pulses.read_record(p, **kw) for p in (task.path, task.path2))
-        vname = task.vertical
-        try:
-            vert = pulses.read_record(vname, **kw)
-        except pulses.RecordError as exc:
-            first, second = pulses.check_pair(first, second)
-            return _directed(task, first, second, None), None, f"vertical not used: {exc}"
-    else:
-        return site.read_task(task), None, None
-    up = None
-    if vert is not None:
-        try:
-            first, second, up = pulses.check_triplet(first, second, vert, vname)
-        except pulses.RecordError as exc:
-            note = f"vertical not used: {exc}"
-    if up is None:
-        first, second = pulses.check_pair(first, second)
-    return _directed(task, first, second, up), scaled(task, up), note
-
-
-def _directed(task, first, second, up):
-    import pulses
-
-    record = pulses.component(first, second, task.direction or 0.0)
-    return record.scaled(task.scale) if task.scale != 1.0 else record
-
-
-def scaled(task, up):
-    return up.scaled(task.scale) if (up is not None and task.scale != 1.0) else up
-
-
 def design(record, up, height, horizontal, cap_mass_ratio=0.0, limit=None, overturning=None,
            body="rectangular", restitution=None):
     """The design width of a column ``height`` (m) tall: ``horizontal`` (the horizontal motion's

@@ -7,7 +7,8 @@ import os
 
 from . import joblog, memo
 from .quiet import quiet_now  # noqa: F401 (what the pools' initializers are given)
-from .record import failure, fields_for, process_record
+from .record import failure, process_record
+from .row import fields_for
 from .tasks import Task
 
 
@@ -104,7 +105,7 @@ TEXT = "text"
 def rows_text(rows, options):
     """``<record>.csv``'s text of ``rows`` (the columns of the run's ``options``), or None where
     they do not match the columns (the main process then fails as it did)."""
-    from ..reports.report import ReportError, csv_text
+    from ..reports.columns import csv_text, ReportError
 
     try:
         return csv_text(fields_for(options), rows)

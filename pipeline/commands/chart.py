@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import time
 
-from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration,
-                    parse_column_block, parse_positive, parse_restitution)
+from ..args import ShapeNames, add_restitution_option, parse_acceleration
+from ..values import ArgumentError, parse_column_block, parse_positive, parse_restitution
 
 
 def _floats(text, what):
@@ -137,7 +137,7 @@ def _run_heights(args, heights, pulse, column, eta=None) -> int:
     import pulses
 
     from ..reports.outpaths import figure_png, write_output
-    from ..reports.width_chart import RULES, width_figure, widths_by_height
+    from ..reports.figures.chart import RULES, width_figure, widths_by_height
 
     shape, ap, tp = pulse
     start = time.perf_counter()

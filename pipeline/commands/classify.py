@@ -14,7 +14,8 @@ from __future__ import annotations
 import json
 import sys
 
-from ..args import ArgumentError, add_pair_options, add_record_options, pair_files, record_options
+from ..args import add_pair_options, add_record_options, record_options
+from ..values import ArgumentError, pair_files
 from ..reports.pulse_row import COLUMNS, RUN_COLUMNS, classify_fields, result_row  # noqa: F401 (this command's row)
 
 def add_parser(subparsers) -> None:
@@ -41,8 +42,6 @@ def _message(path, exc) -> str:
 
 
 def main(args) -> int:
-    import pulses
-
     from ..batch.tasks import expand_inputs, skipped_note
 
     if not args.files and not args.pair:
@@ -55,8 +54,28 @@ def main(args) -> int:
         print(f"pipeline classify: note: {skipped_note(skipped, glob_option=False)}", file=sys.stderr)
     inputs = files + [p for pair in args.pair for p in pair]
     _check_outputs(args, inputs)
+    records, failures = _read_all(inputs, opts)
+    rows, failed = _classify_all(_units(args, files, records), records, args, inputs)
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    elif rows:
+        print(format_rows(rows))
+    if args.csv and rows:
+        from ..reports.columns import csv_text
+        from ..reports.outpaths import write_output
+
+        write_output(args.csv, csv_text(COLUMNS, [{c: row[c] for c in COLUMNS} for row in rows]), "csv",
+                     inputs=inputs)
+    return 1 if failures or failed else 0
+
+
+def _read_all(paths, opts):
+    """``({path: record or None}, failures)``: every file read once; one that cannot be read is
+    said and counted."""
+    import pulses
+
     records, failures = {}, 0
-    for path in files + [p for pair in args.pair for p in pair]:
+    for path in paths:
         if path in records:
             continue
         try:
@@ -65,31 +84,43 @@ def main(args) -> int:
             print(f"pipeline classify: {_message(path, exc)}", file=sys.stderr)
             records[path] = None
             failures += 1
-    jobs = []  # (first, second or None, named with --pair), in order
-    paired = set()
+    return records, failures
+
+
+def _units(args, files, records) -> list:
+    """``(first, second or None, named with --pair)`` in order: the ``--pair`` couples, then the
+    other readable files, paired by what they say with ``--pairs auto``."""
+    import pulses
+
+    units, paired = [], set()
     for a, b in args.pair:
-        jobs.append((a, b, True))
+        units.append((a, b, True))
         paired.update((a, b))
     rest = [p for p in files if p not in paired and records.get(p) is not None]
-    if args.pairs == "auto":
-        found = pulses.pair_files(rest, metadata={p: records[p].metadata for p in rest})
-        for note in found.notes:
-            print(f"pipeline classify: note: {note}", file=sys.stderr)
-        for v in found.verticals:
-            print(f"pipeline classify: note: {v}: vertical component, left out", file=sys.stderr)
-        order = {p: i for i, p in enumerate(rest)}
-        found_jobs = [(order[a], a, b) for a, b in found.pairs] + [(order[s], s, None) for s in found.singles]
-        jobs += [(a, b, False) for _, a, b in sorted(found_jobs, key=lambda u: u[0])]
-    else:
-        jobs += [(p, None, False) for p in rest]
+    if args.pairs != "auto":
+        return units + [(p, None, False) for p in rest]
+    found = pulses.pair_files(rest, metadata={p: records[p].metadata for p in rest})
+    for note in found.notes:
+        print(f"pipeline classify: note: {note}", file=sys.stderr)
+    for v in found.verticals:
+        print(f"pipeline classify: note: {v}: vertical component, left out", file=sys.stderr)
+    order = {p: i for i, p in enumerate(rest)}
+    found_units = [(order[a], a, b) for a, b in found.pairs] + [(order[s], s, None) for s in found.singles]
+    return units + [(a, b, False) for _, a, b in sorted(found_units, key=lambda u: u[0])]
 
-    rows, results = [], []
+
+def _classify_all(units, records, args, inputs):
+    """``(rows, failures)``: each pair (or single file) of ``units`` classified, and drawn with
+    ``--plot``; a pair found by ``--pairs auto`` that is no pair is classified one file at a time."""
+    import pulses
+
+    rows, failures = [], 0
     stems = set()  # plot file names taken: two inputs named alike never share a PNG
-    for a, b, explicit in jobs:
+    for a, b, explicit in units:
         first, second = records.get(a), records.get(b) if b is not None else None
         if first is None or (b is not None and second is None):
             continue  # already reported as unreadable
-        units = [(a, b)]
+        alone = [(a, b)]
         if second is not None:
             try:
                 pulses.check_pair(first, second)
@@ -99,8 +130,8 @@ def main(args) -> int:
                     failures += 1
                     continue
                 print(f"pipeline classify: note: classifying {a} and {b} one by one", file=sys.stderr)
-                units = [(a, None), (b, None)]
-        for x, y in units:
+                alone = [(a, None), (b, None)]
+        for x, y in alone:
             try:
                 result = pulses.classify_pulse(records[x], records[y] if y is not None else None)
             except (pulses.RecordError, ValueError) as exc:
@@ -108,28 +139,22 @@ def main(args) -> int:
                 failures += 1
                 continue
             rows.append(result_row(result, x, y or ""))
-            results.append((result, x, y))
             if args.plot:
-                from ..reports.plot_classify import plot_classification
+                failures += _plot(result, args.plot, records, x, y, stems, inputs)
+    return rows, failures
 
-                try:
-                    plot_classification(result, args.plot, records[x],
-                                        records[y] if y is not None else None,
-                                        stem=_unique_stem(result.name, stems), inputs=inputs)
-                except OSError as exc:  # one plot that cannot be written fails its row only
-                    print(f"pipeline classify: {_message(x, exc)}", file=sys.stderr)
-                    failures += 1
-    if args.json:
-        print(json.dumps(rows, indent=2))
-    elif rows:
-        print(format_rows(rows))
-    if args.csv and rows:
-        from ..reports.outpaths import write_output
-        from ..reports.report import csv_text
 
-        write_output(args.csv, csv_text(COLUMNS, [{c: row[c] for c in COLUMNS} for row in rows]), "csv",
-                     inputs=inputs)
-    return 1 if failures else 0
+def _plot(result, folder, records, x, y, stems, inputs) -> int:
+    """Draw one classification into ``folder``; 1 where it cannot be written (its row fails), else 0."""
+    from ..reports.figures.classify import plot_classification
+
+    try:
+        plot_classification(result, folder, records[x], records[y] if y is not None else None,
+                            stem=_unique_stem(result.name, stems), inputs=inputs)
+    except OSError as exc:  # one plot that cannot be written fails its row only
+        print(f"pipeline classify: {_message(x, exc)}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def _unique_stem(name, taken) -> str:

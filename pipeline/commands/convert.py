@@ -9,7 +9,8 @@ from __future__ import annotations
 import pathlib
 import sys
 
-from ..args import ArgumentError, add_record_options, record_options
+from ..args import add_record_options, record_options
+from ..values import ArgumentError
 from .fit import _with_path
 
 

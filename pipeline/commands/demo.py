@@ -38,7 +38,7 @@ def bundled_records():
 
 def main(args) -> int:
     from ..batch.tasks import Column
-    from ..args import parse_block
+    from ..values import parse_block
     from ..batch.runner import run
 
     jobs = parse_jobs(args.jobs)

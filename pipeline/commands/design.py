@@ -9,9 +9,8 @@ import json
 import math
 import sys
 
-from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration,
-                   parse_column_block, parse_column_height, parse_friction, parse_positive,
-                   parse_restitution)
+from ..args import ShapeNames, add_restitution_option, parse_acceleration
+from ..values import ArgumentError, parse_column_block, parse_column_height, parse_friction, parse_positive, parse_restitution
 
 
 
@@ -187,26 +186,7 @@ def run(args) -> int:
         "body": rocking.Body.parse(body).describe(),
         "restitution": None if eta is None else str(eta),
     }
-    rules = {}
-    if block is not None:
-        p = block.p
-        exact = rocking.min_slenderness(pulse, p, criterion=args.criterion, body=body, eta=eta)
-        values = {
-            "eq31": rocking.eq31(pulse.ap, pulse.tp, p),
-            "eq20": rocking.eq20(pulse.ap, pulse.tp, p, lam),
-            "envelope": rocking.envelope_rule(pulse.ap, pulse.tp, p, pulse.shape),
-            "exact": exact.tan_alpha,
-        }
-        out["envelope_shape"] = pulse.shape
-        out["block"] = {"height_m": height, "width_m": width, "p_rad_s": p,
-                        "tan_alpha": block.tan_alpha, "alpha_deg": math.degrees(block.alpha),
-                        "eta": _eta_of(height, width, eta), "pTp": p * pulse.tp}
-        if exact.band is not None:
-            out["exact_restitution_governing"] = str(exact.eta)
-        out["exact_transitions"] = list(exact.transitions)
-        out["exact_safe_islands"] = [list(s) for s in exact.safe_islands]
-        for name, value in values.items():
-            rules[name] = {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
+    rules = {} if block is None else _block_rules(out, block, pulse, args.criterion, lam, eta, body)
     _required_widths(rules, height, pulse, lam, args.criterion, eta, body)
     names = ["eq31", "eq20", "envelope", "exact"]
     if limit is not None:
@@ -222,17 +202,54 @@ def run(args) -> int:
         json.dump(out, sys.stdout, indent=2)
         print()
         return 0
+    _print_rules(out, pulse, origin, block, eta, lam, limit, args.criterion, names, mu)
+    return 0
+
+
+def _block_rules(out, block, pulse, criterion, lam, eta, body) -> dict:
+    """What each rule asks of the column as it stands (``out`` gets the block's facts and the
+    exact answer's transitions and islands): ``{rule: {"min_tan_alpha", "adequate"}}``."""
+    import rocking
+
+    p = block.p
+    exact = rocking.min_slenderness(pulse, p, criterion=criterion, body=body, eta=eta)
+    values = {
+        "eq31": rocking.eq31(pulse.ap, pulse.tp, p),
+        "eq20": rocking.eq20(pulse.ap, pulse.tp, p, lam),
+        "envelope": rocking.envelope_rule(pulse.ap, pulse.tp, p, pulse.shape),
+        "exact": exact.tan_alpha,
+    }
+    height, width = block.height, block.width
+    out["envelope_shape"] = pulse.shape
+    out["block"] = {"height_m": height, "width_m": width, "p_rad_s": p,
+                    "tan_alpha": block.tan_alpha, "alpha_deg": math.degrees(block.alpha),
+                    "eta": _eta_of(height, width, eta), "pTp": p * pulse.tp}
+    if exact.band is not None:
+        out["exact_restitution_governing"] = str(exact.eta)
+    out["exact_transitions"] = list(exact.transitions)
+    out["exact_safe_islands"] = [list(s) for s in exact.safe_islands]
+    return {name: {"min_tan_alpha": value, "adequate": bool(block.tan_alpha >= value)}
+            for name, value in values.items()}
+
+
+def _print_rules(out, pulse, origin, block, eta, lam, limit, criterion, names, mu) -> None:
+    """The command's answer as text: the pulse, the block, a line per rule, friction, notes."""
+    import rocking
+    from pulses import G
+
+    rules, height = out["rules"], out["height_m"]
+    ap_g = abs(pulse.ap) / G
     print(f"Pulse: {pulse.label}, ap = {ap_g:.4g} g ({abs(pulse.ap):.4g} m/s2), "
           f"Tp = {pulse.tp:.4g} s ({origin})")
     if block is not None:
         b = out["block"]
-        print(f"Block: {height:g} x {width:g} m, p = {b['p_rad_s']:.4g} rad/s, tan(alpha) = "
+        print(f"Block: {height:g} x {b['width_m']:g} m, p = {b['p_rad_s']:.4g} rad/s, tan(alpha) = "
               f"{b['tan_alpha']:.4g} (alpha = {b['alpha_deg']:.3g} deg), eta = {_eta_text(b['eta'])}, "
               f"pTp = {b['pTp']:.4g}")
     _print_restitution(eta, rules)
     labels = {"eq31": "Eq. 31", "eq20": f"Eq. 20 (lambda={lam:g})",
               "envelope": f"envelope ({pulse.shape})",
-              "exact": f"exact ({args.criterion})",
+              "exact": f"exact ({criterion})",
               "level": f"exact (level {limit:g})" if limit is not None else ""}
     head = f"{'rule':<22}"
     if block is not None:
@@ -261,4 +278,3 @@ def run(args) -> int:
     if not (lo <= ap_g <= hi) or any(not (ptp_lo <= x <= ptp_hi) for x in ptps):
         print(f"note: the envelope rule was derived for {ptp_lo:g} <= pTp <= {ptp_hi:g} and "
               f"{lo:g} <= ap/g <= {hi:g}; outside that range rely on the exact answer.")
-    return 0

@@ -12,8 +12,9 @@ from __future__ import annotations
 import json
 import sys
 
-from ..args import ShapeNames, add_record_options, add_weighting_option, parse_shapes, record_options
-from ..reports.report import text_cell
+from ..args import ShapeNames, add_record_options, add_weighting_option, record_options
+from ..values import parse_shapes
+from ..reports.cells import text_cell
 
 
 def add_parser(subparsers) -> None:

@@ -13,8 +13,8 @@ import json
 import math
 import sys
 
-from ..args import (ArgumentError, parse_scale, ShapeNames, add_record_options, parse_acceleration,
-                   parse_column_block, parse_friction, parse_positive, record_options)
+from ..args import ShapeNames, add_record_options, parse_acceleration, record_options
+from ..values import ArgumentError, parse_scale, parse_column_block, parse_friction, parse_positive
 
 
 def add_parser(subparsers) -> None:
@@ -84,7 +84,7 @@ def run(args) -> int:
         if not (0.0 <= eta <= 1.0):
             raise ArgumentError(f"--eta must lie in [0, 1], got {args.eta!r}")
     if args.restitution is not None:
-        from ..args import parse_restitution
+        from ..values import parse_restitution
 
         if args.eta is not None:
             raise ArgumentError("give --eta or --restitution, not both")

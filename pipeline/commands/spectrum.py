@@ -9,8 +9,8 @@ import math
 import re
 import time
 
-from ..args import (ArgumentError, ShapeNames, add_restitution_option, parse_acceleration, parse_angle,
-                    parse_column_block, parse_positive, parse_restitution)
+from ..args import ShapeNames, add_restitution_option, parse_acceleration, parse_angle
+from ..values import ArgumentError, parse_column_block, parse_positive, parse_restitution
 
 
 

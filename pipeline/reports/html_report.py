@@ -15,15 +15,13 @@ import html
 import pathlib
 import urllib.parse
 
-from . import report
-from .design_table import (check_reach_words, design_text, eq31_ratios, eq31_text, failing_text, metadata_text,
-                           passes_text, pulse_text, search_text, survives_text, verdict_lines, verge_text,
-                           fine_print, governing_print, vertical_text, with_eq31_ratio)
+from . import cells, outfiles
+from .answer import (check_reach_words, design_text, eq31_ratios, eq31_text, failing_text, metadata_text,
+                     fine_print, governing_print, passes_text, pulse_text, search_text, survives_text, verdict_lines,
+                     verge_text, vertical_text, with_eq31_ratio)
 from .design_table import number as _num
-from .report import FIT_TOLERANCE
+from .shapes import FIT_TOLERANCE
 
-#: the file in ``--out``
-REPORT_HTML = "report.html"
 
 _CSS = """
 body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.5em auto;max-width:90em;
@@ -75,13 +73,8 @@ def _whole(value):
     number = _num(value)
     return int(number) if number is not None and float(number).is_integer() else value
 
-def output_files() -> list[str]:
-    """The files this module writes into ``--out``."""
-    return [REPORT_HTML]
-
-
 def _e(value) -> str:
-    return html.escape(report.display("" if value is None else value), quote=True)
+    return html.escape(cells.display("" if value is None else value), quote=True)
 
 
 def _sort_value(value) -> str:
@@ -93,7 +86,7 @@ def _sort_value(value) -> str:
         return ""
     if isinstance(value, bool):
         return "yes" if value else "no"
-    return report.display(value)
+    return cells.display(value)
 
 
 def _cell(value, shown=None, numeric=False) -> str:
@@ -117,7 +110,7 @@ def _href(rel: str) -> str:
 
 def _anchor(record_id) -> str:
     # "_" escaped too: "a+b" (a%2Bb) and "a_2Bb" were one anchor
-    return "r-" + urllib.parse.quote(report.display(record_id), safe="").replace("_", "%5F").replace("%", "_")
+    return "r-" + urllib.parse.quote(cells.display(record_id), safe="").replace("_", "%5F").replace("%", "_")
 
 
 def _batch_table(design, anchors, ratios=None) -> list[str]:
@@ -165,86 +158,13 @@ def _batch_table(design, anchors, ratios=None) -> list[str]:
 
 
 def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str]:
+    """The section of one record: its facts, a line per column, its failure and figures."""
     first = rows[0] if rows else {}
     out = [f'<section class="rec" id="{anchor}"><h3>{_e(rid)}</h3>']
     if first:
-        facts = [("file", first.get("file"))]
-        if metadata_text(first):
-            facts.append(("PEER search report", metadata_text(first)))
-        if first.get("file2"):
-            facts.append(("second component", first.get("file2")))
-        if first.get("direction_deg") is not None:
-            facts.append(("direction", f"{_fixed(first['direction_deg'], 1)} deg ({first.get('direction_kind') or ''})"))
-        if _num(first.get("scale")) not in (None, 1.0):
-            facts.append(("scale", first.get("scale")))
-        facts += [
-            ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s "
-                         "(peaks of the record's acceleration and of its velocity after the fitter's "
-                         "baseline correction)"),
-            ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
-                           f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
-                           f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"
-                           + (f": {first['pulse_like_reason']}" if first.get("pulse_like_reason") else "")),
-            ("fitted pulse", f"{first.get('pulse_shape') or '-'}: ap {_fixed(first.get('pulse_ap_g'), 3) or '-'} g, "
-                             f"Tp {_fixed(first.get('pulse_tp_s'), 3) or '-'} s, score {_fixed(first.get('pulse_score'), 2) or '-'} "
-                             f"({first.get('pulse_fit') or '-'} least squares); shapes fitting almost as well (score at least "
-                             f"{FIT_TOLERANCE:g} x the best): "
-                             f"{first.get('shapes_fitting') or '-'}"),
-        ]
-        if first.get("warnings"):
-            facts.append(("warnings", first.get("warnings")))
-        out.append("<dl>" + "".join(f"<dt>{_e(k)}</dt><dd>{_e(v)}</dd>" for k, v in facts) + "</dl>")
+        out.append("<dl>" + "".join(f"<dt>{_e(k)}</dt><dd>{_e(v)}</dd>" for k, v in _facts(first)) + "</dl>")
         out.append("<ul>")
-        for r in rows:
-            governs = f"column {r.get('column')}: governing pulse {pulse_text(r)}"
-            if r.get("governing_shape") and r.get("governing_shape") != first.get("pulse_shape"):
-                governs += (f" (not the best fit, {first.get('pulse_shape')}: of the shapes that fit, "
-                            "the one asking for the widest column by Eq. 31)")
-            parts = [governs,
-                     f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
-                     + (" (below the design width)" if (_num(r.get("eq31_width_m")) or 0) < (_num(r.get("design_width_m")) or 0) else "")
-                     + (" (overturns)" if r.get("eq31_width_overturns") else ""),
-                     f"design width {_fixed(r.get('design_width_m')) or '-'} m"
-                     + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
-                     + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else
-                        " (--limit none: the verge of overturning, no margin)")
-                     + (f" (max theta/alpha {_fixed(r['design_max_theta_ratio'], 2)} there"
-                        + passes_text(r["design_max_theta_ratio"]) + ")"
-                        if _num(r.get("design_max_theta_ratio")) is not None else "")
-                     + _overturning_words(r),
-                     f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
-            if r.get("restitution_values_run") is not None:
-                parts.append(f"restitution {r['restitution']} ({_whole(r.get('restitution_values_run'))} "
-                             f"value(s) run, {r.get('restitution_governing')} governed: "
-                             f"{r.get('restitution_design_widths_m')}); at the design width eta "
-                             f"{_fixed(r.get('design_eta'), 4) or '-'}, r {_fixed(r.get('design_r'), 4) or '-'}")
-            if r.get("check_runs"):
-                share = _num(r.get("failing_share"))
-                parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to "
-                             f"{check_reach_words()} (or the no-uplift width), "
-                             + (f"{100 * share:.2g} % fail, the widest at "
-                                + (failing_text(r.get("widest_failing_width_m"), r.get("search_width_m")) or "-")
-                                + " (the design width lies just above it)"
-                                if share else "none fails"))
-            if r.get("column_kind") == "block":
-                surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
-                                      "design_adequate": r.get("design_adequate"),
-                                      "max_theta_ratio": r.get("max_theta_ratio")})
-                verdict = {"yes": "survives", "NO": "overturns",
-                           "NO: safe island": "NO: survives only on a safe island (narrower than the design width)"}
-                parts.append(f"as it stands: {verdict.get(surv, surv)}"
-                             + ("" if r.get("overturns") else f", max theta/alpha {_fixed(r.get('max_theta_ratio')) or '-'}"))
-                if r.get("vertical_overturns") is not None:
-                    lift = _num(r.get("vertical_t_lift_off_s")) if r.get("vertical_lifts_off") else None
-                    said = ("overturns" if r["vertical_overturns"] else
-                            "survives" if lift is None else
-                            f"lifts off at {lift:.2f} s (the ground falls faster than gravity: the rocking "
-                            "model stops there, no verdict)")
-                    parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): {said}"
-                                 + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}")
-            if r.get("validity"):
-                parts.append(f"model: {r['validity']}")
-            out.append(f"<li>{_e('; '.join(parts))}</li>")
+        out += [f"<li>{_e('; '.join(_row_words(r, first)))}</li>" for r in rows]
         out.append("</ul>")
     if failure:
         out.append(f'<p class="muted">failed ({_e(failure["stage"])}): {_e(failure["reason"])}</p>')
@@ -254,6 +174,97 @@ def _record_section(rid, rows, failure, plot, anchor, friction=None) -> list[str
         out.append(f'<p><a href="{_href(friction)}">the friction its responses need against time</a></p>')
     out.append("</section>")
     return out
+
+
+def _facts(first) -> list[tuple[str, object]]:
+    """``(label, value)`` of what a record's first row says of the record: its file, reading, pulse."""
+    facts = [("file", first.get("file"))]
+    if metadata_text(first):
+        facts.append(("PEER search report", metadata_text(first)))
+    if first.get("file2"):
+        facts.append(("second component", first.get("file2")))
+    if first.get("direction_deg") is not None:
+        facts.append(("direction", f"{_fixed(first['direction_deg'], 1)} deg ({first.get('direction_kind') or ''})"))
+    if _num(first.get("scale")) not in (None, 1.0):
+        facts.append(("scale", first.get("scale")))
+    facts += [
+        ("PGA, PGV", f"{_fixed(first.get('pga_g'), 3) or '-'} g, {_fixed(first.get('pgv_m_s'), 3) or '-'} m/s "
+                     "(peaks of the record's acceleration and of its velocity after the fitter's "
+                     "baseline correction)"),
+        ("pulse-like", f"{_yes(first.get('pulse_like'))} (indicator {_fixed(first.get('velocity_pulse_indicator'), 2) or '-'}, "
+                       f"velocity Tp {_fixed(first.get('velocity_tp_s'), 2) or '-'} s, "
+                       f"orientation {_fixed(first.get('orientation_deg'), 1) or '-'} deg)"
+                       + (f": {first['pulse_like_reason']}" if first.get("pulse_like_reason") else "")),
+        ("fitted pulse", f"{first.get('pulse_shape') or '-'}: ap {_fixed(first.get('pulse_ap_g'), 3) or '-'} g, "
+                         f"Tp {_fixed(first.get('pulse_tp_s'), 3) or '-'} s, score {_fixed(first.get('pulse_score'), 2) or '-'} "
+                         f"({first.get('pulse_fit') or '-'} least squares); shapes fitting almost as well (score at least "
+                         f"{FIT_TOLERANCE:g} x the best): "
+                         f"{first.get('shapes_fitting') or '-'}"),
+    ]
+    if first.get("warnings"):
+        facts.append(("warnings", first.get("warnings")))
+    return facts
+
+
+def _row_words(r, first) -> list[str]:
+    """The parts of the line of one row (one column) of a record whose first row is ``first``."""
+    governs = f"column {r.get('column')}: governing pulse {pulse_text(r)}"
+    if r.get("governing_shape") and r.get("governing_shape") != first.get("pulse_shape"):
+        governs += (f" (not the best fit, {first.get('pulse_shape')}: of the shapes that fit, "
+                    "the one asking for the widest column by Eq. 31)")
+    parts = [governs,
+             f"Eq. 31 width {_fixed(r.get('eq31_width_m')) or '-'} m"
+             + (" (below the design width)" if (_num(r.get("eq31_width_m")) or 0) < (_num(r.get("design_width_m")) or 0) else "")
+             + (" (overturns)" if r.get("eq31_width_overturns") else ""),
+             f"design width {_fixed(r.get('design_width_m')) or '-'} m"
+             + (f" (governed by the {r['design_governed_by']} motion)" if r.get("design_governed_by") else "")
+             + (f" for max theta/alpha <= {r['design_limit']:g}" if _num(r.get("design_limit")) else
+                " (--limit none: the verge of overturning, no margin)")
+             + (f" (max theta/alpha {_fixed(r['design_max_theta_ratio'], 2)} there"
+                + passes_text(r["design_max_theta_ratio"]) + ")"
+                if _num(r.get("design_max_theta_ratio")) is not None else "")
+             + _overturning_words(r),
+             f"search width {_fixed(r.get('search_width_m')) or '-'} m"]
+    if r.get("restitution_values_run") is not None:
+        parts.append(f"restitution {r['restitution']} ({_whole(r.get('restitution_values_run'))} "
+                     f"value(s) run, {r.get('restitution_governing')} governed: "
+                     f"{r.get('restitution_design_widths_m')}); at the design width eta "
+                     f"{_fixed(r.get('design_eta'), 4) or '-'}, r {_fixed(r.get('design_r'), 4) or '-'}")
+    if r.get("check_runs"):
+        share = _num(r.get("failing_share"))
+        parts.append(f"check above the search width: {_whole(r.get('check_runs'))} widths up to "
+                     f"{check_reach_words()} (or the no-uplift width), "
+                     + (f"{100 * share:.2g} % fail, the widest at "
+                        + (failing_text(r.get("widest_failing_width_m"), r.get("search_width_m")) or "-")
+                        + " (the design width lies just above it)"
+                        if share else "none fails"))
+    parts += _as_stands_words(r)
+    if r.get("validity"):
+        parts.append(f"model: {r['validity']}")
+    return parts
+
+
+def _as_stands_words(r) -> list[str]:
+    """The verdicts of a row's column as it stands (without and with the vertical); none for a
+    height only."""
+    if r.get("column_kind") != "block":
+        return []
+    surv = survives_text({"survives": None if r.get("overturns") is None else not r["overturns"],
+                          "design_adequate": r.get("design_adequate"),
+                          "max_theta_ratio": r.get("max_theta_ratio")})
+    verdict = {"yes": "survives", "NO": "overturns",
+               "NO: safe island": "NO: survives only on a safe island (narrower than the design width)"}
+    parts = [f"as it stands: {verdict.get(surv, surv)}"
+             + ("" if r.get("overturns") else f", max theta/alpha {_fixed(r.get('max_theta_ratio')) or '-'}")]
+    if r.get("vertical_overturns") is not None:
+        lift = _num(r.get("vertical_t_lift_off_s")) if r.get("vertical_lifts_off") else None
+        said = ("overturns" if r["vertical_overturns"] else
+                "survives" if lift is None else
+                f"lifts off at {lift:.2f} s (the ground falls faster than gravity: the rocking "
+                "model stops there, no verdict)")
+        parts.append(f"with the vertical ({r.get('vertical_model') or '-'}): {said}"
+                     + f", max theta/alpha {_fixed(r.get('vertical_max_theta_ratio')) or '-'}")
+    return parts
 
 
 def _overturning_words(r) -> str:
@@ -353,10 +364,10 @@ def figures_in(out, record_ids, plots: bool, names: dict) -> dict:
         if (out / rel).is_file():
             found[key] = rel
     for rid in record_ids:
-        rel = report.record_plot_name(rid)
+        rel = outfiles.record_plot_name(rid)
         if (out / rel).is_file():
             found[("record", rid)] = rel
-        rel = report.record_friction_plot_name(rid)
+        rel = outfiles.record_friction_plot_name(rid)
         if (out / rel).is_file():
             found[("friction", rid)] = rel
     return found

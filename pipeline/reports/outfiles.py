@@ -1,17 +1,48 @@
-"""The files ``pipeline run`` writes into ``--out``, listed once: the output checks, the record ids
-(an id never names a file of the run's own), the lock on ``--log``, the clean-up of temporaries and
-the HTML report's figures all read them here.
+"""The files ``pipeline run`` writes into ``--out``, named and listed once: the output checks, the
+record ids (an id never names a file of the run's own), the lock on ``--log``, the clean-up of
+temporaries and the HTML report's figures all read them here.
 """
 from __future__ import annotations
 
-from . import design_table, html_report
-from .report import (COLUMNS_MD, FAILURES, FRAGILITY_CSV, FRAGILITY_CURVE_CSV, FRAGILITY_PLOT, MANIFEST,
-                     PAIRS_CSV, RESUME, SUITE_CSV, SUITE_PLOT, SUMMARY, SUMMARY_PLOT, record_csv_name,
-                     record_friction_plot_name, record_plot_name, record_widths_plot_name)
+#: the manifest in ``--out``: the files ``pipeline run`` wrote there, which alone it replaces or removes
+MANIFEST = "pipeline-manifest.txt"
+#: the resume journal in ``--out`` (:mod:`pipeline.batch.resume`): which records a later run may keep
+RESUME = "pipeline-resume.txt"
+
+SUMMARY, FAILURES, COLUMNS_MD = "summary.csv", "failures.csv", "columns.md"
+SUMMARY_PLOT = "plots/summary.png"
+#: the suite's tables and figures (pipeline.reports.suite: pairs, suite, fragility)
+PAIRS_CSV, SUITE_CSV, FRAGILITY_CSV, FRAGILITY_CURVE_CSV = ("pairs.csv", "suite.csv", "fragility.csv",
+                                                           "fragility_curve.csv")
+SUITE_PLOT, FRAGILITY_PLOT = "plots/suite.png", "plots/fragility.png"
+
+
+def record_csv_name(record_id: str) -> str:
+    """Path of a record's report, relative to the output folder."""
+    return f"{record_id}.csv"
+
+
+def record_plot_name(record_id: str) -> str:
+    """Path of a record's figure, relative to the output folder."""
+    return f"plots/{record_id}.png"
+
+
+def record_widths_plot_name(record_id: str) -> str:
+    """Path of a record's barcode of the widths checked above its search width (a folder of
+    its own: ``plots/<record>_widths.png`` could be another record's figure)."""
+    return f"plots/widths/{record_id}.png"
+
+
+def record_friction_plot_name(record_id: str) -> str:
+    """Path of a record's figure of the friction its responses need (a folder of its own)."""
+    return f"plots/friction/{record_id}.png"
+
+#: the answer in view (pipeline.reports.design_table, pipeline.reports.html_report)
+DESIGN_CSV, REPORT_HTML = "design.csv", "report.html"
 
 
 def site_files(plots: bool, fragility: bool) -> list[str]:
-    """The fixed files of the site part (pipeline.batch.site): pairs, suite and, with ``--fragility``,
+    """The fixed files of the suite (pipeline.reports.suite): pairs, suite and, with ``--fragility``,
     the fragility tables; their figures with ``plots``."""
     files = [PAIRS_CSV, SUITE_CSV]
     if plots:
@@ -23,7 +54,7 @@ def site_files(plots: bool, fragility: bool) -> list[str]:
 
 def answer_files() -> list[str]:
     """The answer in view: ``design.csv`` and ``report.html``."""
-    return [design_table.DESIGN_CSV] + html_report.output_files()
+    return [DESIGN_CSV, REPORT_HTML]
 
 
 #: the files of ``--hazard`` (pipeline.batch.risk)

@@ -23,8 +23,9 @@ import re
 import struct
 import zlib
 
-from ..args import ArgumentError
-from .report import NotOurs, display, write_atomic
+from ..values import ArgumentError
+from .cells import display
+from .files import NotOurs, write_atomic
 
 #: the ``Software`` text chunk of the PNG files this package writes (no version: the bytes of a
 #: figure do not change with it)
@@ -114,7 +115,7 @@ def check_output_file(path, what: str, kind: str, *, inputs=(), reserved=(), com
     description); :class:`ArgumentError` with a one-line reason otherwise.  ``inputs``: the
     command's input files; ``reserved``: files the same run writes itself.  The folder is
     created if needed."""
-    from ..args import output_folder
+    from ..values import output_folder
 
     text = str(path) if path is not None else ""
     if not text.strip():
@@ -151,7 +152,7 @@ def check_file_options(args, command: str, inputs=()) -> None:
 
 def check_output_dir(path, what: str, *, inputs=()) -> pathlib.Path:
     """An output folder (created if needed, writable) that is none of the inputs."""
-    from ..args import output_folder
+    from ..values import output_folder
 
     if path is not None and str(path).strip() and _same(path, [p for p in inputs if p is not None]):
         raise ArgumentError(f"{what} {display(path)} is one of the inputs; name another folder")
@@ -170,7 +171,7 @@ def mark_png(raw: bytes) -> bytes:
 
 def write_output(path, data, kind: str, *, what: str = "output", inputs=()) -> pathlib.Path:
     """Write an output file atomically, unless a file this package did not write is there (or
-    it is an input): :class:`pipeline.reports.report.NotOurs` (an :class:`OSError`) naming it, the file
+    it is an input): :class:`pipeline.reports.files.NotOurs` (an :class:`OSError`) naming it, the file
     left as it is.  PNG data gets this package's mark."""
     path = pathlib.Path(path)
     same = _same(path, inputs)

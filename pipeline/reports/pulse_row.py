@@ -3,7 +3,7 @@ record or pair as ``pipeline classify`` reports it, and the subset ``pipeline ru
 """
 from __future__ import annotations
 
-from .report import Columns
+from .columns import Columns, FLAG, TEXT
 
 #: columns of one row, in order (units in the names)
 COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_tp_s", "pgv_m_s",
@@ -13,7 +13,7 @@ COLUMNS = ["file", "file2", "pulse_like", "velocity_pulse_indicator", "velocity_
 RUN_PULSE_COLUMNS = Columns(
     ("pulse_like", "-", "The record (for a pair: the pair) is pulse-like by Shahi & Baker's (2014) "
                         "velocity-pulse classification (`pulses.classify_pulse`). When it is not, "
-                        "`warnings` notes that Eq. 31 assumes a pulse."),
+                        "`warnings` notes that Eq. 31 assumes a pulse.", FLAG),
     ("velocity_pulse_indicator", "-", "Shahi & Baker's pulse indicator PI (pulse-like when above 0, "
                                       "with an early enough arrival)."),
     ("velocity_tp_s", "s", "Pseudo-period Tp of the extracted velocity pulse."),
@@ -24,7 +24,7 @@ RUN_PULSE_COLUMNS = Columns(
     ("pulse_like_reason", "-", "Why the record is or is not pulse-like: the test of Shahi & Baker's "
                                "that decided (the indicator PI with the residual's shares, or a late "
                                "arrival), and a note where the velocity is one-sided, which their "
-                               "two-sided wavelets fit poorly (`PulseClassification.reason`)."),
+                               "two-sided wavelets fit poorly (`PulseClassification.reason`).", TEXT),
 )
 #: their names
 RUN_COLUMNS = list(RUN_PULSE_COLUMNS.names)

@@ -13,7 +13,7 @@ import pathlib
 
 import numpy as np
 
-from .outpaths import write_output
+from ..outpaths import write_output
 
 #: figure size in inches and resolution: 1100 x 720 pixels
 FIGSIZE, DPI = (11.0, 7.2), 100

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plot_site import DPI, WIDTH_IN, _png
+from .site import DPI, WIDTH_IN, _png
 
 
 def widths_figure(width_rows, risk_rows):

@@ -52,7 +52,7 @@ def friction_png(record_id, frictions, mu=None) -> bytes | None:
     """PNG bytes of :func:`friction_figure`; None without a column."""
     if not frictions:
         return None
-    from .plots import _LOCK
+    from .record import _LOCK
 
     with _LOCK:
         fig = friction_figure(record_id, frictions, mu)

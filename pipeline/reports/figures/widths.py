@@ -9,7 +9,7 @@ import io
 
 import numpy as np
 
-from .design_table import excess_text
+from ..answer import excess_text
 
 #: dots per inch; the figures are 9 in wide: 1350 px
 DPI = 150
