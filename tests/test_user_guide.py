@@ -15,14 +15,10 @@ DOCS = ROOT / "docs"
 #: a worked example starts within this many lines of the page's top
 FIRST_LINES = 40
 
-#: not yet rewritten: the page's lead flips the mark once it is (strict: a page that passes fails
-#: the mark, so the list cannot fall behind the pages)
-_PENDING = "being rewritten on its own branch (margin by default, risk at a site); the lead flips this mark"
+#: the pages a user reads to do a job: each opens with a worked example
 USER_GUIDE = [
-    "records", "fitting", "classification", "solver",
-    pytest.param("design", marks=pytest.mark.xfail(reason=_PENDING, strict=True)),
-    pytest.param("site", marks=pytest.mark.xfail(reason=_PENDING, strict=True)),
-    "peer", "slivers",
+    "records", "fitting", "classification", "solver", "design", "site", "peer", "slivers",
+    "risk", "validity",
 ]
 
 #: what tells history rather than what the package does (case-insensitive).  A station's number
