@@ -300,7 +300,10 @@ def test_report_in_chromium(demo):
     finally:
         probe.unlink()
     assert result["rows"] == _demo_ids()  # every record in the table, in input order
-    assert len(result["images"]) == 5 + 2  # each record's figure, the summary and the suite
+    # each record's figure, the summary, the suite, and the governing record's friction demand
+    # ("Where the rocking model holds")
+    assert len(result["images"]) == 5 + 2 + 1
+    assert sum("plots/friction/" in i["src"] for i in result["images"]) == 1
     failed = [i["src"] for i in result["images"] if not i["ok"]]
     assert failed == [], failed
     assert result["errors"] == []
