@@ -15,14 +15,10 @@ DOCS = ROOT / "docs"
 #: a worked example starts within this many lines of the page's top
 FIRST_LINES = 40
 
-#: not yet rewritten: the page's lead flips the mark once it is (strict: a page that passes fails
-#: the mark, so the list cannot fall behind the pages)
-_PENDING = "being rewritten on its own branch (margin by default, risk at a site); the lead flips this mark"
+#: the pages a user reads to do a job: each opens with a worked example
 USER_GUIDE = [
-    "records", "fitting", "classification", "solver",
-    pytest.param("design", marks=pytest.mark.xfail(reason=_PENDING, strict=True)),
-    pytest.param("site", marks=pytest.mark.xfail(reason=_PENDING, strict=True)),
-    "peer", "slivers",
+    "records", "fitting", "classification", "solver", "design", "site", "peer", "slivers",
+    "risk", "validity",
 ]
 
 #: what tells history rather than what the package does (case-insensitive).  A station's number
@@ -32,7 +28,7 @@ HISTORY = re.compile("|".join([
     r"(?<![\w/])#\d{2,}\b",                  # #34
     r"\b0\.\d+\.(?:\d+|x)\b",                # 0.5.0, 0.1.x
     r"\b0\.\d+'s\b",                         # 0.6's check
-    r"\b(?:before|since|until|after) (?:version )?0\.\d+\b(?![-\d])(?!\s?(?:%|(?:g|s|m|x|rad|Hz|times)\b))",
+    r"\b(?:before|since|until|after) (?:version )?0\.\d{1,2}\b(?![-\d])(?!\s?(?:%|(?:g|s|m|x|rad|Hz|times)\b))",
     r"\bversion \d",
     r"\b(?:earlier|previous|older|old|former) (?:version|release|layout|default|rule|round)s?\b",
     r"\bthe former\b", r"\bformerly\b", r"\bused to\b", r"\bthis round\b", r"\bprevious round\b",
@@ -78,6 +74,8 @@ def test_the_checks_read_what_they_should():
     assert history_mentions("the verified width before 0.5; since issue 34, see #41")
     assert history_mentions("0.3.0's run of the script") and history_mentions("it used to hop")
     assert not history_mentions("El Centro #6 at 0.5 g; before 0.5 s the block rests; since 0.25 %")
+    assert not history_mentions("the rates rise with the level (0.002 at 0.2 after 0.001 at 0.1)")
+    assert history_mentions("as after 0.7, the level") and history_mentions("until 0.10 it did")
     page = "# A page\n\n```{doctest}\n>>> 1 + 1\n2\n```\n"
     assert first_example_line(page) == 5
     assert first_example_line("# A page\n\n```bash\npipeline run x\n```\n") is None
@@ -106,3 +104,44 @@ def test_no_docs_page_tells_history(page):
     CHANGELOG's."""
     found = history_mentions((DOCS / f"{page}.md").read_text(encoding="utf-8"))
     assert not found, f"{page}.md: " + "; ".join(found)
+
+
+def _other_sources():
+    """The rest of what the site and the repository's first page show: the README, and the
+    gallery's scripts and index (their text becomes the gallery's pages)."""
+    yield ROOT / "README.md"
+    yield from sorted((DOCS / "examples").glob("*.py"))
+    yield from sorted((DOCS / "examples").glob("*.rst"))
+
+
+@pytest.mark.parametrize("path", list(_other_sources()), ids=lambda p: p.name)
+def test_readme_and_gallery_tell_no_history(path):
+    found = history_mentions(path.read_text(encoding="utf-8"))
+    assert not found, f"{path.relative_to(ROOT)}: " + "; ".join(found)
+
+
+def _docstrings(package: str):
+    """``(name, docstring)`` of each public name of ``package`` and of its classes' public members:
+    the text of the API reference's pages."""
+    import importlib
+    import inspect
+
+    mod = importlib.import_module(package)
+    for name in mod.__all__:
+        obj = getattr(mod, name)
+        yield f"{package}.{name}", inspect.getdoc(obj) or ""
+        if inspect.isclass(obj):
+            for member, value in vars(obj).items():
+                if member.startswith("_") and member != "__init__":
+                    continue
+                doc = inspect.getdoc(value) if (callable(value) or isinstance(value, property)) else None
+                if doc:
+                    yield f"{package}.{name}.{member}", doc
+
+
+@pytest.mark.parametrize("package", ["pulses", "rocking", "pipeline"])
+def test_api_pages_tell_no_history(package):
+    """The API reference is written from the public names' docstrings: they too say what the code
+    does, not how it came to be."""
+    found = [f"{name}: {hit}" for name, doc in _docstrings(package) for hit in history_mentions(doc)]
+    assert not found, "; ".join(found)
